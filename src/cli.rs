@@ -1,0 +1,493 @@
+//! The command line: clap arguments checked into a job before any pixel is
+//! rendered, the `render`, `info` and `pick` subcommands, progress bars, and
+//! exit codes.
+
+use crate::error::{Error, Result};
+use crate::march::{march, normal};
+use crate::output::{self, Format};
+use crate::render::{render_frame, FrameStats};
+use crate::timeline::{Timeline, ZOOM_TRACK};
+use clap::{Parser, Subcommand};
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use serde::Serialize;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Exit status: success.
+pub const EXIT_OK: u8 = 0;
+/// Exit status: the work failed (a file could not be read or written).
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit status: a command-line argument is wrong (clap uses 2 as well).
+pub const EXIT_USAGE: u8 = 2;
+/// Exit status: the timeline is malformed or invalid.
+pub const EXIT_INVALID_TIMELINE: u8 = 3;
+
+#[derive(Debug, Parser)]
+#[command(
+    name = "mandelreel",
+    version,
+    about = "Render keyframed Mandelbulb timelines (RON) to numbered PNG/EXR frames",
+    after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline.\n\
+                  Timeline format and examples: README.md and timelines/*.ron."
+)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render a timeline to numbered frames, skipping frames already complete and current.
+    Render(RenderArgs),
+    /// Validate a timeline and print its frames, duration, tracks and effects.
+    Info {
+        /// The RON timeline file.
+        timeline: PathBuf,
+    },
+    /// Print the world-space point that the ray through one pixel hits.
+    Pick(PickArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// The RON timeline file.
+    pub timeline: PathBuf,
+    /// Output folder [default: out/<timeline name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Frames to render, half-open like a Rust range: 0..4 is frames 0 to 3; also A.., ..B, or N.
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<String>,
+    /// Override the timeline's output size (nothing else is scaled).
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Quick look: half width and height, one sample per pixel, written to <out>/preview.
+    #[arg(long)]
+    pub preview: bool,
+    /// Output formats, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
+    pub format: Vec<Format>,
+    /// Worker threads [default: all cores]. The image does not depend on it.
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Render every frame even if a current one exists.
+    #[arg(long)]
+    pub force: bool,
+    /// No progress bars or summary; errors still go to stderr.
+    #[arg(long, short)]
+    pub quiet: bool,
+    /// Print distance-estimator evaluations per frame and in total.
+    #[arg(long)]
+    pub stats: bool,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct PickArgs {
+    /// The RON timeline file.
+    pub timeline: PathBuf,
+    /// Frame whose camera and fractal are used.
+    #[arg(long, default_value_t = 0)]
+    pub frame: u32,
+    /// Pixel column and row, from the top-left corner.
+    #[arg(long, value_name = "X,Y")]
+    pub pixel: String,
+    /// Image size the pixel refers to [default: the timeline's].
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Exit code for an error chain: input errors are the user's to fix.
+pub fn exit_code(error: &anyhow::Error) -> u8 {
+    match error.downcast_ref::<Error>() {
+        Some(Error::Usage { .. }) => EXIT_USAGE,
+        Some(e) if e.is_input_error() => EXIT_INVALID_TIMELINE,
+        _ => EXIT_FAILURE,
+    }
+}
+
+pub fn run(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Render(args) => render(args),
+        Command::Info { timeline } => info(&timeline),
+        Command::Pick(args) => pick(args),
+    }
+}
+
+/// Parses `WxH`.
+pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
+    let bad = || Error::usage(option, format!("expected WIDTHxHEIGHT such as 640x360, got {text:?}"));
+    let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
+        return Err(Error::usage(option, format!("width and height must be 1..=32768, got {text:?}")));
+    }
+    Ok((w, h))
+}
+
+/// Parses a half-open frame range (`A..B`, `A..`, `..B` or `N`) against `count` frames.
+pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
+    let bad = |why: String| Error::usage("--frames", why);
+    let number = |s: &str, default: u32| -> Result<u32> {
+        if s.trim().is_empty() {
+            Ok(default)
+        } else {
+            s.trim().parse().map_err(|_| bad(format!("{s:?} is not a frame number")))
+        }
+    };
+    let range = match text.split_once("..") {
+        Some((a, b)) => number(a, 0)?..number(b, count)?,
+        None => {
+            let n = number(text, 0)?;
+            n..n.saturating_add(1)
+        }
+    };
+    if range.start >= range.end {
+        return Err(bad(format!("{text:?} is empty (the range is half-open: 0..4 is frames 0 to 3)")));
+    }
+    if range.end > count {
+        return Err(bad(format!(
+            "{text:?} goes past the last frame: the timeline has {count} frames, 0..{count}"
+        )));
+    }
+    Ok(range)
+}
+
+/// Quotes a path for a POSIX shell when it needs it.
+fn shell_quote(s: &str) -> String {
+    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "/._-+%:=,".contains(c)) {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
+pub fn ffmpeg_command(dir: &Path, name: &str, fps: f64, range: &std::ops::Range<u32>, format: Format) -> String {
+    let input = dir.join(output::frame_pattern(format));
+    let movie = dir.join(format!("{name}.mp4"));
+    // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
+    let trc = if format == Format::Exr { "-apply_trc iec61966_2_1 " } else { "" };
+    format!(
+        "ffmpeg -y -framerate {fps} -start_number {start} {trc}-i {input} -frames:v {count} \
+         -vf pad=ceil(iw/2)*2:ceil(ih/2)*2 -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
+        start = range.start,
+        count = range.end - range.start,
+        input = shell_quote(&input.to_string_lossy()),
+        movie = shell_quote(&movie.to_string_lossy()),
+    )
+}
+
+fn render(args: RenderArgs) -> anyhow::Result<()> {
+    // Everything is checked before the output folder is touched.
+    let timeline = Timeline::load(&args.timeline)?;
+    let (mut width, mut height) = match &args.size {
+        Some(s) => parse_size("--size", s)?,
+        None => (timeline.width, timeline.height),
+    };
+    let range = match &args.frames {
+        Some(f) => parse_frames(f, timeline.frame_count)?,
+        None => 0..timeline.frame_count,
+    };
+    if let Some(n) = args.threads {
+        if n == 0 {
+            return Err(Error::usage("--threads", "must be at least 1").into());
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| Error::usage("--threads", e.to_string()))?;
+    }
+    let mut formats = args.format.clone();
+    formats.dedup();
+    let mut out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(&timeline.name));
+    if args.preview {
+        width = (width / 2).max(1);
+        height = (height / 2).max(1);
+        out_dir = out_dir.join("preview");
+    }
+    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+
+    // Decide which frames need work, so the progress bar and ETA count only those.
+    let mut todo = Vec::new();
+    for frame in range.clone() {
+        let mut scene = timeline.scene_at(frame);
+        if args.preview {
+            scene.samples_per_pixel = 1;
+        }
+        let hash = output::frame_hash(&scene, frame, width, height);
+        let current = !args.force
+            && formats.iter().all(|&f| {
+                output::is_current(&out_dir.join(output::frame_file_name(frame, f)), f, &hash)
+            });
+        if !current {
+            todo.push((frame, scene, hash));
+        }
+    }
+    let total = range.len();
+    let skipped = total - todo.len();
+
+    let show_bars = !args.quiet && std::io::stderr().is_terminal();
+    let log_lines = !args.quiet && !show_bars;
+    let bars = MultiProgress::with_draw_target(if show_bars {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    });
+    let overall = bars.add(ProgressBar::new(todo.len() as u64));
+    overall.set_style(
+        ProgressStyle::with_template("{prefix:>8} [{bar:32}] {pos}/{len} frames  {elapsed_precise}  ETA {eta_precise}")
+            .expect("template is valid")
+            .progress_chars("=> "),
+    );
+    overall.set_prefix("frames");
+    let current = bars.add(ProgressBar::new(height as u64));
+    current.set_style(
+        ProgressStyle::with_template("{prefix:>8} [{bar:32}] {pos}/{len} rows  {msg}")
+            .expect("template is valid")
+            .progress_chars("=> "),
+    );
+    if !args.quiet && skipped > 0 {
+        bars.println(format!(
+            "{skipped} of {total} frames already complete and current in {}; rendering {}",
+            out_dir.display(),
+            todo.len()
+        ))?;
+    }
+
+    let started = Instant::now();
+    let mut totals = FrameStats::default();
+    for (i, (frame, scene, hash)) in todo.iter().enumerate() {
+        current.reset();
+        current.set_prefix(format!("#{frame}"));
+        current.set_message(format!("{width}x{height}"));
+        let t0 = Instant::now();
+        let film = render_frame(scene, *frame, width, height, &|| current.inc(1));
+        for &f in &formats {
+            output::write_frame(&out_dir.join(output::frame_file_name(*frame, f)), f, &film, hash)?;
+        }
+        totals = totals + film.stats;
+        overall.inc(1);
+        let seconds = t0.elapsed().as_secs_f64();
+        if args.stats && !args.quiet {
+            bars.println(format!(
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample), {} of {} samples hit",
+                film.stats.de_evaluations,
+                film.stats.de_evaluations as f64 / film.stats.samples.max(1) as f64,
+                film.stats.hits,
+                film.stats.samples
+            ))?;
+        } else if log_lines {
+            eprintln!("frame {frame} ({}/{}) rendered in {seconds:.2} s", i + 1, todo.len());
+        }
+    }
+    current.finish_and_clear();
+    overall.finish_and_clear();
+
+    if !args.quiet {
+        let elapsed = started.elapsed().as_secs_f64();
+        eprintln!(
+            "{} frames rendered in {elapsed:.1} s ({:.2} s/frame), {skipped} skipped; frames in {}",
+            todo.len(),
+            elapsed / todo.len().max(1) as f64,
+            out_dir.display()
+        );
+        if args.stats {
+            eprintln!("total DE evaluations: {}", totals.de_evaluations);
+        }
+        let video_format = if formats.contains(&Format::Png) { Format::Png } else { Format::Exr };
+        eprintln!("encode the video with:");
+        println!(
+            "{}",
+            ffmpeg_command(&out_dir, &timeline.name, timeline.fps, &range, video_format)
+        );
+    }
+    Ok(())
+}
+
+fn info(path: &Path) -> anyhow::Result<()> {
+    let t = Timeline::load(path)?;
+    let base = &t.base;
+    println!("timeline: {}", path.display());
+    println!(
+        "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {} sample(s) per pixel",
+        t.frame_count,
+        t.fps,
+        t.duration_seconds(),
+        t.width,
+        t.height,
+        base.samples_per_pixel
+    );
+    let f = &base.fractal;
+    let animated_julia = t.tracks.iter().any(|tr| tr.name == "fractal.julia");
+    let mode = match (f.julia, animated_julia) {
+        (_, true) => "Julia mode (constant animated)".to_string(),
+        (Some(k), false) => format!("Julia mode, c = ({}, {}, {})", k.x, k.y, k.z),
+        (None, false) => "Mandelbrot mode".to_string(),
+    };
+    println!(
+        "fractal:  {mode}, formula {}, power {}, {} iterations, bailout {}",
+        f.formula.name(),
+        f.power,
+        f.iterations,
+        f.bailout
+    );
+    if t.tracks.is_empty() {
+        println!("tracks:   none (a still)");
+    } else {
+        println!("tracks:");
+        for tr in &t.tracks {
+            let first = tr.key_times[0];
+            let last = tr.key_times[tr.key_times.len() - 1];
+            let mut line = format!(
+                "  {:<24} {:<10} {} key(s), {first:.3} s .. {last:.3} s",
+                tr.name,
+                format!("{:?}", tr.interpolation),
+                tr.key_times.len()
+            );
+            if tr.name == ZOOM_TRACK {
+                let (a, b) = (tr.sample(first)[0], tr.sample(last)[0]);
+                line += &format!(
+                    "  (log-space zoom {a:.3e} -> {b:.3e}, {:.1} decades)",
+                    (a / b).log10().abs()
+                );
+            }
+            println!("{line}");
+        }
+    }
+    println!("effects:  none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)");
+    println!("output:   out/{}/ by default", t.name);
+    Ok(())
+}
+
+#[derive(Serialize)]
+struct PickReport {
+    frame: u32,
+    pixel: [u32; 2],
+    size: [u32; 2],
+    ray_origin: [f64; 3],
+    ray_direction: [f64; 3],
+    hit: bool,
+    point: Option<[f64; 3]>,
+    distance: Option<f64>,
+    normal: Option<[f64; 3]>,
+    /// Width of the pixel's cone at the hit (or at the far side of the bounding sphere).
+    pixel_footprint: f64,
+    fractal: PickFractal,
+}
+
+#[derive(Serialize)]
+struct PickFractal {
+    formula: &'static str,
+    power: f64,
+    iterations: u32,
+    bailout: f64,
+    julia: Option<[f64; 3]>,
+}
+
+fn pick(args: PickArgs) -> anyhow::Result<()> {
+    let t = Timeline::load(&args.timeline)?;
+    let (width, height) = match &args.size {
+        Some(s) => parse_size("--size", s)?,
+        None => (t.width, t.height),
+    };
+    if args.frame >= t.frame_count {
+        return Err(Error::usage(
+            "--frame",
+            format!("frame {} is past the last frame ({})", args.frame, t.frame_count - 1),
+        )
+        .into());
+    }
+    let bad = || Error::usage("--pixel", format!("expected X,Y inside {width}x{height}, got {:?}", args.pixel));
+    let (x, y) = args.pixel.split_once(',').ok_or_else(bad)?;
+    let (x, y): (u32, u32) = (x.trim().parse().map_err(|_| bad())?, y.trim().parse().map_err(|_| bad())?);
+    if x >= width || y >= height {
+        return Err(bad().into());
+    }
+    let scene = t.scene_at(args.frame);
+    let camera = scene.camera.frame();
+    let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
+    let result = march(&ray, &scene.fractal, &scene.quality);
+    let hit = result.hit.map(|h| (h, normal(&ray, &h, &scene.fractal, &scene.quality).0));
+    let arr = |v: crate::math::DVec3| [v.x, v.y, v.z];
+    let report = PickReport {
+        frame: args.frame,
+        pixel: [x, y],
+        size: [width, height],
+        ray_origin: arr(ray.origin),
+        ray_direction: arr(ray.dir),
+        hit: hit.is_some(),
+        point: hit.map(|(h, _)| arr(h.point)),
+        distance: hit.map(|(h, _)| h.t),
+        normal: hit.map(|(_, n)| arr(n)),
+        pixel_footprint: ray.footprint(hit.map(|(h, _)| h.t).unwrap_or(
+            crate::math::sphere_interval(ray.origin, ray.dir, scene.quality.bounding_radius)
+                .map(|(_, far)| far)
+                .unwrap_or(0.0),
+        )),
+        fractal: PickFractal {
+            formula: scene.fractal.formula.name(),
+            power: scene.fractal.power,
+            iterations: scene.fractal.iterations,
+            bailout: scene.fractal.bailout,
+            julia: scene.fractal.julia.map(arr),
+        },
+    };
+    if args.json {
+        println!("{}", serde_json::to_string(&report)?);
+        return Ok(());
+    }
+    println!("frame {}, pixel ({x}, {y}) of {width}x{height}", args.frame);
+    match hit {
+        Some((h, n)) => {
+            println!("hit:       ({:.12}, {:.12}, {:.12})", h.point.x, h.point.y, h.point.z);
+            println!("distance:  {:.6e} along the ray from the camera", h.t);
+            println!("normal:    ({:.4}, {:.4}, {:.4})", n.x, n.y, n.z);
+            println!("footprint: {:.3e} (one pixel's width there)", report.pixel_footprint);
+            println!(
+                "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
+                h.point.x, h.point.y, h.point.z
+            );
+        }
+        None => println!("miss: the ray leaves the bounding sphere without meeting the fractal"),
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_ranges_are_half_open() {
+        assert_eq!(parse_frames("0..4", 10).unwrap(), 0..4);
+        assert_eq!(parse_frames("3..", 10).unwrap(), 3..10);
+        assert_eq!(parse_frames("..2", 10).unwrap(), 0..2);
+        assert_eq!(parse_frames("7", 10).unwrap(), 7..8);
+        assert!(parse_frames("4..4", 10).is_err());
+        assert!(parse_frames("5..11", 10).unwrap_err().to_string().contains("10 frames"));
+        assert!(parse_frames("a..b", 10).is_err());
+    }
+
+    #[test]
+    fn sizes_parse_and_reject_zero() {
+        assert_eq!(parse_size("--size", "640x360").unwrap(), (640, 360));
+        assert!(parse_size("--size", "0x360").is_err());
+        assert!(parse_size("--size", "640").is_err());
+    }
+
+    #[test]
+    fn ffmpeg_command_has_rate_start_and_count() {
+        let c = ffmpeg_command(Path::new("out/zoom"), "zoom", 24.0, &(10..20), Format::Png);
+        assert!(c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"), "{c}");
+        assert!(c.ends_with("out/zoom/zoom.mp4"));
+        let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
+        assert!(spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"), "{spaced}");
+    }
+}

@@ -1,0 +1,66 @@
+//! The library's one error type, grouped by kind. Every variant says where:
+//! the file with line and column, the field path inside a timeline, or the
+//! path on disk.
+
+use std::path::PathBuf;
+
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// The timeline is not valid RON or does not fit the schema.
+    #[error("{file}:{line}:{column}: {message}")]
+    Syntax {
+        file: PathBuf,
+        line: usize,
+        column: usize,
+        message: String,
+    },
+    /// The timeline parses but a value is unusable.
+    #[error("{file}{}: {path}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    Invalid {
+        file: PathBuf,
+        /// Line of the offending item in the file, where it can be found.
+        line: Option<usize>,
+        /// Field path, e.g. `tracks["camera.position"].keys[3].time`.
+        path: String,
+        message: String,
+    },
+    /// A command-line value is unusable (frame range, size, pixel).
+    #[error("{option}: {message}")]
+    Usage { option: String, message: String },
+    /// Reading or writing a file failed.
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// Encoding or decoding an image failed.
+    #[error("{}: {message}", path.display())]
+    Image { path: PathBuf, message: String },
+}
+
+impl Error {
+    pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
+        Error::Io {
+            path: path.into(),
+            source,
+        }
+    }
+
+    pub fn usage(option: &str, message: impl Into<String>) -> Self {
+        Error::Usage {
+            option: option.to_string(),
+            message: message.into(),
+        }
+    }
+
+    /// True for errors in the user's input (timeline or flags) rather than the machine.
+    pub fn is_input_error(&self) -> bool {
+        matches!(
+            self,
+            Error::Syntax { .. } | Error::Invalid { .. } | Error::Usage { .. }
+        )
+    }
+}
+
+pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -1,0 +1,20 @@
+//! mandelreel: keyframed Mandelbulb films from RON timelines.
+//!
+//! Layers, each depending only on those after it:
+//! `cli → render, output → shade → march → fractal → math`, and `timeline → scene`.
+
+#![forbid(unsafe_code)]
+
+pub mod cli;
+pub mod error;
+pub mod fractal;
+pub mod march;
+pub mod math;
+pub mod output;
+pub mod render;
+pub mod scene;
+pub mod shade;
+pub mod timeline;
+
+/// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.
+pub const RENDERER_REVISION: u32 = 1;

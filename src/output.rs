@@ -1,0 +1,276 @@
+//! Frames on disk: naming, PNG (8-bit sRGB) and EXR (linear half-float RGBA plus
+//! a float Z) writing, write-to-temporary-then-rename, and the content hash that
+//! each file carries in its own metadata so resume can tell a current frame from
+//! a stale one.
+
+use crate::error::{Error, Result};
+use crate::math::linear_to_srgb;
+use crate::render::Film;
+use crate::scene::Scene;
+use serde::Serialize;
+use sha2::{Digest, Sha256};
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+/// Metadata key under which every frame stores the hash of what made it.
+pub const HASH_KEY: &str = "mandelreel-hash";
+/// Metadata key for the frame's render statistics.
+pub const STATS_KEY: &str = "mandelreel-stats";
+/// Digits in frame numbers: `frame_00042.png`.
+pub const FRAME_DIGITS: usize = 5;
+
+/// An output file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Format {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// OpenEXR: linear half-float R, G, B, A and a float Z (camera distance).
+    Exr,
+}
+
+impl Format {
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Exr => "exr",
+        }
+    }
+}
+
+/// `frame_00042.png` for frame 42.
+pub fn frame_file_name(frame_index: u32, format: Format) -> String {
+    format!(
+        "frame_{frame_index:0width$}.{}",
+        format.extension(),
+        width = FRAME_DIGITS
+    )
+}
+
+/// The ffmpeg input pattern matching `frame_file_name`.
+pub fn frame_pattern(format: Format) -> String {
+    format!("frame_%0{FRAME_DIGITS}d.{}", format.extension())
+}
+
+/// The hidden name a frame is written under until it is complete. It never
+/// matches a final frame name, so a leftover one is never taken for a frame.
+pub fn temporary_path(final_path: &Path) -> PathBuf {
+    let name = final_path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    final_path.with_file_name(format!(".{name}.partial"))
+}
+
+/// Hash of everything that decides a frame's pixels: the effective scene, the
+/// frame index (it seeds the sampler), the size and the renderer's revision.
+pub fn frame_hash(scene: &Scene, frame_index: u32, width: u32, height: u32) -> String {
+    #[derive(Serialize)]
+    struct Inputs<'a> {
+        renderer: &'a str,
+        revision: u32,
+        frame_index: u32,
+        width: u32,
+        height: u32,
+        scene: &'a Scene,
+    }
+    let inputs = Inputs {
+        renderer: env!("CARGO_PKG_VERSION"),
+        revision: crate::RENDERER_REVISION,
+        frame_index,
+        width,
+        height,
+        scene,
+    };
+    let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
+    let digest = Sha256::digest(&json);
+    digest.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+/// The hash stored in an existing frame file, if it has one and can be read.
+pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
+    match format {
+        Format::Png => {
+            let file = File::open(path).ok()?;
+            let reader = png::Decoder::new(std::io::BufReader::new(file))
+                .read_info()
+                .ok()?;
+            let info = reader.info();
+            info.uncompressed_latin1_text
+                .iter()
+                .find(|t| t.keyword == HASH_KEY)
+                .map(|t| t.text.clone())
+        }
+        Format::Exr => {
+            let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
+            let header = meta.headers.first()?;
+            match header.own_attributes.other.get(&exr::prelude::Text::from(HASH_KEY))? {
+                exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
+                _ => None,
+            }
+        }
+    }
+}
+
+/// Whether `path` holds a finished frame made from inputs with this `hash`.
+pub fn is_current(path: &Path, format: Format, hash: &str) -> bool {
+    stored_hash(path, format).as_deref() == Some(hash)
+}
+
+/// Writes `film` as `path` in `format`, atomically: the bytes go to a temporary
+/// name in the same folder, are flushed to disk, and only then renamed.
+pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Result<()> {
+    let temp = temporary_path(path);
+    let result = (|| {
+        let file = File::create(&temp).map_err(|e| Error::io(&temp, e))?;
+        let mut writer = BufWriter::new(file);
+        match format {
+            Format::Png => encode_png(&mut writer, film, hash)
+                .map_err(|message| Error::Image { path: temp.clone(), message })?,
+            Format::Exr => encode_exr(&mut writer, film, hash)
+                .map_err(|message| Error::Image { path: temp.clone(), message })?,
+        }
+        let file = writer
+            .into_inner()
+            .map_err(|e| Error::io(&temp, e.into_error()))?;
+        file.sync_all().map_err(|e| Error::io(&temp, e))?;
+        std::fs::rename(&temp, path).map_err(|e| Error::io(path, e))
+    })();
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    result
+}
+
+fn stats_text(film: &Film) -> String {
+    format!(
+        "de_evaluations={} samples={} hits={}",
+        film.stats.de_evaluations, film.stats.samples, film.stats.hits
+    )
+}
+
+fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Result<(), String> {
+    let mut encoder = png::Encoder::new(out, film.width, film.height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    let text = [
+        (HASH_KEY, hash.to_string()),
+        (STATS_KEY, stats_text(film)),
+        ("Software", format!("mandelreel {}", env!("CARGO_PKG_VERSION"))),
+    ];
+    for (key, value) in text {
+        encoder
+            .add_text_chunk(key.to_string(), value)
+            .map_err(|e| e.to_string())?;
+    }
+    let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    let bytes: Vec<u8> = film
+        .colour
+        .iter()
+        .flat_map(|c| [c.x, c.y, c.z])
+        .map(|v| (linear_to_srgb(v) * 255.0 + 0.5) as u8)
+        .collect();
+    writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
+    writer.finish().map_err(|e| e.to_string())
+}
+
+fn encode_exr(
+    out: &mut (impl Write + std::io::Seek),
+    film: &Film,
+    hash: &str,
+) -> std::result::Result<(), String> {
+    use exr::prelude::*;
+    let half = |f: &dyn Fn(usize) -> f32| -> Vec<f16> {
+        (0..film.colour.len()).map(|i| f16::from_f32(f(i))).collect()
+    };
+    let channels = AnyChannels::sort(SmallVec::from_vec(vec![
+        AnyChannel::new("R", FlatSamples::F16(half(&|i| film.colour[i].x))),
+        AnyChannel::new("G", FlatSamples::F16(half(&|i| film.colour[i].y))),
+        AnyChannel::new("B", FlatSamples::F16(half(&|i| film.colour[i].z))),
+        AnyChannel::new("A", FlatSamples::F16(half(&|i| film.alpha[i]))),
+        AnyChannel::new("Z", FlatSamples::F32(film.depth.clone())),
+    ]));
+    let mut attributes = LayerAttributes::named("");
+    attributes.software_name = Some(Text::from(
+        format!("mandelreel {}", env!("CARGO_PKG_VERSION")).as_str(),
+    ));
+    attributes
+        .other
+        .insert(Text::from(HASH_KEY), AttributeValue::Text(Text::from(hash)));
+    attributes.other.insert(
+        Text::from(STATS_KEY),
+        AttributeValue::Text(Text::from(stats_text(film).as_str())),
+    );
+    let layer = Layer::new(
+        (film.width as usize, film.height as usize),
+        attributes,
+        Encoding::FAST_LOSSLESS,
+        channels,
+    );
+    Image::from_layer(layer)
+        .write()
+        .to_buffered(out)
+        .map_err(|e| e.to_string())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::Vec3;
+    use crate::render::FrameStats;
+
+    fn film() -> Film {
+        Film {
+            width: 3,
+            height: 2,
+            colour: vec![Vec3::new(0.0, 0.5, 1.0); 6],
+            alpha: vec![1.0; 6],
+            depth: vec![2.5; 6],
+            stats: FrameStats::default(),
+        }
+    }
+
+    #[test]
+    fn names_are_zero_padded_and_temporaries_hidden() {
+        assert_eq!(frame_file_name(42, Format::Png), "frame_00042.png");
+        assert_eq!(frame_file_name(7, Format::Exr), "frame_00007.exr");
+        let t = temporary_path(Path::new("out/x/frame_00042.png"));
+        assert_eq!(t, Path::new("out/x/.frame_00042.png.partial"));
+    }
+
+    #[test]
+    fn hash_changes_with_any_input() {
+        let s = Scene::default();
+        let h = frame_hash(&s, 0, 4, 3);
+        assert_eq!(h.len(), 64);
+        assert_eq!(h, frame_hash(&s, 0, 4, 3));
+        assert_ne!(h, frame_hash(&s, 1, 4, 3));
+        assert_ne!(h, frame_hash(&s, 0, 5, 3));
+        let mut t = s.clone();
+        t.fractal.power = 8.000001;
+        assert_ne!(h, frame_hash(&t, 0, 4, 3));
+    }
+
+    #[test]
+    fn written_frames_carry_their_hash_and_leave_no_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        for format in [Format::Png, Format::Exr] {
+            let path = dir.path().join(frame_file_name(0, format));
+            write_frame(&path, format, &film(), "abc123").unwrap();
+            assert!(path.exists());
+            assert!(!temporary_path(&path).exists());
+            assert_eq!(stored_hash(&path, format).as_deref(), Some("abc123"));
+            assert!(is_current(&path, format, "abc123"));
+            assert!(!is_current(&path, format, "other"));
+        }
+    }
+
+    #[test]
+    fn a_truncated_file_is_not_current() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frame_00000.png");
+        std::fs::write(&path, b"\x89PNG\r\n\x1a\n").unwrap();
+        assert!(!is_current(&path, Format::Png, "abc"));
+    }
+}

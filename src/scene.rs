@@ -1,0 +1,159 @@
+//! Plain data for one frame: camera, fractal, marcher quality and look. A
+//! timeline produces one `Scene` per frame; the renderer consumes it. Its serde
+//! form is also the timeline's `scene:` block, and its JSON serialisation is
+//! what each frame's content hash is taken over.
+
+use crate::fractal::Fractal;
+use crate::march::{MarchSettings, Ray};
+use crate::math::{normalize_or, DVec3, Real};
+use serde::{Deserialize, Serialize};
+
+/// A pinhole camera.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Camera {
+    pub position: DVec3,
+    pub target: DVec3,
+    /// Approximate up direction; the true up is made perpendicular to the view.
+    pub up: DVec3,
+    /// Rotation about the viewing direction, counter-clockwise as seen by the camera.
+    pub roll_degrees: Real,
+    /// Vertical field of view.
+    pub fov_degrees: Real,
+}
+
+impl Default for Camera {
+    fn default() -> Self {
+        Camera {
+            position: DVec3::new(0.0, 0.6, 2.6),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            roll_degrees: 0.0,
+            fov_degrees: 45.0,
+        }
+    }
+}
+
+/// Orthonormal camera frame with the image-plane half-height.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFrame {
+    pub origin: DVec3,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+    pub tan_half_fov: Real,
+}
+
+impl Camera {
+    /// Builds the camera's orthonormal frame. Validation guarantees position ≠
+    /// target and an up vector not parallel to the view; the fallbacks only keep
+    /// the maths finite.
+    pub fn frame(&self) -> CameraFrame {
+        let forward = normalize_or(self.target - self.position, -DVec3::Z);
+        let mut right = normalize_or(forward.cross(self.up), DVec3::X);
+        let mut up = right.cross(forward);
+        if self.roll_degrees != 0.0 {
+            let (s, c) = self.roll_degrees.to_radians().sin_cos();
+            (right, up) = (right * c + up * s, up * c - right * s);
+        }
+        CameraFrame {
+            origin: self.position,
+            forward,
+            right,
+            up,
+            tan_half_fov: (self.fov_degrees.to_radians() * 0.5).tan(),
+        }
+    }
+}
+
+impl CameraFrame {
+    /// The ray through image position (`x`, `y`) in pixels from the top-left
+    /// corner (pixel centres at +0.5) of a `width`×`height` image.
+    pub fn ray(&self, x: Real, y: Real, width: u32, height: u32) -> Ray {
+        let (w, h) = (width as Real, height as Real);
+        let sx = (2.0 * x / w - 1.0) * self.tan_half_fov * (w / h);
+        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
+        let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+        Ray {
+            origin: self.origin,
+            dir,
+            pixel_angle: 2.0 * self.tan_half_fov / h,
+        }
+    }
+}
+
+/// Everything needed to render one frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Scene {
+    pub camera: Camera,
+    pub fractal: Fractal,
+    pub quality: MarchSettings,
+    pub look: crate::shade::Look,
+    /// Anti-aliasing samples per pixel (1 = one ray through the pixel centre).
+    pub samples_per_pixel: u32,
+    /// Seed of the deterministic sample pattern.
+    pub seed: u64,
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Scene {
+            camera: Camera::default(),
+            fractal: Fractal::default(),
+            quality: MarchSettings::default(),
+            look: crate::shade::Look::default(),
+            samples_per_pixel: 1,
+            seed: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera() -> Camera {
+        Camera {
+            position: DVec3::new(0.0, 0.0, 5.0),
+            target: DVec3::ZERO,
+            up: DVec3::Y,
+            roll_degrees: 0.0,
+            fov_degrees: 90.0,
+        }
+    }
+
+    #[test]
+    fn centre_pixel_looks_at_target() {
+        let f = camera().frame();
+        let r = f.ray(50.0, 25.0, 100, 50);
+        assert!((r.dir - -DVec3::Z).length() < 1e-12);
+        assert!((r.pixel_angle - 2.0 / 50.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn corners_follow_fov_and_aspect() {
+        let f = camera().frame();
+        // fov 90°: the top edge is at 45° up; the right edge at atan(aspect).
+        let top = f.ray(50.0, 0.0, 100, 50);
+        assert!((top.dir.y - (0.5f64).sqrt()).abs() < 1e-12, "{}", top.dir);
+        let right = f.ray(100.0, 25.0, 100, 50);
+        assert!((right.dir.x / -right.dir.z - 2.0).abs() < 1e-12);
+        let left = f.ray(0.0, 25.0, 100, 50);
+        assert!(left.dir.x < 0.0);
+    }
+
+    #[test]
+    fn roll_rotates_the_up_vector() {
+        let rolled = Camera {
+            roll_degrees: 90.0,
+            ..camera()
+        }
+        .frame();
+        // Rolling 90° counter-clockwise turns the image's up towards the world's −x.
+        assert!((rolled.up - -DVec3::X).length() < 1e-12, "{}", rolled.up);
+        let frame = camera().frame();
+        assert!(frame.right.dot(frame.up).abs() < 1e-15);
+        assert!(frame.forward.dot(frame.up).abs() < 1e-15);
+    }
+}

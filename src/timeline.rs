@@ -1,0 +1,780 @@
+//! The RON timeline: its schema, validation with locations, keyframe tracks on
+//! the `splines` crate, and `scene_at(frame)`.
+//!
+//! A track animates one scene parameter by name (`camera.position`,
+//! `fractal.julia`, …). Every component of every parameter is interpolated by
+//! the same scalar spline code; `camera.distance` is interpolated in log space
+//! so a zoom keeps a constant apparent speed over many decades of scale.
+
+use crate::error::{Error, Result};
+use crate::math::{DVec3, Real, Vec3};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use splines::{Key, Spline};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// How a track moves between its keys.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Interpolation {
+    /// Hold each key's value until the next key.
+    Step,
+    /// Straight lines between keys.
+    Linear,
+    /// Catmull–Rom cubic through the keys (the default): smooth paths.
+    CatmullRom,
+    /// Ease in and out of every key (cosine), stopping at each.
+    Smooth,
+}
+
+impl Interpolation {
+    fn spline_mode(self) -> splines::Interpolation<Real, Real> {
+        match self {
+            Interpolation::Step => splines::Interpolation::Step(1.0),
+            Interpolation::Linear => splines::Interpolation::Linear,
+            Interpolation::CatmullRom => splines::Interpolation::CatmullRom,
+            Interpolation::Smooth => splines::Interpolation::Cosine,
+        }
+    }
+}
+
+/// A key's value: a number or a triple such as a position or colour.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum KeyValue {
+    Number(Real),
+    Triple(Real, Real, Real),
+}
+
+impl KeyValue {
+    fn components(&self) -> Vec<Real> {
+        match *self {
+            KeyValue::Number(v) => vec![v],
+            KeyValue::Triple(x, y, z) => vec![x, y, z],
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct KeySpec {
+    time: Real,
+    value: KeyValue,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TrackSpec {
+    #[serde(default)]
+    interpolation: Option<Interpolation>,
+    keys: Vec<KeySpec>,
+}
+
+/// The file as written, before validation.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TimelineFile {
+    fps: Real,
+    #[serde(default)]
+    frames: Option<u32>,
+    #[serde(default)]
+    duration_seconds: Option<Real>,
+    size: (u32, u32),
+    #[serde(default)]
+    scene: Scene,
+    #[serde(default)]
+    tracks: BTreeMap<String, TrackSpec>,
+}
+
+/// Every parameter a track can animate, with its number of components.
+pub const PARAMETERS: &[(&str, usize)] = &[
+    ("camera.position", 3),
+    ("camera.target", 3),
+    ("camera.up", 3),
+    ("camera.roll_degrees", 1),
+    ("camera.fov_degrees", 1),
+    ("camera.distance", 1),
+    ("fractal.power", 1),
+    ("fractal.iterations", 1),
+    ("fractal.bailout", 1),
+    ("fractal.julia", 3),
+    ("quality.hit_threshold", 1),
+    ("quality.fudge", 1),
+    ("quality.max_steps", 1),
+    ("quality.normal_step", 1),
+    ("quality.bounding_radius", 1),
+    ("look.light_direction", 3),
+    ("look.light_colour", 3),
+    ("look.ambient", 3),
+    ("look.base_colour", 3),
+    ("look.trap_x_colour", 3),
+    ("look.trap_y_colour", 3),
+    ("look.trap_z_colour", 3),
+    ("look.trap_occlusion", 1),
+    ("look.background_top", 3),
+    ("look.background_bottom", 3),
+];
+
+/// The track that sets the camera–target distance, interpolated in log space.
+pub const ZOOM_TRACK: &str = "camera.distance";
+
+/// Writes the sampled `values` of parameter `name` into `scene`.
+fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
+    let triple = || DVec3::new(v[0], v[1], v[2]);
+    let colour = || Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+    let count = || v[0].round().clamp(0.0, u32::MAX as Real) as u32;
+    let (c, f, q, l) = (
+        &mut scene.camera,
+        &mut scene.fractal,
+        &mut scene.quality,
+        &mut scene.look,
+    );
+    match name {
+        "camera.position" => c.position = triple(),
+        "camera.target" => c.target = triple(),
+        "camera.up" => c.up = triple(),
+        "camera.roll_degrees" => c.roll_degrees = v[0],
+        "camera.fov_degrees" => c.fov_degrees = v[0],
+        ZOOM_TRACK => {
+            let away = crate::math::normalize_or(c.position - c.target, DVec3::Z);
+            c.position = c.target + away * v[0];
+        }
+        "fractal.power" => f.power = v[0],
+        "fractal.iterations" => f.iterations = count(),
+        "fractal.bailout" => f.bailout = v[0],
+        "fractal.julia" => f.julia = Some(triple()),
+        "quality.hit_threshold" => q.hit_threshold = v[0],
+        "quality.fudge" => q.fudge = v[0],
+        "quality.max_steps" => q.max_steps = count(),
+        "quality.normal_step" => q.normal_step = v[0],
+        "quality.bounding_radius" => q.bounding_radius = v[0],
+        "look.light_direction" => l.light_direction = triple(),
+        "look.light_colour" => l.light_colour = colour(),
+        "look.ambient" => l.ambient = colour(),
+        "look.base_colour" => l.base_colour = colour(),
+        "look.trap_x_colour" => l.trap_x_colour = colour(),
+        "look.trap_y_colour" => l.trap_y_colour = colour(),
+        "look.trap_z_colour" => l.trap_z_colour = colour(),
+        "look.trap_occlusion" => l.trap_occlusion = v[0] as f32,
+        "look.background_top" => l.background_top = colour(),
+        "look.background_bottom" => l.background_bottom = colour(),
+        other => unreachable!("track {other:?} passed validation but has no parameter"),
+    }
+}
+
+/// One validated, ready-to-sample track.
+#[derive(Clone, Debug)]
+pub struct Track {
+    pub name: String,
+    pub interpolation: Interpolation,
+    pub key_times: Vec<Real>,
+    /// One spline per component, over padded keys (see `build_spline`).
+    splines: Vec<Spline<Real, Real>>,
+    /// First and last key values per component, for sampling outside the keys.
+    ends: (Vec<Real>, Vec<Real>),
+    /// Values are stored as logarithms and exponentiated when sampled.
+    log_space: bool,
+}
+
+impl Track {
+    /// The parameter's value at `time_seconds`; held constant outside the keys.
+    pub fn sample(&self, time_seconds: Real) -> Vec<Real> {
+        let first = self.key_times[0];
+        let last = self.key_times[self.key_times.len() - 1];
+        let raw: Vec<Real> = if time_seconds <= first {
+            self.ends.0.clone()
+        } else if time_seconds >= last {
+            self.ends.1.clone()
+        } else {
+            self.splines
+                .iter()
+                .zip(&self.ends.0)
+                .map(|(s, &fallback)| s.sample(time_seconds).unwrap_or(fallback))
+                .collect()
+        };
+        if self.log_space {
+            raw.into_iter().map(Real::exp).collect()
+        } else {
+            raw
+        }
+    }
+}
+
+/// Builds the spline of one component. Phantom keys are mirrored beyond both
+/// ends so Catmull–Rom, which needs a neighbour on each side, covers the first
+/// and last segments too.
+fn build_spline(times: &[Real], values: &[Real], mode: Interpolation) -> Spline<Real, Real> {
+    let m = mode.spline_mode();
+    let mut keys: Vec<Key<Real, Real>> = times
+        .iter()
+        .zip(values)
+        .map(|(&t, &v)| Key::new(t, v, m))
+        .collect();
+    let n = times.len();
+    if n >= 2 {
+        let before = Key::new(
+            2.0 * times[0] - times[1],
+            2.0 * values[0] - values[1],
+            m,
+        );
+        let after = Key::new(
+            2.0 * times[n - 1] - times[n - 2],
+            2.0 * values[n - 1] - values[n - 2],
+            m,
+        );
+        keys.insert(0, before);
+        keys.push(after);
+    }
+    Spline::from_vec(keys)
+}
+
+/// A validated timeline.
+#[derive(Clone, Debug)]
+pub struct Timeline {
+    pub source: PathBuf,
+    /// The file stem; names the default output folder.
+    pub name: String,
+    pub fps: Real,
+    pub frame_count: u32,
+    pub width: u32,
+    pub height: u32,
+    /// The scene before any track is applied.
+    pub base: Scene,
+    pub tracks: Vec<Track>,
+}
+
+impl Timeline {
+    /// Reads, parses and validates a timeline file.
+    pub fn load(path: &Path) -> Result<Timeline> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Timeline::parse(&text, path)
+    }
+
+    /// Parses and validates timeline `text`; `path` is used in messages.
+    pub fn parse(text: &str, path: &Path) -> Result<Timeline> {
+        let options =
+            ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        let file: TimelineFile = options.from_str(text).map_err(|e| Error::Syntax {
+            file: path.to_path_buf(),
+            line: e.span.start.line,
+            column: e.span.start.col,
+            message: e.code.to_string(),
+        })?;
+        let invalid = |line: Option<usize>, field: String, message: String| Error::Invalid {
+            file: path.to_path_buf(),
+            line,
+            path: field,
+            message,
+        };
+        let top = |field: &str, message: String| {
+            invalid(line_of(text, &format!("{field}:"), 0), field.to_string(), message)
+        };
+
+        if !(file.fps.is_finite() && file.fps > 0.0) {
+            return Err(top("fps", format!("must be a positive number, got {}", file.fps)));
+        }
+        let (width, height) = file.size;
+        const MAX_SIDE: u32 = 32_768;
+        if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+            return Err(top(
+                "size",
+                format!("width and height must be 1..={MAX_SIDE}, got ({width}, {height})"),
+            ));
+        }
+        let frame_count = match (file.frames, file.duration_seconds) {
+            (Some(_), Some(_)) => {
+                return Err(top("frames", "give frames or duration_seconds, not both".into()))
+            }
+            (None, None) => {
+                return Err(top("frames", "give frames or duration_seconds".into()))
+            }
+            (Some(0), None) => return Err(top("frames", "must be at least 1".into())),
+            (Some(n), None) => n,
+            (None, Some(d)) => {
+                let n = d * file.fps;
+                if !(d.is_finite() && d > 0.0 && n >= 0.5 && n < u32::MAX as Real) {
+                    return Err(top(
+                        "duration_seconds",
+                        format!("must give at least one frame at {} fps, got {d}", file.fps),
+                    ));
+                }
+                n.round() as u32
+            }
+        };
+        if let Err((field, message)) = validate_scene(&file.scene) {
+            let line = line_of(text, &format!("{}:", field.rsplit('.').next().unwrap_or("")), 0);
+            return Err(invalid(line, format!("scene.{field}"), message));
+        }
+
+        let mut tracks = Vec::new();
+        for (name, spec) in &file.tracks {
+            let track_line = line_of(text, &format!("\"{name}\""), 0);
+            let at = |what: String, key: Option<usize>, message: String| {
+                let line = key
+                    .and_then(|k| nth_line_after(text, &format!("\"{name}\""), "time", k))
+                    .or(track_line);
+                invalid(line, format!("tracks[\"{name}\"]{what}"), message)
+            };
+            let Some(&(_, arity)) = PARAMETERS.iter().find(|(p, _)| p == name) else {
+                let known: Vec<&str> = PARAMETERS.iter().map(|(p, _)| *p).collect();
+                return Err(at(
+                    String::new(),
+                    None,
+                    format!("no such parameter; tracks can animate: {}", known.join(", ")),
+                ));
+            };
+            if spec.keys.is_empty() {
+                return Err(at(".keys".into(), None, "a track needs at least one key".into()));
+            }
+            let log_space = name == ZOOM_TRACK;
+            let mut times = Vec::with_capacity(spec.keys.len());
+            let mut columns = vec![Vec::with_capacity(spec.keys.len()); arity];
+            for (k, key) in spec.keys.iter().enumerate() {
+                if !key.time.is_finite() {
+                    return Err(at(
+                        format!(".keys[{k}].time"),
+                        Some(k),
+                        format!("must be a finite number of seconds, got {}", key.time),
+                    ));
+                }
+                if let Some(&prev) = times.last() {
+                    if key.time <= prev {
+                        return Err(at(
+                            format!(".keys[{k}].time"),
+                            Some(k),
+                            format!("key times must increase: {} follows {prev}", key.time),
+                        ));
+                    }
+                }
+                times.push(key.time);
+                let values = key.value.components();
+                let shape = |n: usize| if n == 1 { "a number".to_string() } else { format!("a triple (x, y, z)") };
+                if values.len() != arity {
+                    return Err(at(
+                        format!(".keys[{k}].value"),
+                        Some(k),
+                        format!("{name} takes {}, got {}", shape(arity), shape(values.len())),
+                    ));
+                }
+                if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
+                    return Err(at(
+                        format!(".keys[{k}].value"),
+                        Some(k),
+                        format!("values must be finite, got {bad}"),
+                    ));
+                }
+                if log_space && values[0] <= 0.0 {
+                    return Err(at(
+                        format!(".keys[{k}].value"),
+                        Some(k),
+                        format!("a camera distance must be positive, got {}", values[0]),
+                    ));
+                }
+                for (column, v) in columns.iter_mut().zip(values) {
+                    column.push(if log_space { v.ln() } else { v });
+                }
+            }
+            let interpolation = spec.interpolation.unwrap_or(Interpolation::CatmullRom);
+            let ends = (
+                columns.iter().map(|c| c[0]).collect(),
+                columns.iter().map(|c| c[c.len() - 1]).collect(),
+            );
+            tracks.push(Track {
+                name: name.clone(),
+                interpolation,
+                splines: columns
+                    .iter()
+                    .map(|c| build_spline(&times, c, interpolation))
+                    .collect(),
+                key_times: times,
+                ends,
+                log_space,
+            });
+        }
+        // The zoom distance acts on the animated position and target, so it goes last.
+        tracks.sort_by_key(|t| t.name == ZOOM_TRACK);
+
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_else(|| "timeline".into());
+        let timeline = Timeline {
+            source: path.to_path_buf(),
+            name,
+            fps: file.fps,
+            frame_count,
+            width,
+            height,
+            base: file.scene,
+            tracks,
+        };
+        // Splines can overshoot their keys: check every frame the tracks produce.
+        for frame in 0..frame_count {
+            if let Err((field, message)) = validate_scene(&timeline.scene_at(frame)) {
+                let animated = timeline
+                    .tracks
+                    .iter()
+                    .filter(|t| field.starts_with(t.name.as_str()) || (t.name == ZOOM_TRACK && field.starts_with("camera")))
+                    .map(|t| format!("\"{}\"", t.name))
+                    .collect::<Vec<_>>();
+                return Err(invalid(
+                    animated.first().and_then(|n| line_of(text, n, 0)),
+                    format!("frame {frame} (t = {:.4} s): scene.{field}", timeline.time_of(frame)),
+                    format!(
+                        "{message}{}",
+                        if animated.is_empty() {
+                            String::new()
+                        } else {
+                            format!(" (set by track {})", animated.join(", "))
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(timeline)
+    }
+
+    /// Time in seconds of frame `frame_index`.
+    pub fn time_of(&self, frame_index: u32) -> Real {
+        frame_index as Real / self.fps
+    }
+
+    /// Length of the sequence in seconds.
+    pub fn duration_seconds(&self) -> Real {
+        self.frame_count as Real / self.fps
+    }
+
+    /// The scene of frame `frame_index`: the base scene with every track applied.
+    pub fn scene_at(&self, frame_index: u32) -> Scene {
+        let time = self.time_of(frame_index);
+        let mut scene = self.base.clone();
+        for track in &self.tracks {
+            apply(&mut scene, &track.name, &track.sample(time));
+        }
+        scene
+    }
+}
+
+/// Checks one frame's scene; on failure returns the field path and the problem.
+pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
+    fn check(ok: bool, field: &str, message: String) -> Result<(), (String, String)> {
+        if ok {
+            Ok(())
+        } else {
+            Err((field.to_string(), message))
+        }
+    }
+    let finite3 = |v: DVec3| v.is_finite();
+    let c = &s.camera;
+    for (field, v) in [
+        ("camera.position", c.position),
+        ("camera.target", c.target),
+        ("camera.up", c.up),
+    ] {
+        check(finite3(v), field, format!("must be finite, got {v}"))?;
+    }
+    check(
+        c.roll_degrees.is_finite(),
+        "camera.roll_degrees",
+        format!("must be finite, got {}", c.roll_degrees),
+    )?;
+    check(
+        c.fov_degrees.is_finite() && c.fov_degrees > 0.0 && c.fov_degrees < 179.0,
+        "camera.fov_degrees",
+        format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
+    )?;
+    let view = c.target - c.position;
+    check(
+        view.length() > 1e-12,
+        "camera.target",
+        "the camera position and target coincide".into(),
+    )?;
+    check(
+        view.normalize().cross(c.up).length() > 1e-9,
+        "camera.up",
+        format!("must not be zero or parallel to the view direction, got {}", c.up),
+    )?;
+    let f = &s.fractal;
+    check(
+        f.power.is_finite() && f.power >= 1.0 && f.power <= 64.0,
+        "fractal.power",
+        format!("must be between 1 and 64, got {}", f.power),
+    )?;
+    check(
+        (1..=10_000).contains(&f.iterations),
+        "fractal.iterations",
+        format!("must be 1..=10000, got {}", f.iterations),
+    )?;
+    check(
+        f.bailout.is_finite() && f.bailout > 1.0,
+        "fractal.bailout",
+        format!("must be a finite number above 1, got {}", f.bailout),
+    )?;
+    if let Some(k) = f.julia {
+        check(finite3(k), "fractal.julia", format!("must be finite, got {k}"))?;
+    }
+    let q = &s.quality;
+    for (field, v) in [
+        ("quality.hit_threshold", q.hit_threshold),
+        ("quality.normal_step", q.normal_step),
+        ("quality.bounding_radius", q.bounding_radius),
+    ] {
+        check(
+            v.is_finite() && v > 0.0,
+            field,
+            format!("must be a positive number, got {v}"),
+        )?;
+    }
+    check(
+        q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
+        "quality.fudge",
+        format!("must be in (0, 1], got {}", q.fudge),
+    )?;
+    check(
+        (1..=1_000_000).contains(&q.max_steps),
+        "quality.max_steps",
+        format!("must be 1..=1000000, got {}", q.max_steps),
+    )?;
+    check(
+        (1..=4096).contains(&s.samples_per_pixel),
+        "samples_per_pixel",
+        format!("must be 1..=4096, got {}", s.samples_per_pixel),
+    )?;
+    let l = &s.look;
+    check(
+        finite3(l.light_direction) && l.light_direction.length() > 0.0,
+        "look.light_direction",
+        format!("must be a finite non-zero vector, got {}", l.light_direction),
+    )?;
+    for (field, v) in [
+        ("look.light_colour", l.light_colour),
+        ("look.ambient", l.ambient),
+        ("look.base_colour", l.base_colour),
+        ("look.trap_x_colour", l.trap_x_colour),
+        ("look.trap_y_colour", l.trap_y_colour),
+        ("look.trap_z_colour", l.trap_z_colour),
+        ("look.background_top", l.background_top),
+        ("look.background_bottom", l.background_bottom),
+    ] {
+        check(
+            v.is_finite() && v.min_element() >= 0.0,
+            field,
+            format!("colours must be finite and non-negative, got {v}"),
+        )?;
+    }
+    check(
+        l.trap_occlusion.is_finite() && (0.0..=1.0).contains(&l.trap_occlusion),
+        "look.trap_occlusion",
+        format!("must be in [0, 1], got {}", l.trap_occlusion),
+    )?;
+    Ok(())
+}
+
+/// 1-based line of the first occurrence of `needle` at or after byte `from`.
+fn line_of(text: &str, needle: &str, from: usize) -> Option<usize> {
+    let at = from + text.get(from..)?.find(needle)?;
+    Some(text[..at].matches('\n').count() + 1)
+}
+
+/// Line of the `k`-th (0-based) `word` after the first `anchor`: locates a key inside a track.
+fn nth_line_after(text: &str, anchor: &str, word: &str, k: usize) -> Option<usize> {
+    let mut at = text.find(anchor)?;
+    for _ in 0..=k {
+        at += text[at..].find(word)? + word.len();
+    }
+    line_of(text, word, at - word.len())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Timeline> {
+        Timeline::parse(text, Path::new("test.ron"))
+    }
+
+    const MINIMAL: &str = "(fps: 10, frames: 11, size: (8, 6))";
+
+    fn with_track(track: &str) -> String {
+        format!("(fps: 10, frames: 11, size: (8, 6), tracks: {{ {track} }})")
+    }
+
+    #[test]
+    fn minimal_timeline_uses_defaults() {
+        let t = parse(MINIMAL).unwrap();
+        assert_eq!(t.frame_count, 11);
+        assert_eq!((t.width, t.height), (8, 6));
+        assert_eq!(t.scene_at(5), Scene::default());
+    }
+
+    #[test]
+    fn duration_gives_frame_count() {
+        let t = parse("(fps: 24, duration_seconds: 2.5, size: (8, 6))").unwrap();
+        assert_eq!(t.frame_count, 60);
+    }
+
+    fn sample(track: &str, time: Real) -> Vec<Real> {
+        let t = parse(&with_track(track)).unwrap();
+        t.tracks[0].sample(time)
+    }
+
+    const KEYS: &str = "keys: [(time: 0, value: 1), (time: 0.5, value: 3), (time: 1, value: 2)]";
+
+    #[test]
+    fn every_mode_passes_through_its_keys() {
+        for mode in ["Step", "Linear", "CatmullRom", "Smooth"] {
+            let track = format!("\"fractal.power\": (interpolation: {mode}, {KEYS})");
+            for (time, value) in [(0.0, 1.0), (0.5, 3.0), (1.0, 2.0)] {
+                assert_eq!(sample(&track, time), vec![value], "{mode} at {time}");
+            }
+            // Held constant outside the keys.
+            assert_eq!(sample(&track, -1.0), vec![1.0]);
+            assert_eq!(sample(&track, 9.0), vec![2.0]);
+        }
+    }
+
+    #[test]
+    fn modes_between_keys() {
+        let at = |mode: &str, time: Real| {
+            sample(&format!("\"fractal.power\": (interpolation: {mode}, {KEYS})"), time)[0]
+        };
+        assert_eq!(at("Step", 0.25), 1.0);
+        assert_eq!(at("Step", 0.75), 3.0);
+        assert!((at("Linear", 0.25) - 2.0).abs() < 1e-12);
+        assert!((at("Linear", 0.75) - 2.5).abs() < 1e-12);
+        // Smooth: the cosine ease is at the midpoint halfway, and slow near keys.
+        assert!((at("Smooth", 0.25) - 2.0).abs() < 1e-12);
+        assert!(at("Smooth", 0.05) - 1.0 < 0.3 * (at("Linear", 0.05) - 1.0));
+        // Catmull–Rom overshoots the peak at 3 between 0.5 and 1 before settling to 2.
+        let c = at("CatmullRom", 0.55);
+        assert!(c > 3.0 && c < 3.5, "{c}");
+        // With two keys, Catmull–Rom over mirrored end keys is a straight line.
+        let two = "\"fractal.power\": (keys: [(time: 0, value: 2), (time: 2, value: 6)])";
+        assert!((sample(two, 0.5)[0] - 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn triples_interpolate_per_component() {
+        let track = "\"camera.position\": (interpolation: Linear, keys: [(time: 0, value: (0, 0, 4)), (time: 1, value: (2, -2, 2))])";
+        assert_eq!(sample(track, 0.5), vec![1.0, -1.0, 3.0]);
+    }
+
+    #[test]
+    fn zoom_distance_interpolates_in_log_space() {
+        let track = "\"camera.distance\": (interpolation: Linear, keys: [(time: 0, value: 1), (time: 1, value: 0.0001)])";
+        // Linear in log space: every tenth of the time divides distance by the same factor.
+        for i in 0..=10 {
+            let t = i as Real / 10.0;
+            let expect = 10f64.powf(-4.0 * t);
+            let got = sample(track, t)[0];
+            assert!((got / expect - 1.0).abs() < 1e-9, "t={t}: {got} vs {expect}");
+        }
+        // And it moves the camera towards the target along the current view line.
+        let t = parse(&with_track(track)).unwrap();
+        let s = t.scene_at(5);
+        let d = (s.camera.position - s.camera.target).length();
+        assert!((d - 1e-2).abs() < 1e-12);
+        let dir = (s.camera.position - s.camera.target).normalize();
+        let base = (t.base.camera.position - t.base.camera.target).normalize();
+        assert!((dir - base).length() < 1e-12);
+    }
+
+    #[test]
+    fn julia_track_switches_to_julia_mode() {
+        let t = parse(&with_track(
+            "\"fractal.julia\": (keys: [(time: 0, value: (0.1, 0.2, 0.3)), (time: 1, value: (0.3, 0.2, 0.1))])",
+        ))
+        .unwrap();
+        assert_eq!(t.scene_at(0).fractal.julia, Some(DVec3::new(0.1, 0.2, 0.3)));
+        assert_eq!(t.scene_at(10).fractal.julia, Some(DVec3::new(0.3, 0.2, 0.1)));
+    }
+
+    fn error_of(text: &str) -> String {
+        parse(text).expect_err("timeline should be rejected").to_string()
+    }
+
+    #[test]
+    fn syntax_error_names_line_and_column() {
+        let e = error_of("(\n  fps: 24,\n  frames: 3\n  size: (8, 6),\n)");
+        assert!(e.starts_with("test.ron:4:"), "{e}");
+    }
+
+    #[test]
+    fn unknown_field_is_rejected_with_its_name() {
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (camra: ()))");
+        assert!(e.contains("camra") && e.starts_with("test.ron:1:"), "{e}");
+    }
+
+    #[test]
+    fn wrong_type_is_rejected() {
+        let e = error_of("(fps: \"fast\", frames: 3, size: (8, 6))");
+        assert!(e.starts_with("test.ron:1:"), "{e}");
+    }
+
+    #[test]
+    fn nan_and_inf_are_rejected() {
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: NaN)))");
+        assert!(e.contains("scene.fractal.power"), "{e}");
+        let e = error_of(&with_track("\"fractal.power\": (keys: [(time: 0, value: inf)])"));
+        assert!(e.contains("tracks[\"fractal.power\"].keys[0].value") && e.contains("finite"), "{e}");
+        let e = error_of("(fps: inf, frames: 3, size: (8, 6))");
+        assert!(e.contains("fps"), "{e}");
+    }
+
+    #[test]
+    fn non_increasing_key_times_name_the_key_and_line() {
+        let text = "(fps: 10, frames: 3, size: (8, 6), tracks: {\n  \"fractal.power\": (keys: [\n    (time: 0, value: 8),\n    (time: 1, value: 7),\n    (time: 1, value: 6),\n  ]),\n})";
+        let e = error_of(text);
+        assert!(e.starts_with("test.ron:5: tracks[\"fractal.power\"].keys[2].time"), "{e}");
+    }
+
+    #[test]
+    fn non_positive_fps_size_fov_are_rejected() {
+        assert!(error_of("(fps: 0, frames: 3, size: (8, 6))").contains("fps"));
+        assert!(error_of("(fps: -24, frames: 3, size: (8, 6))").contains("fps"));
+        assert!(error_of("(fps: 24, frames: 3, size: (0, 6))").contains("size"));
+        assert!(error_of("(fps: 24, frames: 0, size: (8, 6))").contains("frames"));
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (camera: (fov_degrees: 0)))");
+        assert!(e.contains("scene.camera.fov_degrees"), "{e}");
+        let e = error_of(&with_track(
+            "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: -3)])",
+        ));
+        assert!(e.contains("frame") && e.contains("camera.fov_degrees"), "{e}");
+    }
+
+    #[test]
+    fn empty_and_unknown_tracks_are_rejected() {
+        let e = error_of(&with_track("\"fractal.power\": (keys: [])"));
+        assert!(e.contains("tracks[\"fractal.power\"].keys") && e.contains("at least one"), "{e}");
+        let e = error_of(&with_track("\"fractal.pwer\": (keys: [(time: 0, value: 1)])"));
+        assert!(e.contains("fractal.pwer") && e.contains("fractal.power"), "{e}");
+    }
+
+    #[test]
+    fn wrong_arity_and_bad_zoom_distance_are_rejected() {
+        let e = error_of(&with_track("\"camera.position\": (keys: [(time: 0, value: 2)])"));
+        assert!(e.contains("triple"), "{e}");
+        let e = error_of(&with_track("\"camera.distance\": (keys: [(time: 0, value: 0)])"));
+        assert!(e.contains("positive"), "{e}");
+    }
+
+    #[test]
+    fn overshoot_caught_per_frame() {
+        // Catmull–Rom overshoots below 1 between these keys; iterations must stay ≥ 1.
+        let e = error_of(&with_track(
+            "\"fractal.bailout\": (keys: [(time: 0, value: 4), (time: 0.5, value: 1.01), (time: 0.6, value: 50)])",
+        ));
+        assert!(e.contains("fractal.bailout") && e.contains("set by track"), "{e}");
+    }
+
+    #[test]
+    fn every_parameter_name_applies() {
+        for &(name, arity) in PARAMETERS {
+            let mut scene = Scene::default();
+            let before = scene.clone();
+            let v = vec![0.25; arity];
+            apply(&mut scene, name, &v);
+            assert_ne!(scene, before, "{name} changed nothing");
+        }
+    }
+}
