@@ -47,6 +47,26 @@ pub enum Command {
     },
     /// Print the world-space point that the ray through one pixel hits.
     Pick(PickArgs),
+    /// Tile rendered PNG frames from a folder into one contact-sheet image.
+    Sheet(SheetArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct SheetArgs {
+    /// Folder holding frame_NNNNN.png files.
+    pub dir: PathBuf,
+    /// Number of frames to show, evenly spaced over the sequence (first and last included).
+    #[arg(long, default_value_t = 12)]
+    pub count: usize,
+    /// Thumbnails per row.
+    #[arg(long, default_value_t = 4)]
+    pub columns: u32,
+    /// Width of each thumbnail in pixels.
+    #[arg(long, default_value_t = 240)]
+    pub thumb_width: u32,
+    /// Where to write the sheet [default: <dir>/sheet.png].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -114,16 +134,28 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render(args),
         Command::Info { timeline } => info(&timeline),
         Command::Pick(args) => pick(args),
+        Command::Sheet(args) => sheet(args),
     }
 }
 
 /// Parses `WxH`.
 pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
-    let bad = || Error::usage(option, format!("expected WIDTHxHEIGHT such as 640x360, got {text:?}"));
+    let bad = || {
+        Error::usage(
+            option,
+            format!("expected WIDTHxHEIGHT such as 640x360, got {text:?}"),
+        )
+    };
     let (w, h) = text.split_once(['x', 'X']).ok_or_else(bad)?;
-    let (w, h): (u32, u32) = (w.trim().parse().map_err(|_| bad())?, h.trim().parse().map_err(|_| bad())?);
+    let (w, h): (u32, u32) = (
+        w.trim().parse().map_err(|_| bad())?,
+        h.trim().parse().map_err(|_| bad())?,
+    );
     if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
-        return Err(Error::usage(option, format!("width and height must be 1..=32768, got {text:?}")));
+        return Err(Error::usage(
+            option,
+            format!("width and height must be 1..=32768, got {text:?}"),
+        ));
     }
     Ok((w, h))
 }
@@ -135,7 +167,9 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
         if s.trim().is_empty() {
             Ok(default)
         } else {
-            s.trim().parse().map_err(|_| bad(format!("{s:?} is not a frame number")))
+            s.trim()
+                .parse()
+                .map_err(|_| bad(format!("{s:?} is not a frame number")))
         }
     };
     let range = match text.split_once("..") {
@@ -146,7 +180,9 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
         }
     };
     if range.start >= range.end {
-        return Err(bad(format!("{text:?} is empty (the range is half-open: 0..4 is frames 0 to 3)")));
+        return Err(bad(format!(
+            "{text:?} is empty (the range is half-open: 0..4 is frames 0 to 3)"
+        )));
     }
     if range.end > count {
         return Err(bad(format!(
@@ -158,7 +194,10 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
 
 /// Quotes a path for a POSIX shell when it needs it.
 fn shell_quote(s: &str) -> String {
-    if !s.is_empty() && s.chars().all(|c| c.is_ascii_alphanumeric() || "/._-+%:=,".contains(c)) {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-+%:=,".contains(c))
+    {
         s.to_string()
     } else {
         format!("'{}'", s.replace('\'', r"'\''"))
@@ -166,14 +205,24 @@ fn shell_quote(s: &str) -> String {
 }
 
 /// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
-pub fn ffmpeg_command(dir: &Path, name: &str, fps: f64, range: &std::ops::Range<u32>, format: Format) -> String {
+pub fn ffmpeg_command(
+    dir: &Path,
+    name: &str,
+    fps: f64,
+    range: &std::ops::Range<u32>,
+    format: Format,
+) -> String {
     let input = dir.join(output::frame_pattern(format));
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
-    let trc = if format == Format::Exr { "-apply_trc iec61966_2_1 " } else { "" };
+    let trc = if format == Format::Exr {
+        "-apply_trc iec61966_2_1 "
+    } else {
+        ""
+    };
     format!(
         "ffmpeg -y -framerate {fps} -start_number {start} {trc}-i {input} -frames:v {count} \
-         -vf pad=ceil(iw/2)*2:ceil(ih/2)*2 -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
+         -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
         start = range.start,
         count = range.end - range.start,
         input = shell_quote(&input.to_string_lossy()),
@@ -242,9 +291,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     });
     let overall = bars.add(ProgressBar::new(todo.len() as u64));
     overall.set_style(
-        ProgressStyle::with_template("{prefix:>8} [{bar:32}] {pos}/{len} frames  {elapsed_precise}  ETA {eta_precise}")
-            .expect("template is valid")
-            .progress_chars("=> "),
+        ProgressStyle::with_template(
+            "{prefix:>8} [{bar:32}] {pos}/{len} frames  {elapsed_precise}  ETA {eta_precise}",
+        )
+        .expect("template is valid")
+        .progress_chars("=> "),
     );
     overall.set_prefix("frames");
     let current = bars.add(ProgressBar::new(height as u64));
@@ -253,12 +304,20 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             .expect("template is valid")
             .progress_chars("=> "),
     );
+    // Lines printed above the bars when they show, plainly to stderr otherwise.
+    let say = |line: String| {
+        if show_bars {
+            let _ = bars.println(line);
+        } else {
+            eprintln!("{line}");
+        }
+    };
     if !args.quiet && skipped > 0 {
-        bars.println(format!(
+        say(format!(
             "{skipped} of {total} frames already complete and current in {}; rendering {}",
             out_dir.display(),
             todo.len()
-        ))?;
+        ));
     }
 
     let started = Instant::now();
@@ -270,21 +329,30 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let film = render_frame(scene, *frame, width, height, &|| current.inc(1));
         for &f in &formats {
-            output::write_frame(&out_dir.join(output::frame_file_name(*frame, f)), f, &film, hash)?;
+            output::write_frame(
+                &out_dir.join(output::frame_file_name(*frame, f)),
+                f,
+                &film,
+                hash,
+            )?;
         }
         totals = totals + film.stats;
         overall.inc(1);
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
-            bars.println(format!(
+            say(format!(
                 "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample), {} of {} samples hit",
                 film.stats.de_evaluations,
                 film.stats.de_evaluations as f64 / film.stats.samples.max(1) as f64,
                 film.stats.hits,
                 film.stats.samples
-            ))?;
+            ));
         } else if log_lines {
-            eprintln!("frame {frame} ({}/{}) rendered in {seconds:.2} s", i + 1, todo.len());
+            eprintln!(
+                "frame {frame} ({}/{}) rendered in {seconds:.2} s",
+                i + 1,
+                todo.len()
+            );
         }
     }
     current.finish_and_clear();
@@ -301,7 +369,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         if args.stats {
             eprintln!("total DE evaluations: {}", totals.de_evaluations);
         }
-        let video_format = if formats.contains(&Format::Png) { Format::Png } else { Format::Exr };
+        let video_format = if formats.contains(&Format::Png) {
+            Format::Png
+        } else {
+            Format::Exr
+        };
         eprintln!("encode the video with:");
         println!(
             "{}",
@@ -361,7 +433,9 @@ fn info(path: &Path) -> anyhow::Result<()> {
             println!("{line}");
         }
     }
-    println!("effects:  none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)");
+    println!(
+        "effects:  none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
+    );
     println!("output:   out/{}/ by default", t.name);
     Ok(())
 }
@@ -400,13 +474,25 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
     if args.frame >= t.frame_count {
         return Err(Error::usage(
             "--frame",
-            format!("frame {} is past the last frame ({})", args.frame, t.frame_count - 1),
+            format!(
+                "frame {} is past the last frame ({})",
+                args.frame,
+                t.frame_count - 1
+            ),
         )
         .into());
     }
-    let bad = || Error::usage("--pixel", format!("expected X,Y inside {width}x{height}, got {:?}", args.pixel));
+    let bad = || {
+        Error::usage(
+            "--pixel",
+            format!("expected X,Y inside {width}x{height}, got {:?}", args.pixel),
+        )
+    };
     let (x, y) = args.pixel.split_once(',').ok_or_else(bad)?;
-    let (x, y): (u32, u32) = (x.trim().parse().map_err(|_| bad())?, y.trim().parse().map_err(|_| bad())?);
+    let (x, y): (u32, u32) = (
+        x.trim().parse().map_err(|_| bad())?,
+        y.trim().parse().map_err(|_| bad())?,
+    );
     if x >= width || y >= height {
         return Err(bad().into());
     }
@@ -414,7 +500,9 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
     let camera = scene.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
     let result = march(&ray, &scene.fractal, &scene.quality);
-    let hit = result.hit.map(|h| (h, normal(&ray, &h, &scene.fractal, &scene.quality).0));
+    let hit = result
+        .hit
+        .map(|h| (h, normal(&ray, &h, &scene.fractal, &scene.quality).0));
     let arr = |v: crate::math::DVec3| [v.x, v.y, v.z];
     let report = PickReport {
         frame: args.frame,
@@ -426,11 +514,13 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         point: hit.map(|(h, _)| arr(h.point)),
         distance: hit.map(|(h, _)| h.t),
         normal: hit.map(|(_, n)| arr(n)),
-        pixel_footprint: ray.footprint(hit.map(|(h, _)| h.t).unwrap_or(
-            crate::math::sphere_interval(ray.origin, ray.dir, scene.quality.bounding_radius)
-                .map(|(_, far)| far)
-                .unwrap_or(0.0),
-        )),
+        pixel_footprint: ray.footprint(
+            hit.map(|(h, _)| h.t).unwrap_or(
+                crate::math::sphere_interval(ray.origin, ray.dir, scene.quality.bounding_radius)
+                    .map(|(_, far)| far)
+                    .unwrap_or(0.0),
+            ),
+        ),
         fractal: PickFractal {
             formula: scene.fractal.formula.name(),
             power: scene.fractal.power,
@@ -446,10 +536,16 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
     println!("frame {}, pixel ({x}, {y}) of {width}x{height}", args.frame);
     match hit {
         Some((h, n)) => {
-            println!("hit:       ({:.12}, {:.12}, {:.12})", h.point.x, h.point.y, h.point.z);
+            println!(
+                "hit:       ({:.12}, {:.12}, {:.12})",
+                h.point.x, h.point.y, h.point.z
+            );
             println!("distance:  {:.6e} along the ray from the camera", h.t);
             println!("normal:    ({:.4}, {:.4}, {:.4})", n.x, n.y, n.z);
-            println!("footprint: {:.3e} (one pixel's width there)", report.pixel_footprint);
+            println!(
+                "footprint: {:.3e} (one pixel's width there)",
+                report.pixel_footprint
+            );
             println!(
                 "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
                 h.point.x, h.point.y, h.point.z
@@ -457,6 +553,30 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         }
         None => println!("miss: the ray leaves the bounding sphere without meeting the fractal"),
     }
+    Ok(())
+}
+
+fn sheet(args: SheetArgs) -> anyhow::Result<()> {
+    if args.count == 0 || args.columns == 0 || args.thumb_width == 0 {
+        return Err(Error::usage("--count/--columns/--thumb-width", "must be at least 1").into());
+    }
+    let frames = output::frame_files(&args.dir, Format::Png)?;
+    if frames.is_empty() {
+        return Err(Error::usage(
+            "DIR",
+            format!("no frame_NNNNN.png files in {}", args.dir.display()),
+        )
+        .into());
+    }
+    let shown = output::evenly_spaced(&frames, args.count);
+    let out = args.out.unwrap_or_else(|| args.dir.join("sheet.png"));
+    output::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
+    println!(
+        "{} frames of {} tiled into {}",
+        shown.len(),
+        frames.len(),
+        out.display()
+    );
     Ok(())
 }
 
@@ -471,7 +591,10 @@ mod tests {
         assert_eq!(parse_frames("..2", 10).unwrap(), 0..2);
         assert_eq!(parse_frames("7", 10).unwrap(), 7..8);
         assert!(parse_frames("4..4", 10).is_err());
-        assert!(parse_frames("5..11", 10).unwrap_err().to_string().contains("10 frames"));
+        assert!(parse_frames("5..11", 10)
+            .unwrap_err()
+            .to_string()
+            .contains("10 frames"));
         assert!(parse_frames("a..b", 10).is_err());
     }
 
@@ -485,9 +608,15 @@ mod tests {
     #[test]
     fn ffmpeg_command_has_rate_start_and_count() {
         let c = ffmpeg_command(Path::new("out/zoom"), "zoom", 24.0, &(10..20), Format::Png);
-        assert!(c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"), "{c}");
+        assert!(
+            c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"),
+            "{c}"
+        );
         assert!(c.ends_with("out/zoom/zoom.mp4"));
         let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
-        assert!(spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"), "{spaced}");
+        assert!(
+            spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),
+            "{spaced}"
+        );
     }
 }

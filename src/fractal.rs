@@ -187,13 +187,22 @@ mod tests {
         let sq = |z: DVec3, f: Formula| triplex_power(f, z, z.length(), 2.0);
         // White–Nylander: (x > 0, 0, z) with z the real part, x the imaginary.
         let w = sq(DVec3::new(a, 0.0, b), Formula::WhiteNylander);
-        assert!((w - DVec3::new(2.0 * a * b, 0.0, b * b - a * a)).length() < 1e-12, "{w}");
+        assert!(
+            (w - DVec3::new(2.0 * a * b, 0.0, b * b - a * a)).length() < 1e-12,
+            "{w}"
+        );
         // Quilez: (0, y, z > 0) with y the real part, z the imaginary.
         let w = sq(DVec3::new(0.0, b, a), Formula::Quilez);
-        assert!((w - DVec3::new(0.0, b * b - a * a, 2.0 * a * b)).length() < 1e-12, "{w}");
+        assert!(
+            (w - DVec3::new(0.0, b * b - a * a, 2.0 * a * b)).length() < 1e-12,
+            "{w}"
+        );
         // Asin: the plane z = 0, x real and y imaginary.
         let w = sq(DVec3::new(a, b, 0.0), Formula::Asin);
-        assert!((w - DVec3::new(a * a - b * b, 2.0 * a * b, 0.0)).length() < 1e-12, "{w}");
+        assert!(
+            (w - DVec3::new(a * a - b * b, 2.0 * a * b, 0.0)).length() < 1e-12,
+            "{w}"
+        );
     }
 
     #[test]
@@ -224,7 +233,12 @@ mod tests {
             let far = bulb(f).estimate(DVec3::new(0.0, 10.0, 0.0));
             assert!(far.distance.is_finite() && far.distance > 0.0);
             for &radius in &[1.3, 2.0, 3.0] {
-                for dir in [DVec3::X, DVec3::Y, DVec3::Z, DVec3::new(1.0, -2.0, 0.5).normalize()] {
+                for dir in [
+                    DVec3::X,
+                    DVec3::Y,
+                    DVec3::Z,
+                    DVec3::new(1.0, -2.0, 0.5).normalize(),
+                ] {
                     let e = bulb(f).estimate(dir * radius);
                     assert!(e.escaped, "{f:?} at {radius}");
                     assert!(e.distance.is_finite() && e.distance > 0.0);
@@ -263,7 +277,11 @@ mod tests {
         assert!(outside.escaped);
         // The true distance to the unit sphere is 0.05; the ½ in the estimate makes it
         // a lower bound that is within a factor of two of the truth.
-        assert!(outside.distance <= 0.05 && outside.distance > 0.025, "{}", outside.distance);
+        assert!(
+            outside.distance <= 0.05 && outside.distance > 0.025,
+            "{}",
+            outside.distance
+        );
     }
 
     #[test]

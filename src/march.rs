@@ -165,7 +165,10 @@ mod tests {
         assert!(m.hit.is_none());
         assert!(m.evaluations > 0);
         let away = ray(DVec3::new(0.0, 0.0, 3.0), DVec3::Z);
-        assert_eq!(march(&away, &unit_ball(), &MarchSettings::default()).evaluations, 0);
+        assert_eq!(
+            march(&away, &unit_ball(), &MarchSettings::default()).evaluations,
+            0
+        );
     }
 
     #[test]

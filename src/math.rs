@@ -50,7 +50,11 @@ pub fn sphere_interval(origin: DVec3, dir: DVec3, radius: Real) -> Option<(Real,
 
 /// Converts a linear-light value to the sRGB transfer curve (IEC 61966-2-1).
 pub fn linear_to_srgb(x: f32) -> f32 {
-    let x = if x.is_finite() { x.clamp(0.0, 1.0) } else { 0.0 };
+    let x = if x.is_finite() {
+        x.clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     if x <= 0.003_130_8 {
         12.92 * x
     } else {

@@ -104,7 +104,11 @@ pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
         Format::Exr => {
             let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
             let header = meta.headers.first()?;
-            match header.own_attributes.other.get(&exr::prelude::Text::from(HASH_KEY))? {
+            match header
+                .own_attributes
+                .other
+                .get(&exr::prelude::Text::from(HASH_KEY))?
+            {
                 exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
                 _ => None,
             }
@@ -125,10 +129,14 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
         let file = File::create(&temp).map_err(|e| Error::io(&temp, e))?;
         let mut writer = BufWriter::new(file);
         match format {
-            Format::Png => encode_png(&mut writer, film, hash)
-                .map_err(|message| Error::Image { path: temp.clone(), message })?,
-            Format::Exr => encode_exr(&mut writer, film, hash)
-                .map_err(|message| Error::Image { path: temp.clone(), message })?,
+            Format::Png => encode_png(&mut writer, film, hash).map_err(|message| Error::Image {
+                path: temp.clone(),
+                message,
+            })?,
+            Format::Exr => encode_exr(&mut writer, film, hash).map_err(|message| Error::Image {
+                path: temp.clone(),
+                message,
+            })?,
         }
         let file = writer
             .into_inner()
@@ -157,7 +165,10 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
     let text = [
         (HASH_KEY, hash.to_string()),
         (STATS_KEY, stats_text(film)),
-        ("Software", format!("mandelreel {}", env!("CARGO_PKG_VERSION"))),
+        (
+            "Software",
+            format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
+        ),
     ];
     for (key, value) in text {
         encoder
@@ -182,7 +193,9 @@ fn encode_exr(
 ) -> std::result::Result<(), String> {
     use exr::prelude::*;
     let half = |f: &dyn Fn(usize) -> f32| -> Vec<f16> {
-        (0..film.colour.len()).map(|i| f16::from_f32(f(i))).collect()
+        (0..film.colour.len())
+            .map(|i| f16::from_f32(f(i)))
+            .collect()
     };
     let channels = AnyChannels::sort(SmallVec::from_vec(vec![
         AnyChannel::new("R", FlatSamples::F16(half(&|i| film.colour[i].x))),
@@ -212,6 +225,90 @@ fn encode_exr(
         .write()
         .to_buffered(out)
         .map_err(|e| e.to_string())
+}
+
+/// The final frame files of `format` in `dir`, in frame order.
+pub fn frame_files(dir: &Path, format: Format) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let suffix = format!(".{}", format.extension());
+    let mut frames: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| {
+            let name = p
+                .file_name()
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            name.strip_prefix("frame_")
+                .and_then(|rest| rest.strip_suffix(&suffix))
+                .is_some_and(|digits| {
+                    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
+                })
+        })
+        .collect();
+    frames.sort();
+    Ok(frames)
+}
+
+/// Up to `count` items spread evenly from the first to the last.
+pub fn evenly_spaced<T: Clone>(items: &[T], count: usize) -> Vec<T> {
+    if items.len() <= count || count < 2 {
+        return items.iter().take(count.max(1)).cloned().collect();
+    }
+    (0..count)
+        .map(|i| items[i * (items.len() - 1) / (count - 1)].clone())
+        .collect()
+}
+
+/// Tiles the PNG `frames` into a grid `columns` wide, each scaled to `thumb_width`.
+pub fn write_contact_sheet(
+    frames: &[PathBuf],
+    columns: u32,
+    thumb_width: u32,
+    out: &Path,
+) -> Result<()> {
+    use image::{imageops, RgbImage};
+    let decode = |p: &PathBuf| {
+        image::open(p)
+            .map(|i| i.to_rgb8())
+            .map_err(|e| Error::Image {
+                path: p.clone(),
+                message: e.to_string(),
+            })
+    };
+    let first = decode(&frames[0])?;
+    let thumb_height =
+        ((thumb_width as u64 * first.height() as u64) / first.width().max(1) as u64).max(1) as u32;
+    let columns = columns.min(frames.len() as u32);
+    let rows = (frames.len() as u32).div_ceil(columns);
+    let gap = 2;
+    let mut sheet = RgbImage::new(
+        columns * (thumb_width + gap) - gap,
+        rows * (thumb_height + gap) - gap,
+    );
+    for (i, path) in frames.iter().enumerate() {
+        let frame = decode(path)?;
+        let thumb = imageops::resize(
+            &frame,
+            thumb_width,
+            thumb_height,
+            imageops::FilterType::Triangle,
+        );
+        let (cx, cy) = (i as u32 % columns, i as u32 / columns);
+        imageops::replace(
+            &mut sheet,
+            &thumb,
+            (cx * (thumb_width + gap)) as i64,
+            (cy * (thumb_height + gap)) as i64,
+        );
+    }
+    let temp = temporary_path(out);
+    sheet
+        .save_with_format(&temp, image::ImageFormat::Png)
+        .map_err(|e| Error::Image {
+            path: out.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    std::fs::rename(&temp, out).map_err(|e| Error::io(out, e))
 }
 
 #[cfg(test)]
@@ -264,6 +361,33 @@ mod tests {
             assert!(is_current(&path, format, "abc123"));
             assert!(!is_current(&path, format, "other"));
         }
+    }
+
+    #[test]
+    fn evenly_spaced_keeps_both_ends() {
+        let v: Vec<u32> = (0..10).collect();
+        assert_eq!(evenly_spaced(&v, 4), vec![0, 3, 6, 9]);
+        assert_eq!(evenly_spaced(&v, 20), v);
+    }
+
+    #[test]
+    fn frame_files_ignore_temporaries_and_other_names() {
+        let dir = tempfile::tempdir().unwrap();
+        for name in [
+            "frame_00001.png",
+            "frame_00000.png",
+            ".frame_00002.png.partial",
+            "frame_x.png",
+            "sheet.png",
+        ] {
+            std::fs::write(dir.path().join(name), b"").unwrap();
+        }
+        let names: Vec<_> = frame_files(dir.path(), Format::Png)
+            .unwrap()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect();
+        assert_eq!(names, ["frame_00000.png", "frame_00001.png"]);
     }
 
     #[test]

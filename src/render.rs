@@ -88,18 +88,23 @@ pub fn render_frame(
 ) -> Film {
     let camera = scene.camera.frame();
     let n = scene.samples_per_pixel.max(1);
-    let rows: Vec<(Vec<Vec3>, Vec<f32>, Vec<f32>, FrameStats)> = (0..height)
-        .into_par_iter()
-        .map(|y| {
-            let mut colour = Vec::with_capacity(width as usize);
-            let mut alpha = Vec::with_capacity(width as usize);
-            let mut depth = Vec::with_capacity(width as usize);
+    let (w, pixels) = (width as usize, width as usize * height as usize);
+    let mut colour = vec![Vec3::ZERO; pixels];
+    let mut alpha = vec![0.0f32; pixels];
+    let mut depth = vec![BACKGROUND_DEPTH; pixels];
+    // One row per task; rayon spreads rows over threads and each pixel depends
+    // only on its own samples, so the result is independent of the split.
+    let stats = colour
+        .par_chunks_mut(w)
+        .zip(alpha.par_chunks_mut(w))
+        .zip(depth.par_chunks_mut(w))
+        .enumerate()
+        .map(|(y, ((colour_row, alpha_row), depth_row))| {
             let mut stats = FrameStats::default();
-            for x in 0..width {
-                let pixel = y as u64 * width as u64 + x as u64;
+            for x in 0..w {
+                let pixel = (y * w + x) as u64;
                 let mut sum = [0.0f64; 3];
                 let mut hits = 0u32;
-                let mut nearest = BACKGROUND_DEPTH;
                 for s in 0..n {
                     let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
                     let ray = camera.ray(x as Real + ox, y as Real + oy, width, height);
@@ -110,7 +115,7 @@ pub fn render_frame(
                             let (nrm, evals) = normal(&ray, &hit, &scene.fractal, &scene.quality);
                             stats.de_evaluations += evals as u64;
                             hits += 1;
-                            nearest = nearest.min(hit.t as f32);
+                            depth_row[x] = depth_row[x].min(hit.t as f32);
                             scene.look.surface(nrm, &hit.estimate.traps)
                         }
                         None => scene.look.background(ray.dir, camera.up),
@@ -121,35 +126,27 @@ pub fn render_frame(
                     sum[2] += c.z as f64;
                 }
                 let inv = 1.0 / n as f64;
-                colour.push(Vec3::new(
+                colour_row[x] = Vec3::new(
                     (sum[0] * inv) as f32,
                     (sum[1] * inv) as f32,
                     (sum[2] * inv) as f32,
-                ));
-                alpha.push(hits as f32 / n as f32);
-                depth.push(nearest);
+                );
+                alpha_row[x] = hits as f32 / n as f32;
                 stats.samples += n as u64;
                 stats.hits += hits as u64;
             }
             on_row();
-            (colour, alpha, depth, stats)
+            stats
         })
-        .collect();
-    let mut film = Film {
+        .reduce(FrameStats::default, |a, b| a + b);
+    Film {
         width,
         height,
-        colour: Vec::with_capacity((width * height) as usize),
-        alpha: Vec::with_capacity((width * height) as usize),
-        depth: Vec::with_capacity((width * height) as usize),
-        stats: FrameStats::default(),
-    };
-    for (c, a, d, s) in rows {
-        film.colour.extend(c);
-        film.alpha.extend(a);
-        film.depth.extend(d);
-        film.stats = film.stats + s;
+        colour,
+        alpha,
+        depth,
+        stats,
     }
-    film
 }
 
 #[cfg(test)]
@@ -178,8 +175,10 @@ mod tests {
             assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
         }
         // One sample in each quadrant of a 2×2 grid.
-        let quadrants: std::collections::HashSet<_> =
-            pts.iter().map(|&(x, y)| ((x * 2.0) as u8, (y * 2.0) as u8)).collect();
+        let quadrants: std::collections::HashSet<_> = pts
+            .iter()
+            .map(|&(x, y)| ((x * 2.0) as u8, (y * 2.0) as u8))
+            .collect();
         assert_eq!(quadrants.len(), 4);
     }
 

@@ -212,11 +212,7 @@ fn build_spline(times: &[Real], values: &[Real], mode: Interpolation) -> Spline<
         .collect();
     let n = times.len();
     if n >= 2 {
-        let before = Key::new(
-            2.0 * times[0] - times[1],
-            2.0 * values[0] - values[1],
-            m,
-        );
+        let before = Key::new(2.0 * times[0] - times[1], 2.0 * values[0] - values[1], m);
         let after = Key::new(
             2.0 * times[n - 1] - times[n - 2],
             2.0 * values[n - 1] - values[n - 2],
@@ -252,8 +248,8 @@ impl Timeline {
 
     /// Parses and validates timeline `text`; `path` is used in messages.
     pub fn parse(text: &str, path: &Path) -> Result<Timeline> {
-        let options =
-            ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        let options = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
         let file: TimelineFile = options.from_str(text).map_err(|e| Error::Syntax {
             file: path.to_path_buf(),
             line: e.span.start.line,
@@ -267,11 +263,18 @@ impl Timeline {
             message,
         };
         let top = |field: &str, message: String| {
-            invalid(line_of(text, &format!("{field}:"), 0), field.to_string(), message)
+            invalid(
+                line_of(text, &format!("{field}:"), 0),
+                field.to_string(),
+                message,
+            )
         };
 
         if !(file.fps.is_finite() && file.fps > 0.0) {
-            return Err(top("fps", format!("must be a positive number, got {}", file.fps)));
+            return Err(top(
+                "fps",
+                format!("must be a positive number, got {}", file.fps),
+            ));
         }
         let (width, height) = file.size;
         const MAX_SIDE: u32 = 32_768;
@@ -283,11 +286,12 @@ impl Timeline {
         }
         let frame_count = match (file.frames, file.duration_seconds) {
             (Some(_), Some(_)) => {
-                return Err(top("frames", "give frames or duration_seconds, not both".into()))
+                return Err(top(
+                    "frames",
+                    "give frames or duration_seconds, not both".into(),
+                ))
             }
-            (None, None) => {
-                return Err(top("frames", "give frames or duration_seconds".into()))
-            }
+            (None, None) => return Err(top("frames", "give frames or duration_seconds".into())),
             (Some(0), None) => return Err(top("frames", "must be at least 1".into())),
             (Some(n), None) => n,
             (None, Some(d)) => {
@@ -302,7 +306,11 @@ impl Timeline {
             }
         };
         if let Err((field, message)) = validate_scene(&file.scene) {
-            let line = line_of(text, &format!("{}:", field.rsplit('.').next().unwrap_or("")), 0);
+            let line = line_of(
+                text,
+                &format!("{}:", field.rsplit('.').next().unwrap_or("")),
+                0,
+            );
             return Err(invalid(line, format!("scene.{field}"), message));
         }
 
@@ -320,11 +328,18 @@ impl Timeline {
                 return Err(at(
                     String::new(),
                     None,
-                    format!("no such parameter; tracks can animate: {}", known.join(", ")),
+                    format!(
+                        "no such parameter; tracks can animate: {}",
+                        known.join(", ")
+                    ),
                 ));
             };
             if spec.keys.is_empty() {
-                return Err(at(".keys".into(), None, "a track needs at least one key".into()));
+                return Err(at(
+                    ".keys".into(),
+                    None,
+                    "a track needs at least one key".into(),
+                ));
             }
             let log_space = name == ZOOM_TRACK;
             let mut times = Vec::with_capacity(spec.keys.len());
@@ -348,7 +363,13 @@ impl Timeline {
                 }
                 times.push(key.time);
                 let values = key.value.components();
-                let shape = |n: usize| if n == 1 { "a number".to_string() } else { format!("a triple (x, y, z)") };
+                let shape = |n: usize| {
+                    if n == 1 {
+                        "a number".to_string()
+                    } else {
+                        "a triple (x, y, z)".to_string()
+                    }
+                };
                 if values.len() != arity {
                     return Err(at(
                         format!(".keys[{k}].value"),
@@ -414,12 +435,18 @@ impl Timeline {
                 let animated = timeline
                     .tracks
                     .iter()
-                    .filter(|t| field.starts_with(t.name.as_str()) || (t.name == ZOOM_TRACK && field.starts_with("camera")))
+                    .filter(|t| {
+                        field.starts_with(t.name.as_str())
+                            || (t.name == ZOOM_TRACK && field.starts_with("camera"))
+                    })
                     .map(|t| format!("\"{}\"", t.name))
                     .collect::<Vec<_>>();
                 return Err(invalid(
                     animated.first().and_then(|n| line_of(text, n, 0)),
-                    format!("frame {frame} (t = {:.4} s): scene.{field}", timeline.time_of(frame)),
+                    format!(
+                        "frame {frame} (t = {:.4} s): scene.{field}",
+                        timeline.time_of(frame)
+                    ),
                     format!(
                         "{message}{}",
                         if animated.is_empty() {
@@ -492,7 +519,10 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         view.normalize().cross(c.up).length() > 1e-9,
         "camera.up",
-        format!("must not be zero or parallel to the view direction, got {}", c.up),
+        format!(
+            "must not be zero or parallel to the view direction, got {}",
+            c.up
+        ),
     )?;
     let f = &s.fractal;
     check(
@@ -511,7 +541,11 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         format!("must be a finite number above 1, got {}", f.bailout),
     )?;
     if let Some(k) = f.julia {
-        check(finite3(k), "fractal.julia", format!("must be finite, got {k}"))?;
+        check(
+            finite3(k),
+            "fractal.julia",
+            format!("must be finite, got {k}"),
+        )?;
     }
     let q = &s.quality;
     for (field, v) in [
@@ -544,7 +578,10 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         finite3(l.light_direction) && l.light_direction.length() > 0.0,
         "look.light_direction",
-        format!("must be a finite non-zero vector, got {}", l.light_direction),
+        format!(
+            "must be a finite non-zero vector, got {}",
+            l.light_direction
+        ),
     )?;
     for (field, v) in [
         ("look.light_colour", l.light_colour),
@@ -636,7 +673,10 @@ mod tests {
     #[test]
     fn modes_between_keys() {
         let at = |mode: &str, time: Real| {
-            sample(&format!("\"fractal.power\": (interpolation: {mode}, {KEYS})"), time)[0]
+            sample(
+                &format!("\"fractal.power\": (interpolation: {mode}, {KEYS})"),
+                time,
+            )[0]
         };
         assert_eq!(at("Step", 0.25), 1.0);
         assert_eq!(at("Step", 0.75), 3.0);
@@ -667,7 +707,10 @@ mod tests {
             let t = i as Real / 10.0;
             let expect = 10f64.powf(-4.0 * t);
             let got = sample(track, t)[0];
-            assert!((got / expect - 1.0).abs() < 1e-9, "t={t}: {got} vs {expect}");
+            assert!(
+                (got / expect - 1.0).abs() < 1e-9,
+                "t={t}: {got} vs {expect}"
+            );
         }
         // And it moves the camera towards the target along the current view line.
         let t = parse(&with_track(track)).unwrap();
@@ -686,11 +729,16 @@ mod tests {
         ))
         .unwrap();
         assert_eq!(t.scene_at(0).fractal.julia, Some(DVec3::new(0.1, 0.2, 0.3)));
-        assert_eq!(t.scene_at(10).fractal.julia, Some(DVec3::new(0.3, 0.2, 0.1)));
+        assert_eq!(
+            t.scene_at(10).fractal.julia,
+            Some(DVec3::new(0.3, 0.2, 0.1))
+        );
     }
 
     fn error_of(text: &str) -> String {
-        parse(text).expect_err("timeline should be rejected").to_string()
+        parse(text)
+            .expect_err("timeline should be rejected")
+            .to_string()
     }
 
     #[test]
@@ -715,8 +763,13 @@ mod tests {
     fn nan_and_inf_are_rejected() {
         let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: NaN)))");
         assert!(e.contains("scene.fractal.power"), "{e}");
-        let e = error_of(&with_track("\"fractal.power\": (keys: [(time: 0, value: inf)])"));
-        assert!(e.contains("tracks[\"fractal.power\"].keys[0].value") && e.contains("finite"), "{e}");
+        let e = error_of(&with_track(
+            "\"fractal.power\": (keys: [(time: 0, value: inf)])",
+        ));
+        assert!(
+            e.contains("tracks[\"fractal.power\"].keys[0].value") && e.contains("finite"),
+            "{e}"
+        );
         let e = error_of("(fps: inf, frames: 3, size: (8, 6))");
         assert!(e.contains("fps"), "{e}");
     }
@@ -725,7 +778,10 @@ mod tests {
     fn non_increasing_key_times_name_the_key_and_line() {
         let text = "(fps: 10, frames: 3, size: (8, 6), tracks: {\n  \"fractal.power\": (keys: [\n    (time: 0, value: 8),\n    (time: 1, value: 7),\n    (time: 1, value: 6),\n  ]),\n})";
         let e = error_of(text);
-        assert!(e.starts_with("test.ron:5: tracks[\"fractal.power\"].keys[2].time"), "{e}");
+        assert!(
+            e.starts_with("test.ron:5: tracks[\"fractal.power\"].keys[2].time"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -739,22 +795,37 @@ mod tests {
         let e = error_of(&with_track(
             "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: -3)])",
         ));
-        assert!(e.contains("frame") && e.contains("camera.fov_degrees"), "{e}");
+        assert!(
+            e.contains("frame") && e.contains("camera.fov_degrees"),
+            "{e}"
+        );
     }
 
     #[test]
     fn empty_and_unknown_tracks_are_rejected() {
         let e = error_of(&with_track("\"fractal.power\": (keys: [])"));
-        assert!(e.contains("tracks[\"fractal.power\"].keys") && e.contains("at least one"), "{e}");
-        let e = error_of(&with_track("\"fractal.pwer\": (keys: [(time: 0, value: 1)])"));
-        assert!(e.contains("fractal.pwer") && e.contains("fractal.power"), "{e}");
+        assert!(
+            e.contains("tracks[\"fractal.power\"].keys") && e.contains("at least one"),
+            "{e}"
+        );
+        let e = error_of(&with_track(
+            "\"fractal.pwer\": (keys: [(time: 0, value: 1)])",
+        ));
+        assert!(
+            e.contains("fractal.pwer") && e.contains("fractal.power"),
+            "{e}"
+        );
     }
 
     #[test]
     fn wrong_arity_and_bad_zoom_distance_are_rejected() {
-        let e = error_of(&with_track("\"camera.position\": (keys: [(time: 0, value: 2)])"));
+        let e = error_of(&with_track(
+            "\"camera.position\": (keys: [(time: 0, value: 2)])",
+        ));
         assert!(e.contains("triple"), "{e}");
-        let e = error_of(&with_track("\"camera.distance\": (keys: [(time: 0, value: 0)])"));
+        let e = error_of(&with_track(
+            "\"camera.distance\": (keys: [(time: 0, value: 0)])",
+        ));
         assert!(e.contains("positive"), "{e}");
     }
 
@@ -764,7 +835,10 @@ mod tests {
         let e = error_of(&with_track(
             "\"fractal.bailout\": (keys: [(time: 0, value: 4), (time: 0.5, value: 1.01), (time: 0.6, value: 50)])",
         ));
-        assert!(e.contains("fractal.bailout") && e.contains("set by track"), "{e}");
+        assert!(
+            e.contains("fractal.bailout") && e.contains("set by track"),
+            "{e}"
+        );
     }
 
     #[test]

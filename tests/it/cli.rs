@@ -1,0 +1,221 @@
+//! Rendering through the command line: numbered frames, ranges, sizes, the
+//! ffmpeg command, thread-count determinism, `info` and `pick`.
+
+use crate::util::{stderr, stdout, tiny_timeline, Dir};
+
+#[test]
+fn render_writes_numbered_frames_and_prints_the_ffmpeg_command() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    let out = d.ok(&["render", "t.ron"]);
+    assert_eq!(
+        d.files("out/t"),
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    let cmd = stdout(&out);
+    assert!(cmd.starts_with("ffmpeg "), "{cmd}");
+    assert!(
+        cmd.contains("-framerate 24 -start_number 0 -i out/t/frame_%05d.png -frames:v 3"),
+        "{cmd}"
+    );
+    // Distinct frames: the power track changes every frame.
+    assert_ne!(
+        d.bytes("out/t/frame_00000.png"),
+        d.bytes("out/t/frame_00002.png")
+    );
+}
+
+#[test]
+fn frame_range_is_half_open_and_size_overrides() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(5, 6.0));
+    let out = d.ok(&[
+        "render", "t.ron", "--frames", "1..3", "--size", "20x10", "--out", "o",
+    ]);
+    assert_eq!(d.files("o"), ["frame_00001.png", "frame_00002.png"]);
+    let img = image::open(d.path().join("o/frame_00001.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (20, 10));
+    assert!(stdout(&out).contains("-start_number 1 -i o/frame_%05d.png -frames:v 2"));
+}
+
+#[test]
+fn preview_renders_half_size_into_its_own_folder() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 8.0));
+    d.ok(&["render", "t.ron", "--preview"]);
+    assert!(d.files("out/t").contains(&"preview".to_string()));
+    let img = image::open(d.path().join("out/t/preview/frame_00000.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (24, 13));
+}
+
+#[test]
+fn same_frame_is_byte_identical_with_one_or_two_threads() {
+    let d = Dir::new();
+    // Four samples per pixel exercise the jittered sampler too.
+    d.write(
+        "t.ron",
+        &tiny_timeline(2, 7.0).replace(
+            "fractal: (iterations: 8)",
+            "fractal: (iterations: 8), samples_per_pixel: 4",
+        ),
+    );
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--threads",
+        "1",
+        "--out",
+        "one",
+        "--format",
+        "png,exr",
+    ]);
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--threads",
+        "2",
+        "--out",
+        "two",
+        "--format",
+        "png,exr",
+    ]);
+    for f in [
+        "frame_00000.png",
+        "frame_00001.png",
+        "frame_00000.exr",
+        "frame_00001.exr",
+    ] {
+        assert_eq!(
+            d.bytes(&format!("one/{f}")),
+            d.bytes(&format!("two/{f}")),
+            "{f}"
+        );
+    }
+}
+
+#[test]
+fn frames_have_no_nan_and_show_the_bulb() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 8.0));
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let image =
+        exr::prelude::read_all_flat_layers_from_file(d.path().join("out/t/frame_00000.exr"))
+            .unwrap();
+    let layer = &image.layer_data[0];
+    let mut hits = 0;
+    for ch in &layer.channel_data.list {
+        let values: Vec<f32> = ch.sample_data.values_as_f32().collect();
+        assert!(
+            values.iter().all(|v| v.is_finite()),
+            "{} has non-finite values",
+            ch.name
+        );
+        if ch.name.to_string() == "A" {
+            hits = values.iter().filter(|&&a| a > 0.0).count();
+            // The corners see background, the centre the bulb.
+            assert_eq!(values[0], 0.0);
+            assert_eq!(values[13 * 48 + 24], 1.0);
+        }
+    }
+    assert!(hits > 48 * 27 / 10, "only {hits} pixels hit the bulb");
+}
+
+#[test]
+fn info_reports_frames_tracks_and_effects() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(7, 6.0));
+    let out = stdout(&d.ok(&["info", "t.ron"]));
+    assert!(out.contains("7 at 24 fps"), "{out}");
+    assert!(
+        out.contains("fractal.power") && out.contains("Linear"),
+        "{out}"
+    );
+    assert!(out.contains("effects:"), "{out}");
+    assert!(d.files("out").is_empty(), "info must not write anything");
+}
+
+#[test]
+fn pick_json_hits_the_bulb_in_the_centre_and_misses_in_the_corner() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 8.0));
+    let centre = stdout(&d.ok(&[
+        "pick", "t.ron", "--frame", "1", "--pixel", "24,13", "--json",
+    ]));
+    let v: serde_json::Value = serde_json::from_str(&centre).unwrap();
+    assert_eq!(v["hit"], true);
+    let p: Vec<f64> = v["point"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let o: Vec<f64> = v["ray_origin"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let dir: Vec<f64> = v["ray_direction"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    let t = v["distance"].as_f64().unwrap();
+    // The point lies on the ray at the reported distance, inside the bounding sphere.
+    for i in 0..3 {
+        assert!((o[i] + dir[i] * t - p[i]).abs() < 1e-9);
+    }
+    assert!(p.iter().map(|x| x * x).sum::<f64>().sqrt() < 1.5);
+    assert!(v["pixel_footprint"].as_f64().unwrap() > 0.0);
+    assert_eq!(v["fractal"]["power"], 8.0);
+    assert_eq!(v["fractal"]["formula"], "Quilez");
+    let corner: serde_json::Value = serde_json::from_str(&stdout(
+        &d.ok(&["pick", "t.ron", "--pixel", "0,0", "--json"]),
+    ))
+    .unwrap();
+    assert_eq!(corner["hit"], false);
+    assert!(corner["point"].is_null());
+}
+
+#[test]
+fn ffmpeg_encodes_the_frames_with_the_printed_command() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(4, 7.0));
+    let cmd = stdout(&d.ok(&["render", "t.ron"]));
+    let have_ffmpeg = std::process::Command::new("ffmpeg")
+        .arg("-version")
+        .output()
+        .is_ok();
+    if !have_ffmpeg {
+        // .ci/run installs ffmpeg, so in CI this test always runs for real.
+        assert!(std::env::var_os("CI").is_none(), "ffmpeg is missing in CI");
+        eprintln!("ffmpeg not installed: skipping the encode");
+        return;
+    }
+    let status = std::process::Command::new("sh")
+        .arg("-c")
+        .arg(cmd.trim().replace("ffmpeg ", "ffmpeg -loglevel error "))
+        .current_dir(d.path())
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let mp4 = std::fs::metadata(d.path().join("out/t/t.mp4")).unwrap();
+    assert!(mp4.len() > 100);
+}
+
+#[test]
+fn example_timelines_are_valid() {
+    let d = Dir::new();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in ["zoom.ron", "julia_morph.ron"] {
+        let path = root.join("timelines").join(name);
+        let out = d.ok(&["info", path.to_str().unwrap()]);
+        assert!(stdout(&out).contains("frames:"), "{}", stderr(&out));
+    }
+    // The zoom spans at least four decades of scale.
+    let zoom = stdout(&d.ok(&["info", root.join("timelines/zoom.ron").to_str().unwrap()]));
+    let before = &zoom[..zoom.find(" decades").expect("zoom line in info")];
+    let decades: f64 = before.rsplit(' ').next().unwrap().parse().unwrap();
+    assert!(decades >= 4.0, "{zoom}");
+}

@@ -1,0 +1,52 @@
+//! PNG and EXR output decode, with the channels and metadata promised.
+
+use crate::util::{tiny_timeline, Dir};
+
+#[test]
+fn png_and_exr_decode_with_expected_channels() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 8.0));
+    d.ok(&["render", "t.ron", "--format", "png,exr"]);
+    assert_eq!(d.files("out/t"), ["frame_00000.exr", "frame_00000.png"]);
+
+    let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();
+    assert_eq!((png.width(), png.height()), (48, 27));
+    assert_eq!(png.color(), image::ColorType::Rgb8);
+
+    let exr = exr::prelude::read_all_flat_layers_from_file(d.path().join("out/t/frame_00000.exr"))
+        .unwrap();
+    let layer = &exr.layer_data[0];
+    assert_eq!((layer.size.0, layer.size.1), (48, 27));
+    let names: Vec<String> = layer
+        .channel_data
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    assert_eq!(names, ["A", "B", "G", "R", "Z"]);
+    let z: Vec<f32> = layer.channel_data.list[4]
+        .sample_data
+        .values_as_f32()
+        .collect();
+    // Z is the camera distance: about 2 in the middle (camera 3 from the centre), huge for background.
+    assert!(
+        z[13 * 48 + 24] > 1.0 && z[13 * 48 + 24] < 3.1,
+        "{}",
+        z[13 * 48 + 24]
+    );
+    assert!(z[0] >= 1.0e9);
+
+    // The PNG's sRGB bytes and the EXR's linear values describe the same pixel.
+    let r: Vec<f32> = layer.channel_data.list[3]
+        .sample_data
+        .values_as_f32()
+        .collect();
+    let i = 13 * 48 + 24;
+    let srgb = png.to_rgb8().get_pixel(24, 13)[0] as f32 / 255.0;
+    let linear = if srgb <= 0.04045 {
+        srgb / 12.92
+    } else {
+        ((srgb + 0.055) / 1.055).powf(2.4)
+    };
+    assert!((linear - r[i]).abs() < 0.01, "png {linear} vs exr {}", r[i]);
+}

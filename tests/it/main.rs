@@ -1,0 +1,8 @@
+//! Integration tests: the real `mandelreel` binary on tiny frames in temporary folders.
+
+mod util;
+
+mod cli;
+mod formats;
+mod resume;
+mod validation;

@@ -1,0 +1,159 @@
+//! Resume: complete frames are skipped, stale or partial ones re-rendered, and a
+//! render killed mid-way leaves no damaged frame and finishes identically.
+
+use crate::util::{stderr, tiny_timeline, Dir};
+use std::time::{Duration, Instant};
+
+fn mtimes(d: &Dir, sub: &str) -> Vec<std::time::SystemTime> {
+    d.files(sub)
+        .iter()
+        .map(|f| {
+            std::fs::metadata(d.path().join(sub).join(f))
+                .unwrap()
+                .modified()
+                .unwrap()
+        })
+        .collect()
+}
+
+#[test]
+fn second_run_skips_complete_frames() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    d.ok(&["render", "t.ron"]);
+    let before = mtimes(&d, "out/t");
+    let first = d.bytes("out/t/frame_00001.png");
+    std::thread::sleep(Duration::from_millis(20));
+    let out = d.ok(&["render", "t.ron"]);
+    assert!(
+        stderr(&out).contains("3 of 3 frames already complete"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(
+        mtimes(&d, "out/t"),
+        before,
+        "skipped frames must not be rewritten"
+    );
+    // --force renders them again, to the same bytes.
+    let out = d.ok(&["render", "t.ron", "--force"]);
+    assert!(
+        stderr(&out).contains("3 frames rendered"),
+        "{}",
+        stderr(&out)
+    );
+    assert_ne!(mtimes(&d, "out/t"), before);
+    assert_eq!(d.bytes("out/t/frame_00001.png"), first);
+}
+
+#[test]
+fn changed_timeline_rerenders_only_what_changed() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    d.ok(&["render", "t.ron"]);
+    let old = d.bytes("out/t/frame_00002.png");
+    let frame0 = d.bytes("out/t/frame_00000.png");
+    // Frame 0 sits on the first key (power 8) either way; frames 1 and 2 change.
+    d.write("t.ron", &tiny_timeline(3, 4.0));
+    let out = d.ok(&["render", "t.ron"]);
+    assert!(
+        stderr(&out).contains("1 of 3 frames already complete"),
+        "{}",
+        stderr(&out)
+    );
+    assert_ne!(d.bytes("out/t/frame_00002.png"), old);
+    assert_eq!(d.bytes("out/t/frame_00000.png"), frame0);
+    // A different size is a different frame too.
+    let out = d.ok(&["render", "t.ron", "--size", "40x20"]);
+    assert!(
+        !stderr(&out).contains("already complete"),
+        "{}",
+        stderr(&out)
+    );
+}
+
+#[test]
+fn stale_temporary_and_foreign_files_are_not_taken_for_frames() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
+    // Left by a killed run: a half-written temporary, and a garbage file under a final name.
+    d.write("out/t/.frame_00000.png.partial", "half a frame");
+    d.write("out/t/frame_00001.png", "not a png");
+    let out = d.ok(&["render", "t.ron"]);
+    assert!(
+        !stderr(&out).contains("already complete"),
+        "{}",
+        stderr(&out)
+    );
+    assert_eq!(d.files("out/t"), ["frame_00000.png", "frame_00001.png"]);
+    for f in ["frame_00000.png", "frame_00001.png"] {
+        image::open(d.path().join("out/t").join(f)).unwrap();
+    }
+}
+
+#[test]
+fn killed_render_resumes_to_identical_frames() {
+    let d = Dir::new();
+    // Enough work per frame that the kill lands mid-sequence.
+    let text = tiny_timeline(12, 6.0).replace("size: (48, 27)", "size: (160, 90)");
+    d.write("t.ron", &text);
+    let mut child = d
+        .command(&["render", "t.ron", "--quiet", "--threads", "1"])
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while d
+        .files("out/t")
+        .iter()
+        .filter(|f| f.starts_with("frame_"))
+        .count()
+        < 2
+    {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no frames appeared"
+        );
+        if child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap(); // SIGKILL on Unix: no chance to clean up
+    child.wait().unwrap();
+    // Every file under a final name is a whole frame.
+    for f in d.files("out/t").iter().filter(|f| f.starts_with("frame_")) {
+        image::open(d.path().join("out/t").join(f))
+            .unwrap_or_else(|e| panic!("{f} is damaged: {e}"));
+    }
+    let done_before = d
+        .files("out/t")
+        .iter()
+        .filter(|f| f.starts_with("frame_"))
+        .count();
+    assert!(
+        done_before < 12,
+        "the render finished before it could be killed"
+    );
+    let out = d.ok(&["render", "t.ron"]);
+    assert!(
+        stderr(&out).contains(&format!("{done_before} of 12 frames already complete")),
+        "{}",
+        stderr(&out)
+    );
+    let finals: Vec<String> = d
+        .files("out/t")
+        .into_iter()
+        .filter(|f| !f.starts_with('.'))
+        .collect();
+    assert_eq!(finals.len(), 12);
+    // The resumed sequence equals an uninterrupted render.
+    d.ok(&["render", "t.ron", "--out", "clean"]);
+    for f in finals {
+        assert_eq!(
+            d.bytes(&format!("out/t/{f}")),
+            d.bytes(&format!("clean/{f}")),
+            "{f}"
+        );
+    }
+}

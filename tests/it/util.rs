@@ -1,0 +1,88 @@
+//! A temporary folder with timelines in it and a way to run the binary there.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+pub struct Dir {
+    pub root: tempfile::TempDir,
+}
+
+/// A small timeline: `frames` frames of 48×27 looking at the whole bulb, with
+/// the power animated so that every frame differs.
+pub fn tiny_timeline(frames: u32, power_end: f64) -> String {
+    format!(
+        "(
+    fps: 24,
+    frames: {frames},
+    size: (48, 27),
+    scene: (camera: (position: (0, 0.5, 3.0)), fractal: (iterations: 8)),
+    tracks: {{
+        \"fractal.power\": (interpolation: Linear, keys: [(time: 0, value: 8), (time: 1, value: {power_end})]),
+    }},
+)"
+    )
+}
+
+impl Dir {
+    pub fn new() -> Dir {
+        Dir {
+            root: tempfile::tempdir().expect("temporary folder"),
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        self.root.path()
+    }
+
+    pub fn write(&self, name: &str, text: &str) -> PathBuf {
+        let p = self.path().join(name);
+        std::fs::write(&p, text).expect("write test file");
+        p
+    }
+
+    pub fn command(&self, args: &[&str]) -> Command {
+        let mut c = Command::new(env!("CARGO_BIN_EXE_mandelreel"));
+        c.current_dir(self.path()).args(args);
+        c
+    }
+
+    /// Runs the binary and returns its output, whatever the exit status.
+    pub fn run(&self, args: &[&str]) -> Output {
+        self.command(args).output().expect("run mandelreel")
+    }
+
+    /// Runs the binary and panics with its stderr unless it succeeds.
+    pub fn ok(&self, args: &[&str]) -> Output {
+        let out = self.run(args);
+        assert!(
+            out.status.success(),
+            "mandelreel {args:?} failed: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        out
+    }
+
+    /// Names of the files in `sub`, sorted; empty if it does not exist.
+    pub fn files(&self, sub: &str) -> Vec<String> {
+        let Ok(entries) = std::fs::read_dir(self.path().join(sub)) else {
+            return Vec::new();
+        };
+        let mut v: Vec<String> = entries
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+
+    pub fn bytes(&self, rel: &str) -> Vec<u8> {
+        std::fs::read(self.path().join(rel)).unwrap_or_else(|e| panic!("read {rel}: {e}"))
+    }
+}
+
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}

@@ -1,0 +1,136 @@
+//! Bad input through the binary: a clear message with the place, a non-zero
+//! exit code, and nothing written.
+
+use crate::util::{stderr, tiny_timeline, Dir};
+
+/// Renders `text` and expects exit code `code`, a message containing every
+/// item of `needles`, and no output folder.
+fn rejected(text: &str, extra: &[&str], code: i32, needles: &[&str]) {
+    let d = Dir::new();
+    d.write("bad.ron", text);
+    let mut args = vec!["render", "bad.ron"];
+    args.extend_from_slice(extra);
+    let out = d.run(&args);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(code), "{err}");
+    for n in needles {
+        assert!(err.contains(n), "missing {n:?} in: {err}");
+    }
+    assert!(
+        !d.path().join("out").exists(),
+        "output was written for a bad timeline"
+    );
+}
+
+#[test]
+fn syntax_error_points_at_line_and_column() {
+    rejected(
+        "(\n  fps: 24,\n  frames: 3\n  size: (8, 6),\n)",
+        &[],
+        3,
+        &["bad.ron:4:"],
+    );
+}
+
+#[test]
+fn unknown_field_is_named() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace("fractal:", "fractl:"),
+        &[],
+        3,
+        &["bad.ron:", "fractl"],
+    );
+}
+
+#[test]
+fn wrong_type_is_rejected() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace("fps: 24", "fps: \"24\""),
+        &[],
+        3,
+        &["bad.ron:2:"],
+    );
+}
+
+#[test]
+fn nan_value_is_rejected_with_its_track_and_key() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace("value: 6", "value: NaN"),
+        &[],
+        3,
+        &["tracks[\"fractal.power\"].keys[1].value", "finite"],
+    );
+}
+
+#[test]
+fn non_increasing_key_times_are_rejected() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace("time: 1,", "time: 0,"),
+        &[],
+        3,
+        &[
+            "bad.ron:",
+            "tracks[\"fractal.power\"].keys[1].time",
+            "increase",
+        ],
+    );
+}
+
+#[test]
+fn zero_or_negative_fps_size_fov_are_rejected() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace("fps: 24", "fps: 0"),
+        &[],
+        3,
+        &["bad.ron:2: fps"],
+    );
+    rejected(
+        &tiny_timeline(2, 6.0).replace("size: (48, 27)", "size: (0, 27)"),
+        &[],
+        3,
+        &["size"],
+    );
+    rejected(
+        &tiny_timeline(2, 6.0).replace(
+            "position: (0, 0.5, 3.0)",
+            "position: (0, 0.5, 3.0), fov_degrees: -5",
+        ),
+        &[],
+        3,
+        &["scene.camera.fov_degrees"],
+    );
+}
+
+#[test]
+fn empty_track_is_rejected() {
+    rejected(
+        &tiny_timeline(2, 6.0).replace(
+            "keys: [(time: 0, value: 8), (time: 1, value: 6)]",
+            "keys: []",
+        ),
+        &[],
+        3,
+        &["tracks[\"fractal.power\"].keys", "at least one key"],
+    );
+}
+
+#[test]
+fn bad_flags_exit_with_usage_code_and_write_nothing() {
+    rejected(
+        &tiny_timeline(2, 6.0),
+        &["--frames", "0..9"],
+        2,
+        &["--frames", "2 frames"],
+    );
+    rejected(&tiny_timeline(2, 6.0), &["--size", "0x10"], 2, &["--size"]);
+    rejected(&tiny_timeline(2, 6.0), &["--format", "jpg"], 2, &["jpg"]);
+}
+
+#[test]
+fn missing_timeline_is_an_io_failure() {
+    let d = Dir::new();
+    let out = d.run(&["render", "nope.ron"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("nope.ron"));
+    assert!(!d.path().join("out").exists());
+}
