@@ -211,10 +211,12 @@ fn encode_exr(
     attributes
         .other
         .insert(Text::from(HASH_KEY), AttributeValue::Text(Text::from(hash)));
-    attributes.other.insert(
-        Text::from(STATS_KEY),
-        AttributeValue::Text(Text::from(stats_text(film).as_str())),
-    );
+    // `other` is a HashMap written in its (per-process random) iteration order:
+    // it holds only the hash so the file bytes are reproducible; stats go in a
+    // standard attribute.
+    attributes.comments = Some(Text::from(
+        format!("{STATS_KEY}: {}", stats_text(film)).as_str(),
+    ));
     let layer = Layer::new(
         (film.width as usize, film.height as usize),
         attributes,
