@@ -251,6 +251,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             .map_err(|e| Error::usage("--threads", e.to_string()))?;
     }
     let mut formats = args.format.clone();
+    formats.sort_by_key(|f| f.extension());
     formats.dedup();
     let mut out_dir = args
         .out
@@ -262,6 +263,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         out_dir = out_dir.join("preview");
     }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+    let stale = output::remove_stale_partials(&out_dir)?;
 
     // Decide which frames need work, so the progress bar and ETA count only those.
     let mut todo = Vec::new();
@@ -312,6 +314,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("{line}");
         }
     };
+    if !args.quiet && stale > 0 {
+        say(format!(
+            "removed {stale} temporary file(s) left by an interrupted render"
+        ));
+    }
     if !args.quiet && skipped > 0 {
         say(format!(
             "{skipped} of {total} frames already complete and current in {}; rendering {}",
@@ -385,7 +392,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 
 fn info(path: &Path) -> anyhow::Result<()> {
     let t = Timeline::load(path)?;
-    let base = &t.base;
+    let first = t.scene_at(0);
+    let base = &first;
     println!("timeline: {}", path.display());
     println!(
         "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {} sample(s) per pixel",
@@ -404,11 +412,19 @@ fn info(path: &Path) -> anyhow::Result<()> {
         (None, false) => "Mandelbrot mode".to_string(),
     };
     println!(
-        "fractal:  {mode}, formula {}, power {}, {} iterations, bailout {}",
+        "fractal:  {mode}, formula {}, power {}, {} iterations, bailout {} (at frame 0)",
         f.formula.name(),
         f.power,
         f.iterations,
         f.bailout
+    );
+    println!(
+        "quality:  DE {} in {}, hit threshold {} x footprint, fudge {}, {} max steps",
+        f.de.name(),
+        f.precision.name(),
+        base.quality.hit_threshold,
+        base.quality.fudge,
+        base.quality.max_steps
     );
     if t.tracks.is_empty() {
         println!("tracks:   none (a still)");

@@ -6,7 +6,7 @@
 //! Method: ../shared/seeds/004 (ray marching with signed distance bounds,
 //! central-difference normals) and 001 (Christensen on the fudge factor).
 
-use crate::fractal::{Estimate, Fractal};
+use crate::fractal::{Estimate, Fractal, TETRAHEDRON};
 use crate::math::{normalize_or, sphere_interval, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
@@ -71,6 +71,13 @@ pub struct MarchResult {
 }
 
 /// Sphere-traces `ray` against `fractal` inside the bounding sphere.
+///
+/// Every estimate also tells whether its point is inside the set (its orbit
+/// stayed bounded). A step that lands inside has overshot the surface (an
+/// estimator that overestimates, or a fudge too large for a thin feature); the
+/// crossing is then found by bisecting membership between the last point
+/// outside and that one, so the hit never lies past the surface by more than
+/// the hit threshold.
 pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchResult {
     let mut evaluations = 0;
     let Some((t_enter, t_exit)) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
@@ -80,47 +87,88 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
             evaluations,
         };
     };
+    let at = |t: Real| ray.origin + ray.dir * t;
     let mut t = t_enter;
+    let mut t_outside: Option<Real> = None;
     for _ in 0..settings.max_steps {
-        let point = ray.origin + ray.dir * t;
-        let estimate = fractal.estimate(point);
-        evaluations += 1;
+        let point = at(t);
+        let estimate = fractal.estimate(point, ray.footprint(t));
+        evaluations += estimate.orbits;
+        if !estimate.escaped {
+            if let Some(mut lo) = t_outside {
+                // Overshot: bisect [lo (outside), t (inside)] down to the threshold.
+                let mut hi = t;
+                while hi - lo > settings.hit_threshold * ray.footprint(lo) {
+                    let mid = 0.5 * (lo + hi);
+                    if !(lo < mid && mid < hi) {
+                        break; // the interval cannot be split any further
+                    }
+                    evaluations += 1;
+                    if fractal.contains(at(mid)) {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                let estimate = fractal.estimate(at(lo), ray.footprint(lo));
+                evaluations += estimate.orbits;
+                return MarchResult {
+                    hit: Some(Hit {
+                        t: lo,
+                        point: at(lo),
+                        estimate,
+                    }),
+                    evaluations,
+                };
+            }
+        }
         if estimate.distance < settings.hit_threshold * ray.footprint(t) {
             return MarchResult {
                 hit: Some(Hit { t, point, estimate }),
                 evaluations,
             };
         }
+        t_outside = Some(t);
         t += estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;
         if t > t_exit {
-            break;
+            return MarchResult {
+                hit: None,
+                evaluations,
+            };
         }
     }
+    // Out of steps inside the bounding sphere: the ray is creeping along a
+    // surface it keeps almost touching (a grazing ray). Calling that a miss
+    // punches background-coloured speckles into the surface; call it a hit.
+    let estimate = fractal.estimate(at(t), ray.footprint(t));
+    evaluations += estimate.orbits;
     MarchResult {
-        hit: None,
+        hit: Some(Hit {
+            t,
+            point: at(t),
+            estimate,
+        }),
         evaluations,
     }
 }
 
 /// Surface normal at `hit` from a tetrahedral central difference of the
 /// estimate, with a step proportional to the pixel footprint. Returns the normal
-/// and the number of evaluations used; falls back to facing the ray.
+/// and the number of orbits used; falls back to facing the ray.
 pub fn normal(ray: &Ray, hit: &Hit, fractal: &Fractal, settings: &MarchSettings) -> (DVec3, u32) {
-    let h = settings.normal_step * ray.footprint(hit.t);
-    const K: [DVec3; 4] = [
-        DVec3::new(1.0, -1.0, -1.0),
-        DVec3::new(-1.0, -1.0, 1.0),
-        DVec3::new(-1.0, 1.0, -1.0),
-        DVec3::new(1.0, 1.0, 1.0),
-    ];
+    let footprint = ray.footprint(hit.t);
+    let h = settings.normal_step * footprint;
     // Step back along the ray so the samples straddle the surface rather than sit inside,
     // where the estimate is flat zero.
     let centre = hit.point - ray.dir * h;
     let mut gradient = DVec3::ZERO;
-    for k in K {
-        gradient += k * fractal.estimate(centre + k * h).distance;
+    let mut orbits = 0;
+    for k in TETRAHEDRON {
+        let e = fractal.estimate(centre + k * h, footprint);
+        gradient += k * e.distance;
+        orbits += e.orbits;
     }
-    (normalize_or(gradient, -ray.dir), K.len() as u32)
+    (normalize_or(gradient, -ray.dir), orbits)
 }
 
 #[cfg(test)]
@@ -175,7 +223,53 @@ mod tests {
     fn hit_threshold_scales_with_footprint() {
         let far = ray(DVec3::new(0.0, 0.0, 3.0), -DVec3::Z);
         assert!((far.footprint(2.0) - 2e-3).abs() < 1e-15);
-        assert!((far.footprint(2e-4) - 2e-7).abs() < 1e-18);
+        // The marcher stops further from the surface when pixels are wider:
+        // the gap to the unit sphere is below the threshold in each case and
+        // the coarse pixel stops well before the fine one.
+        let settings = MarchSettings::default();
+        let gap = |pixel_angle: Real| {
+            let r = Ray { pixel_angle, ..far };
+            2.0 - march(&r, &unit_ball(), &settings).hit.unwrap().t
+        };
+        let (coarse, fine) = (gap(1e-1), gap(1e-5));
+        assert!(
+            coarse < 2.0 * settings.hit_threshold * 0.2 && coarse > 1e-3,
+            "{coarse}"
+        );
+        assert!(
+            fine < 2.0 * settings.hit_threshold * 2e-5 && fine >= 0.0,
+            "{fine}"
+        );
+    }
+
+    #[test]
+    fn overshooting_steps_are_caught_by_membership() {
+        // A fudge of 3 makes every step overshoot, as an estimator that
+        // overestimates would. On the unit ball the exact answer is known: every
+        // hit must lie outside the ball and within the hit threshold of it.
+        let settings = MarchSettings {
+            fudge: 3.0,
+            ..MarchSettings::default()
+        };
+        let mut hits = 0;
+        for i in 0..40 {
+            let a = i as Real * 0.37;
+            let origin = DVec3::new(a.cos() * 2.5, (a * 0.7).sin(), a.sin() * 2.5);
+            let r = ray(
+                origin,
+                -origin + DVec3::new(0.0, 0.3 * (a * 3.0).sin(), 0.0),
+            );
+            if let Some(hit) = march(&r, &unit_ball(), &settings).hit {
+                let gap = hit.point.length() - 1.0;
+                let limit = settings.hit_threshold * r.footprint(hit.t);
+                assert!(
+                    gap > 0.0 && gap <= limit * 1.0001,
+                    "ray {i}: gap {gap}, limit {limit}"
+                );
+                hits += 1;
+            }
+        }
+        assert!(hits > 30);
     }
 
     #[test]

@@ -52,8 +52,9 @@ pub fn frame_pattern(format: Format) -> String {
     format!("frame_%0{FRAME_DIGITS}d.{}", format.extension())
 }
 
-/// The hidden name a frame is written under until it is complete. It never
-/// matches a final frame name, so a leftover one is never taken for a frame.
+/// The hidden name pattern a frame is written under until it is complete
+/// (`.frame_00042.png.<random>.partial` in practice, unique per writer). It
+/// never matches a final frame name, so a leftover one is never taken for a frame.
 pub fn temporary_path(final_path: &Path) -> PathBuf {
     let name = final_path
         .file_name()
@@ -91,6 +92,9 @@ pub fn frame_hash(scene: &Scene, frame_index: u32, width: u32, height: u32) -> S
 pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
     match format {
         Format::Png => {
+            if !png_is_whole(path) {
+                return None;
+            }
             let file = File::open(path).ok()?;
             let reader = png::Decoder::new(std::io::BufReader::new(file))
                 .read_info()
@@ -116,38 +120,68 @@ pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
     }
 }
 
+/// Whether a PNG file ends with its IEND chunk: a cheap check that a file
+/// copied or damaged outside mandelreel was not cut short.
+fn png_is_whole(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    const IEND: [u8; 12] = [0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xAE, 0x42, 0x60, 0x82];
+    let mut tail = [0u8; 12];
+    File::open(path)
+        .and_then(|mut f| {
+            f.seek(SeekFrom::End(-12))?;
+            f.read_exact(&mut tail)
+        })
+        .is_ok()
+        && tail == IEND
+}
+
 /// Whether `path` holds a finished frame made from inputs with this `hash`.
 pub fn is_current(path: &Path, format: Format, hash: &str) -> bool {
     stored_hash(path, format).as_deref() == Some(hash)
 }
 
-/// Writes `film` as `path` in `format`, atomically: the bytes go to a temporary
-/// name in the same folder, are flushed to disk, and only then renamed.
+/// Writes `film` as `path` in `format`, atomically: the bytes go to a
+/// temporary file of a unique name in the same folder (so two renders into one
+/// folder never write into each other's file), are flushed to disk, and only
+/// then renamed over the final name.
 pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Result<()> {
-    let temp = temporary_path(path);
-    let result = (|| {
-        let file = File::create(&temp).map_err(|e| Error::io(&temp, e))?;
-        let mut writer = BufWriter::new(file);
-        match format {
-            Format::Png => encode_png(&mut writer, film, hash).map_err(|message| Error::Image {
-                path: temp.clone(),
-                message,
-            })?,
-            Format::Exr => encode_exr(&mut writer, film, hash).map_err(|message| Error::Image {
-                path: temp.clone(),
-                message,
-            })?,
-        }
-        let file = writer
-            .into_inner()
-            .map_err(|e| Error::io(&temp, e.into_error()))?;
-        file.sync_all().map_err(|e| Error::io(&temp, e))?;
-        std::fs::rename(&temp, path).map_err(|e| Error::io(path, e))
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&temp);
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let hidden = temporary_path(path);
+    let prefix = hidden
+        .file_name()
+        .map(|n| n.to_string_lossy().trim_end_matches(".partial").to_string() + ".")
+        .unwrap_or_default();
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".partial");
+    #[cfg(unix)]
+    {
+        // Frames are ordinary files, readable by all (tempfile's default is 0600).
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    result
+    let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    let temp_path = temp.path().to_path_buf();
+    let image_error = |message: String| Error::Image {
+        path: temp_path.clone(),
+        message,
+    };
+    let mut writer = BufWriter::new(temp);
+    match format {
+        Format::Png => encode_png(&mut writer, film, hash).map_err(image_error)?,
+        Format::Exr => encode_exr(&mut writer, film, hash).map_err(image_error)?,
+    }
+    let temp = writer
+        .into_inner()
+        .map_err(|e| Error::io(&temp_path, e.into_error()))?;
+    temp.as_file()
+        .sync_all()
+        .map_err(|e| Error::io(&temp_path, e))?;
+    // On any error above the temporary file is deleted when `temp` drops.
+    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
 }
 
 fn stats_text(film: &Film) -> String {
@@ -220,13 +254,47 @@ fn encode_exr(
     let layer = Layer::new(
         (film.width as usize, film.height as usize),
         attributes,
-        Encoding::FAST_LOSSLESS,
+        // Increasing line order: exrs otherwise writes blocks in the order its
+        // compression threads finish, and the bytes would differ run to run.
+        Encoding {
+            line_order: LineOrder::Increasing,
+            ..Encoding::FAST_LOSSLESS
+        },
         channels,
     );
     Image::from_layer(layer)
         .write()
         .to_buffered(out)
         .map_err(|e| e.to_string())
+}
+
+/// How old a temporary `.partial` file must be to count as left behind by a
+/// killed render. A writer holds one only while encoding a finished frame
+/// (seconds), so anything this old belongs to no live process.
+pub const STALE_PARTIAL_AGE: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// Deletes temporary frame files in `dir` older than `STALE_PARTIAL_AGE`;
+/// returns how many went. Younger ones may belong to a render running beside
+/// this one and are left alone.
+pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    let mut removed = 0;
+    for entry in entries.filter_map(|e| e.ok()) {
+        let name = entry.file_name().to_string_lossy().into_owned();
+        if !(name.starts_with(".frame_") && name.ends_with(".partial")) {
+            continue;
+        }
+        let age = entry
+            .metadata()
+            .and_then(|m| m.modified())
+            .ok()
+            .and_then(|t| t.elapsed().ok());
+        if age.is_some_and(|a| a >= STALE_PARTIAL_AGE) && std::fs::remove_file(entry.path()).is_ok()
+        {
+            removed += 1;
+        }
+    }
+    Ok(removed)
 }
 
 /// The final frame files of `format` in `dir`, in frame order.
@@ -358,7 +426,12 @@ mod tests {
             let path = dir.path().join(frame_file_name(0, format));
             write_frame(&path, format, &film(), "abc123").unwrap();
             assert!(path.exists());
-            assert!(!temporary_path(&path).exists());
+            let leftovers: Vec<_> = std::fs::read_dir(dir.path())
+                .unwrap()
+                .filter_map(|e| e.ok())
+                .filter(|e| e.file_name().to_string_lossy().ends_with(".partial"))
+                .collect();
+            assert!(leftovers.is_empty(), "temporary files left behind");
             assert_eq!(stored_hash(&path, format).as_deref(), Some("abc123"));
             assert!(is_current(&path, format, "abc123"));
             assert!(!is_current(&path, format, "other"));
@@ -390,6 +463,17 @@ mod tests {
             .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
             .collect();
         assert_eq!(names, ["frame_00000.png", "frame_00001.png"]);
+    }
+
+    #[test]
+    fn a_png_cut_after_its_header_is_not_current() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frame_00000.png");
+        write_frame(&path, Format::Png, &film(), "abc").unwrap();
+        assert!(is_current(&path, Format::Png, "abc"));
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() - 20]).unwrap();
+        assert!(!is_current(&path, Format::Png, "abc"));
     }
 
     #[test]

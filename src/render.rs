@@ -60,21 +60,22 @@ pub fn sample_1d(seed: u64, frame: u32, pixel: u64, sample: u32, dim: u32) -> Re
     (x >> 11) as Real / (1u64 << 53) as Real
 }
 
-/// Sub-pixel offset of sample `s` of `n`: the centre for one sample, otherwise
-/// a jittered point in cell `s` of a near-square grid over the pixel.
+/// Sub-pixel offset of sample `s` of `n`: the centre for one sample; a
+/// jittered point in cell `s` of a k×k grid when n = k²; otherwise stratified
+/// in n rows with x uniform, which still covers the whole pixel evenly.
 fn subpixel(scene: &Scene, frame: u32, pixel: u64, s: u32, n: u32) -> (Real, Real) {
     if n == 1 {
         return (0.5, 0.5);
     }
-    let cols = (n as Real).sqrt().ceil() as u32;
-    let rows = n.div_ceil(cols);
-    let (cx, cy) = (s % cols, s / cols);
     let jx = sample_1d(scene.seed, frame, pixel, s, 0);
     let jy = sample_1d(scene.seed, frame, pixel, s, 1);
-    (
-        (cx as Real + jx) / cols as Real,
-        (cy as Real + jy) / rows as Real,
-    )
+    let k = (n as Real).sqrt().round() as u32;
+    if k * k == n {
+        let (cx, cy) = (s % k, s / k);
+        ((cx as Real + jx) / k as Real, (cy as Real + jy) / k as Real)
+    } else {
+        (jx, (s as Real + jy) / n as Real)
+    }
 }
 
 /// Renders `scene` at `width`×`height` as frame `frame_index`. `on_row` is called
@@ -174,7 +175,12 @@ mod tests {
         for &(x, y) in &pts {
             assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
         }
-        // One sample in each quadrant of a 2×2 grid.
+        // Three samples: one in each horizontal third, averaging over the whole pixel.
+        let thirds: std::collections::HashSet<_> = (0..3)
+            .map(|s| (subpixel(&scene, 0, 9, s, 3).1 * 3.0) as u8)
+            .collect();
+        assert_eq!(thirds.len(), 3);
+        // Four samples: one in each quadrant of a 2×2 grid.
         let quadrants: std::collections::HashSet<_> = pts
             .iter()
             .map(|&(x, y)| ((x * 2.0) as u8, (y * 2.0) as u8))

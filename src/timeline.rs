@@ -831,7 +831,7 @@ mod tests {
 
     #[test]
     fn overshoot_caught_per_frame() {
-        // Catmull–Rom overshoots below 1 between these keys; iterations must stay ≥ 1.
+        // Catmull–Rom overshoots below 1 between these keys; the bailout must stay above 1.
         let e = error_of(&with_track(
             "\"fractal.bailout\": (keys: [(time: 0, value: 4), (time: 0.5, value: 1.01), (time: 0.6, value: 50)])",
         ));

@@ -77,16 +77,31 @@ fn stale_temporary_and_foreign_files_are_not_taken_for_frames() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(2, 6.0));
     std::fs::create_dir_all(d.path().join("out/t")).unwrap();
-    // Left by a killed run: a half-written temporary, and a garbage file under a final name.
-    d.write("out/t/.frame_00000.png.partial", "half a frame");
+    // Left by a killed run an hour ago: a half-written temporary.
+    let stale = d.write("out/t/.frame_00000.png.x1y2z3.partial", "half a frame");
+    let hour_ago = std::time::SystemTime::now() - Duration::from_secs(3600);
+    std::fs::File::options()
+        .write(true)
+        .open(&stale)
+        .unwrap()
+        .set_modified(hour_ago)
+        .unwrap();
+    // A fresh one may belong to a render running beside this one: kept.
+    d.write("out/t/.frame_00001.png.a1b2c3.partial", "being written");
+    // And garbage under a final name.
     d.write("out/t/frame_00001.png", "not a png");
     let out = d.ok(&["render", "t.ron"]);
-    assert!(
-        !stderr(&out).contains("already complete"),
-        "{}",
-        stderr(&out)
+    let err = stderr(&out);
+    assert!(!err.contains("already complete"), "{err}");
+    assert!(err.contains("removed 1 temporary file"), "{err}");
+    assert_eq!(
+        d.files("out/t"),
+        [
+            ".frame_00001.png.a1b2c3.partial",
+            "frame_00000.png",
+            "frame_00001.png"
+        ]
     );
-    assert_eq!(d.files("out/t"), ["frame_00000.png", "frame_00001.png"]);
     for f in ["frame_00000.png", "frame_00001.png"] {
         image::open(d.path().join("out/t").join(f)).unwrap();
     }
