@@ -49,6 +49,30 @@ pub enum Command {
     Pick(PickArgs),
     /// Tile rendered PNG frames from a folder into one contact-sheet image.
     Sheet(SheetArgs),
+    /// Measure what accuracy costs: sweep every quality knob, distance estimator and
+    /// precision on one frame against a reference; write accuracy.csv, .md and .png.
+    Accuracy(AccuracyArgs),
+}
+
+#[derive(Debug, clap::Args)]
+pub struct AccuracyArgs {
+    /// The RON timeline file.
+    pub timeline: PathBuf,
+    /// Frame to measure.
+    #[arg(long, default_value_t = 0)]
+    pub frame: u32,
+    /// Size to measure at [default: the timeline's aspect, 160 pixels wide at most].
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    /// Folder for accuracy.csv, accuracy.md and accuracy.png [default: out/<timeline name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Worker threads [default: all cores].
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress lines; the table is still printed.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -135,6 +159,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info { timeline } => info(&timeline),
         Command::Pick(args) => pick(args),
         Command::Sheet(args) => sheet(args),
+        Command::Accuracy(args) => accuracy(args),
     }
 }
 
@@ -241,15 +266,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         Some(f) => parse_frames(f, timeline.frame_count)?,
         None => 0..timeline.frame_count,
     };
-    if let Some(n) = args.threads {
-        if n == 0 {
-            return Err(Error::usage("--threads", "must be at least 1").into());
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .map_err(|e| Error::usage("--threads", e.to_string()))?;
-    }
+    set_threads(args.threads)?;
     let mut formats = args.format.clone();
     formats.sort_by_key(|f| f.extension());
     formats.dedup();
@@ -569,6 +586,79 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         }
         None => println!("miss: the ray leaves the bounding sphere without meeting the fractal"),
     }
+    Ok(())
+}
+
+/// Sizes rayon's pool to `--threads` when given.
+fn set_threads(threads: Option<usize>) -> Result<()> {
+    if let Some(n) = threads {
+        if n == 0 {
+            return Err(Error::usage("--threads", "must be at least 1"));
+        }
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build_global()
+            .map_err(|e| Error::usage("--threads", e.to_string()))?;
+    }
+    Ok(())
+}
+
+fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
+    let t = Timeline::load(&args.timeline)?;
+    let (width, height) = match &args.size {
+        Some(s) => parse_size("--size", s)?,
+        None => {
+            let w = t.width.min(160);
+            (
+                w,
+                ((w as u64 * t.height as u64) / t.width as u64).max(1) as u32,
+            )
+        }
+    };
+    if args.frame >= t.frame_count {
+        return Err(Error::usage(
+            "--frame",
+            format!(
+                "frame {} is past the last frame ({})",
+                args.frame,
+                t.frame_count - 1
+            ),
+        )
+        .into());
+    }
+    set_threads(args.threads)?;
+    let out_dir = args
+        .out
+        .clone()
+        .unwrap_or_else(|| Path::new("out").join(&t.name));
+    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+    let scene = t.scene_at(args.frame);
+    let quiet = args.quiet;
+    let rows = crate::accuracy::measure(&scene, args.frame, width, height, &|i, n, v| {
+        if !quiet {
+            eprintln!("[{}/{}] {} = {}", i + 1, n, v.knob, v.setting);
+        }
+    });
+    let title = format!(
+        "What accuracy costs: {} frame {} at {width}x{height}, {} threads",
+        t.name,
+        args.frame,
+        rayon::current_num_threads()
+    );
+    let csv = out_dir.join("accuracy.csv");
+    let md = out_dir.join("accuracy.md");
+    let png = out_dir.join("accuracy.png");
+    let table = crate::accuracy::to_markdown(&rows, &format!("## {title}"));
+    std::fs::write(&csv, crate::accuracy::to_csv(&rows)).map_err(|e| Error::io(&csv, e))?;
+    std::fs::write(&md, &table).map_err(|e| Error::io(&md, e))?;
+    crate::accuracy::write_chart(&rows, &title, &png)?;
+    println!("{table}");
+    eprintln!(
+        "wrote {}, {} and {}",
+        csv.display(),
+        md.display(),
+        png.display()
+    );
     Ok(())
 }
 

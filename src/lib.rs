@@ -1,10 +1,11 @@
 //! mandelreel: keyframed Mandelbulb films from RON timelines.
 //!
 //! Layers, each depending only on those after it:
-//! `cli → render, output → shade → march → fractal → math`, and `timeline → scene`.
+//! `cli → accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`.
 
 #![forbid(unsafe_code)]
 
+pub mod accuracy;
 pub mod cli;
 pub mod error;
 pub mod fractal;

@@ -1,0 +1,85 @@
+//! Kernel benchmarks: each distance estimator in f64 and f32, and one
+//! power-8 triplex iteration by trigonometry versus Quilez's polynomial.
+//! Run with `cargo bench`; CI only builds them.
+
+use mandelreel::fractal::{
+    power8_polynomial, triplex_power_trig, DeMethod, Formula, Fractal, Precision,
+};
+use mandelreel::math::DVec3;
+
+fn main() {
+    divan::main();
+}
+
+/// Points near the power-8 bulb's surface, where marching spends its time.
+fn points() -> Vec<DVec3> {
+    (0..256)
+        .map(|i| {
+            let a = i as f64 * 2.399_963;
+            let z = 1.0 - 2.0 * (i as f64 + 0.5) / 256.0;
+            let s = (1.0 - z * z).sqrt();
+            DVec3::new(s * a.cos(), z, s * a.sin()) * 1.05
+        })
+        .collect()
+}
+
+const METHODS: [DeMethod; 5] = DeMethod::ALL;
+
+#[divan::bench(args = METHODS)]
+fn estimate_f64(bencher: divan::Bencher, de: DeMethod) {
+    bench_estimate(bencher, de, Precision::F64);
+}
+
+#[divan::bench(args = METHODS)]
+fn estimate_f32(bencher: divan::Bencher, de: DeMethod) {
+    bench_estimate(bencher, de, Precision::F32);
+}
+
+fn bench_estimate(bencher: divan::Bencher, de: DeMethod, precision: Precision) {
+    let f = Fractal {
+        de,
+        precision,
+        ..Fractal::default()
+    };
+    let pts = points();
+    bencher
+        .counter(divan::counter::ItemsCount::new(pts.len()))
+        .bench(|| {
+            pts.iter()
+                .map(|&p| f.estimate(divan::black_box(p), 1e-4).distance)
+                .sum::<f64>()
+        });
+}
+
+#[divan::bench(types = [f64, f32])]
+fn power8_trig<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
+    let pts: Vec<[T; 3]> = points()
+        .iter()
+        .map(|p| [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)])
+        .collect();
+    bencher
+        .counter(divan::counter::ItemsCount::new(pts.len()))
+        .bench(|| {
+            pts.iter()
+                .map(|&z| {
+                    let r = (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt();
+                    triplex_power_trig(Formula::Quilez, divan::black_box(z), r, 8.0)[1].value()
+                })
+                .sum::<f64>()
+        });
+}
+
+#[divan::bench(types = [f64, f32])]
+fn power8_polynomial_form<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
+    let pts: Vec<[T; 3]> = points()
+        .iter()
+        .map(|p| [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)])
+        .collect();
+    bencher
+        .counter(divan::counter::ItemsCount::new(pts.len()))
+        .bench(|| {
+            pts.iter()
+                .map(|&z| power8_polynomial(divan::black_box(z)).map_or(0.0, |w| w[1].value()))
+                .sum::<f64>()
+        });
+}

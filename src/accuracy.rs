@@ -1,0 +1,589 @@
+//! What accuracy costs in time: `mandelreel accuracy` renders one frame of a
+//! user's own scene as a reference that trusts no distance estimate, then
+//! sweeps every quality knob, distance estimator and precision one at a time
+//! around the scene's settings and measures, for each, the wall time, the
+//! orbits computed, the depth error against the reference and the image error.
+//!
+//! The reference has two parts: hit depths found by membership stepping and
+//! bisection (`march::march_by_membership`), and a shaded image of the same
+//! fractal with every marching knob set high (`reference_scene`).
+
+use crate::error::{Error, Result};
+use crate::fractal::{DeMethod, Precision};
+use crate::march::march_by_membership;
+use crate::math::{linear_to_srgb, Real};
+use crate::render::{render_frame, Film};
+use crate::scene::Scene;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::path::Path;
+use std::time::Instant;
+
+/// One setting to measure: the scene with one knob changed.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// The knob varied (`iterations`, `de`, …), or `reference` / `scene`.
+    pub knob: &'static str,
+    /// Its value in this variant.
+    pub setting: String,
+    pub scene: Scene,
+}
+
+/// What one variant cost and how far it is from the reference.
+#[derive(Clone, Debug, Serialize)]
+pub struct Measurement {
+    pub knob: &'static str,
+    pub setting: String,
+    pub seconds: f64,
+    /// Orbits computed (distance-estimator evaluations, membership tests, normals).
+    pub de_evaluations: u64,
+    /// Mean and 99th percentile of |depth − reference depth| in pixel footprints,
+    /// over pixels that both hit.
+    pub depth_error_mean_px: f64,
+    pub depth_error_p99_px: f64,
+    /// Share of pixels where this variant and the reference disagree on hit or miss.
+    pub hit_mismatch: f64,
+    /// Share of pixels whose hit lies more than one footprint past the reference
+    /// crossing: the marcher went through the surface (the failure that matters;
+    /// stopping early, where a pixel's cone grazes a sub-pixel feature in front
+    /// of the centre ray's crossing, is what a footprint threshold is meant to do).
+    pub overshoot: f64,
+    /// Root-mean-square difference of the sRGB images (0..1 per channel).
+    pub image_rmse: f64,
+    /// Peak signal-to-noise ratio of that difference in dB (infinite when identical).
+    pub psnr_db: f64,
+    /// On the Pareto front of time against image error: no other variant is
+    /// both faster and closer to the reference.
+    pub pareto: bool,
+}
+
+/// The scene with every marching knob set high: the shaded reference. The
+/// fractal (iterations, bailout, estimator, precision) stays the scene's, so
+/// sweeping those knobs shows what they change in the picture.
+pub fn reference_scene(scene: &Scene) -> Scene {
+    let mut r = scene.clone();
+    r.quality.hit_threshold = scene.quality.hit_threshold / 8.0;
+    r.quality.fudge = scene.quality.fudge.min(0.5);
+    r.quality.max_steps = scene.quality.max_steps.saturating_mul(8);
+    r.quality.normal_step = scene.quality.normal_step / 4.0;
+    r.samples_per_pixel = scene.samples_per_pixel.max(16);
+    r
+}
+
+fn scaled(v: u32, f: Real) -> u32 {
+    ((v as Real * f).round() as u32).max(1)
+}
+
+/// The sweep: the reference, the scene itself, then one knob at a time.
+pub fn variants(scene: &Scene) -> Vec<Variant> {
+    let mut out = vec![
+        Variant {
+            knob: "reference",
+            setting: "membership depth + high-quality shading".into(),
+            scene: reference_scene(scene),
+        },
+        Variant {
+            knob: "scene",
+            setting: "as in the timeline".into(),
+            scene: scene.clone(),
+        },
+    ];
+    let mut add = |knob: &'static str, setting: String, change: &dyn Fn(&mut Scene)| {
+        let mut s = scene.clone();
+        change(&mut s);
+        if s != *scene && !out.iter().any(|v| v.scene == s) {
+            out.push(Variant {
+                knob,
+                setting,
+                scene: s,
+            });
+        }
+    };
+    let f = &scene.fractal;
+    let q = &scene.quality;
+    for k in [0.25, 0.5, 0.75, 1.5] {
+        let n = scaled(f.iterations, k);
+        add("iterations", n.to_string(), &|s| s.fractal.iterations = n);
+    }
+    for b in [2.0, 16.0, 256.0] {
+        add("bailout", format!("{b}"), &|s| s.fractal.bailout = b);
+    }
+    for k in [4.0, 2.0, 0.5, 0.25] {
+        let v = q.hit_threshold * k;
+        add("hit_threshold", format!("{v}"), &|s| {
+            s.quality.hit_threshold = v
+        });
+    }
+    for v in [0.5, 0.7, 1.0] {
+        add("fudge", format!("{v}"), &|s| s.quality.fudge = v);
+    }
+    for k in [0.25, 0.5, 2.0] {
+        let v = scaled(q.max_steps, k);
+        add("max_steps", v.to_string(), &|s| s.quality.max_steps = v);
+    }
+    for k in [4.0, 0.25] {
+        let v = q.normal_step * k;
+        add("normal_step", format!("{v}"), &|s| {
+            s.quality.normal_step = v
+        });
+    }
+    for n in [1, 4, 9, 16] {
+        add("samples_per_pixel", n.to_string(), &|s| {
+            s.samples_per_pixel = n
+        });
+    }
+    for precision in [Precision::F64, Precision::F32] {
+        for de in DeMethod::ALL {
+            add("de", format!("{} {}", de.name(), precision.name()), &|s| {
+                s.fractal.de = de;
+                s.fractal.precision = precision;
+            });
+        }
+    }
+    out
+}
+
+/// Membership-reference hit distance for every pixel centre (None for a miss),
+/// with the number of membership tests spent.
+pub fn reference_depths(scene: &Scene, width: u32, height: u32) -> (Vec<Option<Real>>, u64) {
+    let camera = scene.camera.frame();
+    // Never step finer than a millionth of the camera–target distance: bounds the
+    // work for rays that start right on the surface in deep zooms.
+    let min_step = 1e-6 * (scene.camera.position - scene.camera.target).length();
+    let rows: Vec<(Vec<Option<Real>>, u64)> = (0..height)
+        .into_par_iter()
+        .map(|y| {
+            let mut tests = 0u64;
+            let row = (0..width)
+                .map(|x| {
+                    let ray = camera.ray(x as Real + 0.5, y as Real + 0.5, width, height);
+                    let t = march_by_membership(
+                        &ray,
+                        &scene.fractal,
+                        &scene.quality,
+                        min_step,
+                        200_000,
+                    );
+                    tests += 1;
+                    t
+                })
+                .collect();
+            (row, tests)
+        })
+        .collect();
+    let mut depths = Vec::with_capacity((width * height) as usize);
+    let mut tests = 0;
+    for (row, n) in rows {
+        depths.extend(row);
+        tests += n;
+    }
+    (depths, tests)
+}
+
+/// The sRGB image of a film, as 0..1 floats.
+fn srgb(film: &Film) -> Vec<f32> {
+    film.colour
+        .iter()
+        .flat_map(|c| [c.x, c.y, c.z])
+        .map(linear_to_srgb)
+        .collect()
+}
+
+/// Errors of one variant against the reference.
+struct Errors {
+    depth_mean: f64,
+    depth_p99: f64,
+    hit_mismatch: f64,
+    overshoot: f64,
+    rmse: f64,
+}
+
+fn compare(
+    film: &Film,
+    reference_image: &[f32],
+    reference_depth: &[Option<Real>],
+    footprints: &[Real],
+) -> Errors {
+    let image = srgb(film);
+    let mse = image
+        .iter()
+        .zip(reference_image)
+        .map(|(a, b)| ((a - b) as f64).powi(2))
+        .sum::<f64>()
+        / image.len().max(1) as f64;
+    let mut errors = Vec::new();
+    let mut mismatches = 0usize;
+    let mut overshoots = 0usize;
+    for (i, reference) in reference_depth.iter().enumerate() {
+        let hit = film.alpha[i] > 0.0;
+        match reference {
+            Some(t) if hit => {
+                let signed = (film.depth[i] as f64 - t) / footprints[i];
+                if signed > 1.0 {
+                    overshoots += 1;
+                }
+                errors.push(signed.abs())
+            }
+            Some(_) => mismatches += 1,
+            None if hit => mismatches += 1,
+            None => {}
+        }
+    }
+    errors.sort_by(|a, b| a.total_cmp(b));
+    let mean = if errors.is_empty() {
+        0.0
+    } else {
+        errors.iter().sum::<f64>() / errors.len() as f64
+    };
+    let p99 = errors
+        .get(((errors.len() as f64 * 0.99).ceil() as usize).saturating_sub(1))
+        .copied()
+        .unwrap_or(0.0);
+    let pixels = reference_depth.len().max(1) as f64;
+    Errors {
+        depth_mean: mean,
+        depth_p99: p99,
+        hit_mismatch: mismatches as f64 / pixels,
+        overshoot: overshoots as f64 / pixels,
+        rmse: mse.sqrt(),
+    }
+}
+
+fn psnr(rmse: f64) -> f64 {
+    if rmse == 0.0 {
+        f64::INFINITY
+    } else {
+        -20.0 * rmse.log10()
+    }
+}
+
+/// Renders `scene` and returns the film with its wall time. Quick renders
+/// are repeated until a quarter second has passed (at most 20 times) and the
+/// fastest run is kept, so small frames still give stable timings.
+fn timed_render(scene: &Scene, frame_index: u32, width: u32, height: u32) -> (Film, f64) {
+    let mut best = f64::INFINITY;
+    let mut film = None;
+    let started = Instant::now();
+    for _ in 0..20 {
+        let t0 = Instant::now();
+        let f = render_frame(scene, frame_index, width, height, &|| {});
+        best = best.min(t0.elapsed().as_secs_f64());
+        film = Some(f);
+        if started.elapsed().as_secs_f64() > 0.25 {
+            break;
+        }
+    }
+    (film.expect("rendered at least once"), best)
+}
+
+/// Runs the whole sweep on frame `frame_index` of `scene` at `width`×`height`.
+/// `progress` hears each variant's name before it is rendered.
+pub fn measure(
+    scene: &Scene,
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    progress: &dyn Fn(usize, usize, &Variant),
+) -> Vec<Measurement> {
+    let all = variants(scene);
+    let camera = scene.camera.frame();
+    let footprints: Vec<Real> = (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| camera.ray(x as Real + 0.5, y as Real + 0.5, width, height))
+        .map(|ray| ray.footprint(1.0))
+        .collect();
+
+    progress(0, all.len(), &all[0]);
+    let started = Instant::now();
+    let (reference_depth, tests) = reference_depths(scene, width, height);
+    let reference_film = render_frame(&all[0].scene, frame_index, width, height, &|| {});
+    let reference_seconds = started.elapsed().as_secs_f64();
+    let reference_image = srgb(&reference_film);
+    // Footprints scale with distance: per pixel, footprint(t) = t × footprint(1).
+    let footprint_at_reference: Vec<Real> = reference_depth
+        .iter()
+        .zip(&footprints)
+        .map(|(t, f)| t.map_or(*f, |t| (t * f).max(1e-300)))
+        .collect();
+
+    let mut rows = vec![Measurement {
+        knob: all[0].knob,
+        setting: all[0].setting.clone(),
+        seconds: reference_seconds,
+        de_evaluations: tests + reference_film.stats.de_evaluations,
+        depth_error_mean_px: 0.0,
+        depth_error_p99_px: 0.0,
+        hit_mismatch: 0.0,
+        overshoot: 0.0,
+        image_rmse: 0.0,
+        psnr_db: f64::INFINITY,
+        pareto: false,
+    }];
+    for (i, variant) in all.iter().enumerate().skip(1) {
+        progress(i, all.len(), variant);
+        let (film, seconds) = timed_render(&variant.scene, frame_index, width, height);
+        let e = compare(
+            &film,
+            &reference_image,
+            &reference_depth,
+            &footprint_at_reference,
+        );
+        rows.push(Measurement {
+            knob: variant.knob,
+            setting: variant.setting.clone(),
+            seconds,
+            de_evaluations: film.stats.de_evaluations,
+            depth_error_mean_px: e.depth_mean,
+            depth_error_p99_px: e.depth_p99,
+            hit_mismatch: e.hit_mismatch,
+            overshoot: e.overshoot,
+            image_rmse: e.rmse,
+            psnr_db: psnr(e.rmse),
+            pareto: false,
+        });
+    }
+    mark_pareto(&mut rows);
+    rows
+}
+
+/// Marks the rows no other row beats on both time and image error.
+pub fn mark_pareto(rows: &mut [Measurement]) {
+    let points: Vec<(f64, f64)> = rows.iter().map(|r| (r.seconds, r.image_rmse)).collect();
+    for (i, row) in rows.iter_mut().enumerate() {
+        let (t, e) = points[i];
+        row.pareto = !points
+            .iter()
+            .enumerate()
+            .any(|(j, &(tj, ej))| j != i && tj <= t && ej <= e && (tj < t || ej < e));
+    }
+}
+
+/// The table as CSV, one row per variant.
+pub fn to_csv(rows: &[Measurement]) -> String {
+    let mut out = String::from(
+        "knob,setting,seconds,de_evaluations,depth_error_mean_px,depth_error_p99_px,hit_mismatch,overshoot,image_rmse,psnr_db,pareto\n",
+    );
+    for r in rows {
+        out += &format!(
+            "{},\"{}\",{:.6},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.3},{}\n",
+            r.knob,
+            r.setting,
+            r.seconds,
+            r.de_evaluations,
+            r.depth_error_mean_px,
+            r.depth_error_p99_px,
+            r.hit_mismatch,
+            r.overshoot,
+            r.image_rmse,
+            r.psnr_db,
+            r.pareto
+        );
+    }
+    out
+}
+
+/// The table as Markdown, with times relative to the scene's own settings.
+pub fn to_markdown(rows: &[Measurement], title: &str) -> String {
+    let base = rows
+        .iter()
+        .find(|r| r.knob == "scene")
+        .map(|r| r.seconds)
+        .unwrap_or(1.0)
+        .max(1e-9);
+    let mut out = format!(
+        "{title}\n\n| knob | setting | time (s) | × scene | DE evals | depth err mean (px) | depth err p99 (px) | hit/miss differ | overshoot | PSNR (dB) | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n"
+    );
+    for r in rows {
+        out += &format!(
+            "| {} | {} | {:.3} | {:.2} | {} | {:.2} | {:.2} | {:.2}% | {:.2}% | {} | {} |\n",
+            r.knob,
+            r.setting,
+            r.seconds,
+            r.seconds / base,
+            r.de_evaluations,
+            r.depth_error_mean_px,
+            r.depth_error_p99_px,
+            100.0 * r.hit_mismatch,
+            100.0 * r.overshoot,
+            if r.psnr_db.is_finite() {
+                format!("{:.1}", r.psnr_db)
+            } else {
+                "∞".into()
+            },
+            if r.pareto { "★" } else { "" }
+        );
+    }
+    out
+}
+
+static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSansMono.ttf");
+
+/// Draws image error against time, one series per knob, Pareto front marked,
+/// and writes it as a PNG.
+pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()> {
+    use plotters::prelude::*;
+    let chart_error = |e: String| Error::Image {
+        path: path.to_path_buf(),
+        message: e,
+    };
+    // Registering twice is harmless; a bad font would be a build error in practice.
+    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
+        .map_err(|_| chart_error("the embedded font is unreadable".into()))?;
+    let (w, h) = (1000u32, 640u32);
+    let mut pixels = vec![255u8; (w * h * 3) as usize];
+    // Log axes. The reference (zero error by definition) is not plotted.
+    let measured: Vec<&Measurement> = rows.iter().filter(|r| r.knob != "reference").collect();
+    let positive = |v: f64| v.is_finite() && v > 0.0;
+    let times: Vec<f64> = measured
+        .iter()
+        .map(|r| r.seconds)
+        .filter(|&v| positive(v))
+        .collect();
+    let errors: Vec<f64> = measured
+        .iter()
+        .map(|r| r.image_rmse)
+        .filter(|&v| positive(v))
+        .collect();
+    let range = |v: &[f64], fallback: (f64, f64)| {
+        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.iter().copied().fold(0.0, f64::max);
+        if lo.is_finite() && hi > 0.0 {
+            (lo * 0.7, hi * 1.4)
+        } else {
+            fallback
+        }
+    };
+    let (t_min, t_max) = range(&times, (1e-3, 1.0));
+    let (e_min, e_max) = range(&errors, (1e-4, 1.0));
+    let floor = e_min;
+    {
+        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
+        root.fill(&WHITE).map_err(|e| chart_error(e.to_string()))?;
+        let mut chart = ChartBuilder::on(&root)
+            .caption(title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(44)
+            .y_label_area_size(64)
+            .build_cartesian_2d((t_min..t_max).log_scale(), (e_min..e_max).log_scale())
+            .map_err(|e| chart_error(e.to_string()))?;
+        chart
+            .configure_mesh()
+            .x_desc("wall time per frame (s)")
+            .x_labels(8)
+            .y_labels(8)
+            .x_label_formatter(&|v| format!("{v:.3}"))
+            .y_label_formatter(&|v| format!("{v:.3}"))
+            .y_desc("image RMSE vs reference (sRGB)")
+            .label_style(("sans-serif", 14))
+            .draw()
+            .map_err(|e| chart_error(e.to_string()))?;
+        let mut knobs: Vec<&'static str> = measured.iter().map(|r| r.knob).collect();
+        knobs.dedup();
+        knobs.sort();
+        knobs.dedup();
+        for (k, knob) in knobs.iter().enumerate() {
+            let colour = Palette99::pick(k).to_rgba();
+            let series: Vec<(f64, f64)> = measured
+                .iter()
+                .filter(|r| r.knob == *knob)
+                .map(|r| (r.seconds.max(t_min), r.image_rmse.max(floor)))
+                .collect();
+            chart
+                .draw_series(series.iter().map(|&p| Circle::new(p, 5, colour.filled())))
+                .map_err(|e| chart_error(e.to_string()))?
+                .label(*knob)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
+        }
+        let mut front: Vec<(f64, f64)> = measured
+            .iter()
+            .filter(|r| r.pareto)
+            .map(|r| (r.seconds.max(t_min), r.image_rmse.max(floor)))
+            .collect();
+        front.sort_by(|a, b| a.0.total_cmp(&b.0));
+        chart
+            .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(2)))
+            .map_err(|e| chart_error(e.to_string()))?
+            .label("Pareto front")
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        chart
+            .draw_series(
+                front
+                    .iter()
+                    .map(|&p| Circle::new(p, 7, BLACK.stroke_width(2))),
+            )
+            .map_err(|e| chart_error(e.to_string()))?;
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .label_font(("sans-serif", 14))
+            .position(SeriesLabelPosition::UpperRight)
+            .draw()
+            .map_err(|e| chart_error(e.to_string()))?;
+        root.present().map_err(|e| chart_error(e.to_string()))?;
+    }
+    let image = image::RgbImage::from_raw(w, h, pixels).expect("buffer matches the chart size");
+    let temp = crate::output::temporary_path(path);
+    image
+        .save_with_format(&temp, image::ImageFormat::Png)
+        .map_err(|e| chart_error(e.to_string()))?;
+    std::fs::rename(&temp, path).map_err(|e| Error::io(path, e))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(knob: &'static str, seconds: f64, rmse: f64) -> Measurement {
+        Measurement {
+            knob,
+            setting: String::new(),
+            seconds,
+            de_evaluations: 0,
+            depth_error_mean_px: 0.0,
+            depth_error_p99_px: 0.0,
+            hit_mismatch: 0.0,
+            overshoot: 0.0,
+            image_rmse: rmse,
+            psnr_db: psnr(rmse),
+            pareto: false,
+        }
+    }
+
+    #[test]
+    fn pareto_front_keeps_only_undominated_points() {
+        let mut rows = vec![
+            row("a", 1.0, 0.1),
+            row("b", 2.0, 0.05),
+            row("c", 2.0, 0.2), // slower and worse than a
+            row("d", 0.5, 0.3),
+            row("e", 3.0, 0.05), // as good as b but slower
+        ];
+        mark_pareto(&mut rows);
+        let front: Vec<_> = rows.iter().filter(|r| r.pareto).map(|r| r.knob).collect();
+        assert_eq!(front, ["a", "b", "d"]);
+    }
+
+    #[test]
+    fn psnr_of_known_errors() {
+        assert_eq!(psnr(0.0), f64::INFINITY);
+        assert!((psnr(0.1) - 20.0).abs() < 1e-12);
+        assert!((psnr(0.01) - 40.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn variants_change_one_knob_each_and_are_distinct() {
+        let scene = Scene::default();
+        let all = variants(&scene);
+        assert_eq!(all[0].knob, "reference");
+        assert_eq!(all[1].scene, scene);
+        for (i, v) in all.iter().enumerate().skip(2) {
+            assert_ne!(v.scene, scene, "{} {}", v.knob, v.setting);
+            for w in &all[i + 1..] {
+                assert_ne!(v.scene, w.scene);
+            }
+        }
+        // Every estimator in both precisions appears (the scene's own is the "scene" row).
+        assert_eq!(all.iter().filter(|v| v.knob == "de").count(), 9);
+    }
+}

@@ -1,0 +1,75 @@
+//! `mandelreel accuracy` on a tiny frame: the three files, one row per variant,
+//! and zero error for the reference against itself.
+
+use crate::util::{stdout, tiny_timeline, Dir};
+
+#[test]
+fn accuracy_writes_csv_table_and_chart() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 7.0));
+    let out = d.ok(&[
+        "accuracy", "t.ron", "--frame", "1", "--size", "24x14", "--quiet",
+    ]);
+    assert_eq!(
+        d.files("out/t"),
+        ["accuracy.csv", "accuracy.md", "accuracy.png"]
+    );
+    let csv = std::fs::read_to_string(d.path().join("out/t/accuracy.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    assert_eq!(header[0], "knob");
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| {
+            // Settings are quoted and may hold spaces but no commas.
+            l.split(',')
+                .map(|f| f.trim_matches('"').to_string())
+                .collect()
+        })
+        .collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    // The reference, the scene, and one row per variant of every knob.
+    assert_eq!(rows[0][0], "reference");
+    assert_eq!(rows[1][0], "scene");
+    for knob in [
+        "iterations",
+        "bailout",
+        "hit_threshold",
+        "fudge",
+        "max_steps",
+        "normal_step",
+        "samples_per_pixel",
+        "de",
+    ] {
+        assert!(rows.iter().any(|r| r[0] == knob), "no {knob} rows");
+    }
+    assert_eq!(rows.iter().filter(|r| r[0] == "de").count(), 9);
+    // Zero error for the reference against itself.
+    for c in [
+        "depth_error_mean_px",
+        "depth_error_p99_px",
+        "hit_mismatch",
+        "overshoot",
+        "image_rmse",
+    ] {
+        assert_eq!(rows[0][col(c)].parse::<f64>().unwrap(), 0.0, "{c}");
+    }
+    // Every measurement is a finite number; some variant differs from the reference.
+    let mut differs = false;
+    for r in &rows[1..] {
+        for c in ["seconds", "depth_error_mean_px", "image_rmse"] {
+            let v: f64 = r[col(c)].parse().unwrap();
+            assert!(v.is_finite() && v >= 0.0, "{} {c} = {v}", r[0]);
+        }
+        assert!(r[col("de_evaluations")].parse::<u64>().unwrap() > 0);
+        differs |= r[col("image_rmse")].parse::<f64>().unwrap() > 0.0;
+    }
+    assert!(differs);
+    let md = std::fs::read_to_string(d.path().join("out/t/accuracy.md")).unwrap();
+    assert_eq!(
+        md.lines().filter(|l| l.starts_with("| ")).count(),
+        rows.len() + 1
+    );
+    assert!(stdout(&out).contains("| reference |"));
+    let chart = image::open(d.path().join("out/t/accuracy.png")).unwrap();
+    assert!(chart.width() >= 800);
+}
