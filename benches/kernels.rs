@@ -23,6 +23,14 @@ fn points() -> Vec<DVec3> {
         .collect()
 }
 
+/// The same points in the kernel's number type.
+fn triplexes<T: mandelreel::math::Number>() -> Vec<[T; 3]> {
+    points()
+        .iter()
+        .map(|p| [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)])
+        .collect()
+}
+
 const METHODS: [DeMethod; 5] = DeMethod::ALL;
 
 #[divan::bench(args = METHODS)]
@@ -53,10 +61,7 @@ fn bench_estimate(bencher: divan::Bencher, de: DeMethod, precision: Precision) {
 
 #[divan::bench(types = [f64, f32])]
 fn power8_trig<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
-    let pts: Vec<[T; 3]> = points()
-        .iter()
-        .map(|p| [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)])
-        .collect();
+    let pts = triplexes::<T>();
     bencher
         .counter(divan::counter::ItemsCount::new(pts.len()))
         .bench(|| {
@@ -71,10 +76,7 @@ fn power8_trig<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
 
 #[divan::bench(types = [f64, f32])]
 fn power8_polynomial_form<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
-    let pts: Vec<[T; 3]> = points()
-        .iter()
-        .map(|p| [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)])
-        .collect();
+    let pts = triplexes::<T>();
     bencher
         .counter(divan::counter::ItemsCount::new(pts.len()))
         .bench(|| {

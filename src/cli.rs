@@ -504,17 +504,7 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         Some(s) => parse_size("--size", s)?,
         None => (t.width, t.height),
     };
-    if args.frame >= t.frame_count {
-        return Err(Error::usage(
-            "--frame",
-            format!(
-                "frame {} is past the last frame ({})",
-                args.frame,
-                t.frame_count - 1
-            ),
-        )
-        .into());
-    }
+    check_frame(&t, args.frame)?;
     let bad = || {
         Error::usage(
             "--pixel",
@@ -589,6 +579,20 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// Rejects a `--frame` past the timeline's last frame.
+fn check_frame(t: &Timeline, frame: u32) -> Result<()> {
+    if frame >= t.frame_count {
+        return Err(Error::usage(
+            "--frame",
+            format!(
+                "frame {frame} is past the last frame ({})",
+                t.frame_count - 1
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// Sizes rayon's pool to `--threads` when given.
 fn set_threads(threads: Option<usize>) -> Result<()> {
     if let Some(n) = threads {
@@ -615,17 +619,7 @@ fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
             )
         }
     };
-    if args.frame >= t.frame_count {
-        return Err(Error::usage(
-            "--frame",
-            format!(
-                "frame {} is past the last frame ({})",
-                args.frame,
-                t.frame_count - 1
-            ),
-        )
-        .into());
-    }
+    check_frame(&t, args.frame)?;
     set_threads(args.threads)?;
     let out_dir = args
         .out
