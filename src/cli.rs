@@ -365,9 +365,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
             say(format!(
-                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample), {} of {} samples hit",
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel), {} of {} samples hit",
                 film.stats.de_evaluations,
                 film.stats.de_evaluations as f64 / film.stats.samples.max(1) as f64,
+                film.stats.max_pixel_evaluations,
                 film.stats.hits,
                 film.stats.samples
             ));

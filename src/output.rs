@@ -25,7 +25,8 @@ pub const FRAME_DIGITS: usize = 5;
 pub enum Format {
     /// 8-bit sRGB PNG.
     Png,
-    /// OpenEXR: linear half-float R, G, B, A and a float Z (camera distance).
+    /// OpenEXR: linear half-float R, G, B, A, a float Z (camera distance) and a
+    /// u32 DE channel (orbits computed per pixel, a cost heat map).
     Exr,
 }
 
@@ -186,8 +187,11 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
 
 fn stats_text(film: &Film) -> String {
     format!(
-        "de_evaluations={} samples={} hits={}",
-        film.stats.de_evaluations, film.stats.samples, film.stats.hits
+        "de_evaluations={} samples={} hits={} max_pixel_evaluations={}",
+        film.stats.de_evaluations,
+        film.stats.samples,
+        film.stats.hits,
+        film.stats.max_pixel_evaluations
     )
 }
 
@@ -237,6 +241,8 @@ fn encode_exr(
         AnyChannel::new("B", FlatSamples::F16(half(&|i| film.colour[i].z))),
         AnyChannel::new("A", FlatSamples::F16(half(&|i| film.alpha[i]))),
         AnyChannel::new("Z", FlatSamples::F32(film.depth.clone())),
+        // Cost heat map: orbits computed per pixel.
+        AnyChannel::new("DE", FlatSamples::U32(film.evaluations.clone())),
     ]));
     let mut attributes = LayerAttributes::named("");
     attributes.software_name = Some(Text::from(
@@ -394,6 +400,7 @@ mod tests {
             colour: vec![Vec3::new(0.0, 0.5, 1.0); 6],
             alpha: vec![1.0; 6],
             depth: vec![2.5; 6],
+            evaluations: vec![7; 6],
             stats: FrameStats::default(),
         }
     }

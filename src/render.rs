@@ -23,6 +23,8 @@ pub struct Film {
     pub alpha: Vec<f32>,
     /// Distance from the camera to the nearest hit among the pixel's samples.
     pub depth: Vec<f32>,
+    /// Orbits computed for the pixel (all samples): where the frame's time went.
+    pub evaluations: Vec<u32>,
     pub stats: FrameStats,
 }
 
@@ -33,6 +35,8 @@ pub struct FrameStats {
     pub de_evaluations: u64,
     pub samples: u64,
     pub hits: u64,
+    /// The most evaluations any one pixel took.
+    pub max_pixel_evaluations: u64,
 }
 
 impl std::ops::Add for FrameStats {
@@ -42,6 +46,7 @@ impl std::ops::Add for FrameStats {
             de_evaluations: self.de_evaluations + o.de_evaluations,
             samples: self.samples + o.samples,
             hits: self.hits + o.hits,
+            max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
         }
     }
 }
@@ -93,52 +98,62 @@ pub fn render_frame(
     let mut colour = vec![Vec3::ZERO; pixels];
     let mut alpha = vec![0.0f32; pixels];
     let mut depth = vec![BACKGROUND_DEPTH; pixels];
+    let mut evaluations = vec![0u32; pixels];
     // One row per task; rayon spreads rows over threads and each pixel depends
     // only on its own samples, so the result is independent of the split.
     let stats = colour
         .par_chunks_mut(w)
         .zip(alpha.par_chunks_mut(w))
         .zip(depth.par_chunks_mut(w))
+        .zip(evaluations.par_chunks_mut(w))
         .enumerate()
-        .map(|(y, ((colour_row, alpha_row), depth_row))| {
-            let mut stats = FrameStats::default();
-            for x in 0..w {
-                let pixel = (y * w + x) as u64;
-                let mut sum = [0.0f64; 3];
-                let mut hits = 0u32;
-                for s in 0..n {
-                    let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
-                    let ray = camera.ray(x as Real + ox, y as Real + oy, width, height);
-                    let result = march(&ray, &scene.fractal, &scene.quality);
-                    stats.de_evaluations += result.evaluations as u64;
-                    let c = match result.hit {
-                        Some(hit) => {
-                            let (nrm, evals) = normal(&ray, &hit, &scene.fractal, &scene.quality);
-                            stats.de_evaluations += evals as u64;
-                            hits += 1;
-                            depth_row[x] = depth_row[x].min(hit.t as f32);
-                            scene.look.surface(nrm, &hit.estimate.traps)
-                        }
-                        None => scene.look.background(ray.dir, camera.up),
-                    };
-                    let c = finite_or_zero(c);
-                    sum[0] += c.x as f64;
-                    sum[1] += c.y as f64;
-                    sum[2] += c.z as f64;
+        .map(
+            |(y, (((colour_row, alpha_row), depth_row), evaluations_row))| {
+                let mut stats = FrameStats::default();
+                for x in 0..w {
+                    let pixel = (y * w + x) as u64;
+                    let mut sum = [0.0f64; 3];
+                    let mut hits = 0u32;
+                    let mut pixel_evaluations = 0u64;
+                    for s in 0..n {
+                        let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
+                        let ray = camera.ray(x as Real + ox, y as Real + oy, width, height);
+                        let result = march(&ray, &scene.fractal, &scene.quality);
+                        pixel_evaluations += result.evaluations as u64;
+                        let c = match result.hit {
+                            Some(hit) => {
+                                let (nrm, evals) =
+                                    normal(&ray, &hit, &scene.fractal, &scene.quality);
+                                pixel_evaluations += evals as u64;
+                                hits += 1;
+                                depth_row[x] = depth_row[x].min(hit.t as f32);
+                                scene.look.surface(nrm, &hit.estimate.traps)
+                            }
+                            None => scene.look.background(ray.dir, camera.up),
+                        };
+                        let c = finite_or_zero(c);
+                        sum[0] += c.x as f64;
+                        sum[1] += c.y as f64;
+                        sum[2] += c.z as f64;
+                    }
+                    let inv = 1.0 / n as f64;
+                    colour_row[x] = Vec3::new(
+                        (sum[0] * inv) as f32,
+                        (sum[1] * inv) as f32,
+                        (sum[2] * inv) as f32,
+                    );
+                    alpha_row[x] = hits as f32 / n as f32;
+                    evaluations_row[x] = pixel_evaluations.min(u32::MAX as u64) as u32;
+                    stats.de_evaluations += pixel_evaluations;
+                    stats.max_pixel_evaluations =
+                        stats.max_pixel_evaluations.max(pixel_evaluations);
+                    stats.samples += n as u64;
+                    stats.hits += hits as u64;
                 }
-                let inv = 1.0 / n as f64;
-                colour_row[x] = Vec3::new(
-                    (sum[0] * inv) as f32,
-                    (sum[1] * inv) as f32,
-                    (sum[2] * inv) as f32,
-                );
-                alpha_row[x] = hits as f32 / n as f32;
-                stats.samples += n as u64;
-                stats.hits += hits as u64;
-            }
-            on_row();
-            stats
-        })
+                on_row();
+                stats
+            },
+        )
         .reduce(FrameStats::default, |a, b| a + b);
     Film {
         width,
@@ -146,6 +161,7 @@ pub fn render_frame(
         colour,
         alpha,
         depth,
+        evaluations,
         stats,
     }
 }
@@ -199,6 +215,14 @@ mod tests {
         assert_eq!(film.depth[at(0, 0)], BACKGROUND_DEPTH);
         assert!(film.colour.iter().all(|c| c.is_finite()));
         assert!(film.stats.de_evaluations > film.stats.samples);
+        // Per-pixel counts add up to the frame's, and the bulb costs more than the sky.
+        let per_pixel: u64 = film.evaluations.iter().map(|&e| e as u64).sum();
+        assert_eq!(per_pixel, film.stats.de_evaluations);
+        assert_eq!(
+            film.stats.max_pixel_evaluations,
+            *film.evaluations.iter().max().unwrap() as u64
+        );
+        assert!(film.evaluations[at(16, 12)] > film.evaluations[at(0, 0)]);
         assert_eq!(film.stats.samples, 32 * 24);
     }
 }

@@ -23,11 +23,15 @@ fn png_and_exr_decode_with_expected_channels() {
         .iter()
         .map(|c| c.name.to_string())
         .collect();
-    assert_eq!(names, ["A", "B", "G", "R", "Z"]);
-    let z: Vec<f32> = layer.channel_data.list[4]
-        .sample_data
-        .values_as_f32()
-        .collect();
+    assert_eq!(names, ["A", "B", "DE", "G", "R", "Z"]);
+    let channel = |name: &str| -> Vec<f32> {
+        let i = names.iter().position(|n| n == name).unwrap();
+        layer.channel_data.list[i]
+            .sample_data
+            .values_as_f32()
+            .collect()
+    };
+    let z = channel("Z");
     // Z is the camera distance: about 2 in the middle (camera 3 from the centre), huge for background.
     assert!(
         z[13 * 48 + 24] > 1.0 && z[13 * 48 + 24] < 3.1,
@@ -37,10 +41,10 @@ fn png_and_exr_decode_with_expected_channels() {
     assert!(z[0] >= 1.0e9);
 
     // The PNG's sRGB bytes and the EXR's linear values describe the same pixel.
-    let r: Vec<f32> = layer.channel_data.list[3]
-        .sample_data
-        .values_as_f32()
-        .collect();
+    let r = channel("R");
+    // The cost map: the pixel on the bulb computed several orbits.
+    let de = channel("DE");
+    assert!(de[13 * 48 + 24] >= 5.0, "{}", de[13 * 48 + 24]);
     let i = 13 * 48 + 24;
     let srgb = png.to_rgb8().get_pixel(24, 13)[0] as f32 / 255.0;
     let linear = if srgb <= 0.04045 {
