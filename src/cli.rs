@@ -300,6 +300,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     }
     let total = range.len();
     let skipped = total - todo.len();
+    let inside: Vec<u32> = todo
+        .iter()
+        .filter(|(_, scene, _)| scene.fractal.contains(scene.camera.position))
+        .map(|(frame, _, _)| *frame)
+        .collect();
 
     let show_bars = !args.quiet && std::io::stderr().is_terminal();
     let log_lines = !args.quiet && !show_bars;
@@ -331,6 +336,15 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("{line}");
         }
     };
+    if !inside.is_empty() {
+        // Not an error (a fly-through may pass through the surface), but those
+        // frames show only the inside: every ray starts in the set.
+        say(format!(
+            "warning: the camera is inside the fractal in {} frame(s) (first: {}); they render as a flat inside colour",
+            inside.len(),
+            inside[0]
+        ));
+    }
     if !args.quiet && stale > 0 {
         say(format!(
             "removed {stale} temporary file(s) left by an interrupted render"
@@ -365,12 +379,13 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
             say(format!(
-                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel), {} of {} samples hit",
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel), {} of {} samples hit, {} repaired",
                 film.stats.de_evaluations,
                 film.stats.de_evaluations as f64 / film.stats.samples.max(1) as f64,
                 film.stats.max_pixel_evaluations,
                 film.stats.hits,
-                film.stats.samples
+                film.stats.samples,
+                film.stats.repaired_samples
             ));
         } else if log_lines {
             eprintln!(
@@ -392,7 +407,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             out_dir.display()
         );
         if args.stats {
-            eprintln!("total DE evaluations: {}", totals.de_evaluations);
+            eprintln!(
+                "total DE evaluations: {}, repaired (NaN/inf) samples: {}",
+                totals.de_evaluations, totals.repaired_samples
+            );
         }
         let video_format = if formats.contains(&Format::Png) {
             Format::Png

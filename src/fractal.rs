@@ -319,6 +319,13 @@ impl Fractal {
         let mut orbits = 1;
         let distance = if !centre.escaped {
             0.0
+        } else if centre.iterations == 0 {
+            // Outside the bailout ball before iterating. The set lies inside that
+            // ball by definition, so the distance to it is a bound, where the
+            // estimators' asymptotics (½·r·ln r) are not. Measured without
+            // overflow, for points out to f64's largest.
+            let scale = p.abs().max_element();
+            (scale * (p / scale).length() - self.bailout).max(0.0)
         } else {
             let r = centre.r.value();
             let d = match self.de {
@@ -374,9 +381,7 @@ impl Fractal {
             if d.is_finite() {
                 d.max(0.0)
             } else {
-                // r overflowed or a gradient vanished: the point is far outside, and
-                // the marcher clamps every step to the bounding sphere.
-                Real::MAX
+                guarded_distance(&centre)
             }
         };
         Estimate {
@@ -415,6 +420,21 @@ pub fn spectral_norm(m: glam::DMat3) -> Real {
             .map(|c| m.col(c).length_squared())
             .sum::<Real>()
             .sqrt()
+    }
+}
+
+/// A safe distance where an estimator's formula gave NaN or infinity (a
+/// gradient that vanished or overflowed, a derivative infinite on an axis, a
+/// running derivative beyond f32's range): the analytic estimate from the same
+/// orbit if that is finite, else 0, which the marcher treats as a hit: it may
+/// stop early but never skips surface.
+fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
+    let r = centre.r.value();
+    let analytic = 0.5 * r.ln() * r / centre.dr.value();
+    if analytic.is_finite() && analytic >= 0.0 {
+        analytic
+    } else {
+        0.0
     }
 }
 
@@ -832,6 +852,209 @@ mod tests {
                         (fd - ad).abs() <= 1e-7 * (1.0 + ad.abs()),
                         "{p} J[{row}][{axis}]: {ad} vs {fd}"
                     );
+                }
+            }
+        }
+    }
+
+    // ---- The stability catalogue (README "Stability"): each case fails on the
+    // naive formula, shown first, and passes on ours.
+
+    fn every_variant() -> Vec<Fractal> {
+        let mut v = Vec::new();
+        for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+            for de in DeMethod::ALL {
+                for precision in [Precision::F64, Precision::F32] {
+                    for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
+                        v.push(Fractal {
+                            formula,
+                            de,
+                            precision,
+                            julia,
+                            ..Fractal::default()
+                        });
+                    }
+                }
+            }
+        }
+        v
+    }
+
+    #[test]
+    fn origin_and_tiny_radii_stay_finite_and_inside() {
+        // Naive: the polar angle of the origin is acos(0/0) = NaN.
+        let r: Real = 0.0;
+        assert!((0.0 / r).acos().is_nan());
+        let tiny = [
+            DVec3::ZERO,
+            DVec3::new(1e-300, 0.0, 0.0),
+            DVec3::new(0.0, 1e-300, 0.0),
+            DVec3::new(0.0, 0.0, -1e-300),
+            DVec3::splat(1e-200),
+        ];
+        for f in every_variant() {
+            for p in tiny {
+                let e = f.estimate(p, 1e-3);
+                assert!(e.distance.is_finite() && e.distance >= 0.0, "{f:?} at {p}");
+                assert!(e.traps.origin.is_finite() && e.traps.planes.is_finite());
+                if f.julia.is_none() {
+                    assert!(
+                        !e.escaped && e.distance == 0.0,
+                        "{f:?}: the origin is inside the bulb"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pole_axis_points_give_the_trig_value_without_nan() {
+        // Naive: Quilez's polynomial on its axis (x = z = 0) is 0 · ∞ = NaN.
+        let (x, y, z): (Real, Real, Real) = (0.0, 0.7, 0.0);
+        let k3 = x * x + z * z;
+        let k2 = 1.0 / (k3 * k3 * k3 * k3 * k3 * k3 * k3).sqrt();
+        assert!((64.0 * x * y * z * k2).is_nan());
+        for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+            for axis in [
+                DVec3::X,
+                DVec3::Y,
+                DVec3::Z,
+                -DVec3::X,
+                -DVec3::Y,
+                -DVec3::Z,
+            ] {
+                for radius in [1e-8, 0.3, 1.0, 1.9] {
+                    let p = axis * radius;
+                    let w = power(formula, p, 8.0);
+                    let exact = triplex_power_trig(formula, [p.x, p.y, p.z], radius, 8.0);
+                    assert!(w.is_finite(), "{formula:?} at {p}: {w}");
+                    let scale = radius.powi(8);
+                    assert!(
+                        (w - DVec3::from_array(exact)).length() <= 1e-12 * scale,
+                        "{formula:?} at {p}"
+                    );
+                }
+            }
+        }
+        // And every estimator, including the dual numbers whose acos has an
+        // infinite derivative there, returns a finite distance on the axes.
+        for f in every_variant() {
+            for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+                for radius in [0.5, 1.15, 1.4] {
+                    let d = f.estimate(axis * radius, 1e-4).distance;
+                    assert!(d.is_finite() && d >= 0.0, "{f:?} at {}: {d}", axis * radius);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn huge_radii_bail_out_before_the_power() {
+        // Naive: raising 1e300 to the 8th overflows, and ln(∞)·∞/∞ is NaN.
+        let big: Real = 1e300;
+        let r8 = big.powf(8.0);
+        assert!(r8.is_infinite() && (0.5 * r8.ln() * r8 / r8).is_nan());
+        for f in every_variant() {
+            for radius in [1e30, 1e100, 1e300, 1e308, Real::MAX] {
+                let e = f.estimate(DVec3::new(0.6, 0.0, 0.8) * radius, 1.0);
+                assert!(e.escaped && e.iterations == 0);
+                assert!(
+                    e.distance.is_finite() && e.distance > 0.0,
+                    "{f:?} at {radius}: {}",
+                    e.distance
+                );
+                assert!(e.distance <= radius, "{f:?} at {radius}: {}", e.distance);
+            }
+        }
+    }
+
+    #[test]
+    fn estimate_shrinks_towards_the_surface_down_to_1e_13() {
+        // Find where a ray enters the set, then back off by 1e-3 … 1e-13.
+        let f = Fractal::default();
+        let dir = DVec3::new(0.3, -0.2, -1.0).normalize();
+        let origin = DVec3::new(0.1, 0.35, 2.0);
+        let mut t = 0.0;
+        while !f.contains(origin + dir * (t + 1e-4)) {
+            t += 1e-4;
+            assert!(t < 4.0);
+        }
+        let (mut lo, mut hi) = (t, t + 1e-4);
+        for _ in 0..80 {
+            let mid = 0.5 * (lo + hi);
+            if f.contains(origin + dir * mid) {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let mut previous = Real::INFINITY;
+        for k in 3..=13 {
+            let delta = 10f64.powi(-k);
+            let d = f.estimate(origin + dir * (lo - delta), 0.0).distance;
+            assert!(d.is_finite() && d > 0.0, "1e-{k}: {d}");
+            // Non-increasing as the point closes in. (Below about 1/dr of the
+            // iteration limit it levels off: the surface at that scale is the
+            // iteration-limit boundary, which the marcher finds by bisection.)
+            assert!(d <= previous * (1.0 + 1e-9), "1e-{k}: {d} after {previous}");
+            previous = d;
+        }
+    }
+
+    #[test]
+    fn other_powers_and_dust_julia_sets() {
+        for n in [1.5, 2.0, 3.0, 8.0, 12.5] {
+            let f = Fractal {
+                power: n,
+                ..Fractal::default()
+            };
+            assert!(
+                !f.estimate(DVec3::new(0.0, 0.1, 0.0), 1e-3).escaped,
+                "power {n}"
+            );
+            for p in points(100, 1.0..1.5, 31) {
+                let d = f.estimate(p, 1e-3).distance;
+                assert!(d.is_finite() && d >= 0.0, "power {n} at {p}: {d}");
+            }
+        }
+        // A Julia constant far outside the connected region: everything escapes at once.
+        let dust = Fractal {
+            julia: Some(DVec3::splat(2.0)),
+            ..Fractal::default()
+        };
+        for p in points(100, 0.0..1.5, 37) {
+            let e = dust.estimate(p, 1e-3);
+            assert!(e.escaped && e.iterations <= 2 && e.distance > 0.0);
+        }
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(300))]
+            #[test]
+            fn estimate_is_finite_and_non_negative_anywhere(
+                x in -3.0f64..3.0, y in -3.0f64..3.0, z in -3.0f64..3.0,
+                power in 1.5f64..12.0,
+                julia in proptest::option::of((-1.5f64..1.5, -1.5f64..1.5, -1.5f64..1.5)),
+                method in 0usize..5,
+                single in any::<bool>(),
+            ) {
+                let f = Fractal {
+                    power,
+                    julia: julia.map(|(a, b, c)| DVec3::new(a, b, c)),
+                    de: DeMethod::ALL[method],
+                    precision: if single { Precision::F32 } else { Precision::F64 },
+                    ..Fractal::default()
+                };
+                let e = f.estimate(DVec3::new(x, y, z), 1e-3);
+                prop_assert!(e.distance.is_finite() && e.distance >= 0.0, "{}", e.distance);
+                prop_assert!(e.traps.origin.is_finite());
+                // Outside the bailout ball everything has escaped, with a positive distance.
+                if DVec3::new(x, y, z).length() > f.bailout {
+                    prop_assert!(e.escaped && e.distance > 0.0);
                 }
             }
         }

@@ -187,11 +187,12 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
 
 fn stats_text(film: &Film) -> String {
     format!(
-        "de_evaluations={} samples={} hits={} max_pixel_evaluations={}",
+        "de_evaluations={} samples={} hits={} max_pixel_evaluations={} repaired_samples={}",
         film.stats.de_evaluations,
         film.stats.samples,
         film.stats.hits,
-        film.stats.max_pixel_evaluations
+        film.stats.max_pixel_evaluations,
+        film.stats.repaired_samples
     )
 }
 

@@ -37,6 +37,10 @@ pub struct FrameStats {
     pub hits: u64,
     /// The most evaluations any one pixel took.
     pub max_pixel_evaluations: u64,
+    /// Samples whose colour came out NaN or infinite and were replaced by
+    /// black. Every known cause is guarded upstream, so this should stay 0;
+    /// debug builds stop at the first one instead.
+    pub repaired_samples: u64,
 }
 
 impl std::ops::Add for FrameStats {
@@ -47,6 +51,7 @@ impl std::ops::Add for FrameStats {
             samples: self.samples + o.samples,
             hits: self.hits + o.hits,
             max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
+            repaired_samples: self.repaired_samples + o.repaired_samples,
         }
     }
 }
@@ -131,6 +136,10 @@ pub fn render_frame(
                             }
                             None => scene.look.background(ray.dir, camera.up),
                         };
+                        debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
+                        if !c.is_finite() {
+                            stats.repaired_samples += 1;
+                        }
                         let c = finite_or_zero(c);
                         sum[0] += c.x as f64;
                         sum[1] += c.y as f64;

@@ -511,10 +511,20 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
     )?;
     let view = c.target - c.position;
+    // Below a few ulps of the coordinates the view direction is noise.
+    let scale = c
+        .position
+        .abs()
+        .max_element()
+        .max(c.target.abs().max_element())
+        .max(1.0);
     check(
-        view.length() > 1e-12,
+        view.length() > 8.0 * Real::EPSILON * scale,
         "camera.target",
-        "the camera position and target coincide".into(),
+        format!(
+            "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale)",
+            8.0 * Real::EPSILON * scale
+        ),
     )?;
     check(
         view.normalize().cross(c.up).length() > 1e-9,
@@ -539,6 +549,15 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         f.bailout.is_finite() && f.bailout > 1.0,
         "fractal.bailout",
         format!("must be a finite number above 1, got {}", f.bailout),
+    )?;
+    // An orbit at the bailout is raised to the power once more: keep that finite.
+    check(
+        f.power * f.bailout.ln() < 600.0,
+        "fractal.bailout",
+        format!(
+            "bailout^power must stay below e^600 (f64 overflows near e^709), got {}^{}",
+            f.bailout, f.power
+        ),
     )?;
     if let Some(k) = f.julia {
         check(
@@ -850,5 +869,45 @@ mod tests {
             apply(&mut scene, name, &v);
             assert_ne!(scene, before, "{name} changed nothing");
         }
+    }
+
+    #[test]
+    fn single_key_holds_its_value_everywhere() {
+        let track = "\"fractal.power\": (keys: [(time: 0.4, value: 5)])";
+        for time in [-1.0, 0.0, 0.4, 0.5, 100.0] {
+            assert_eq!(sample(track, time), vec![5.0]);
+        }
+    }
+
+    #[test]
+    fn log_zoom_reaches_1e_minus_12_without_nan() {
+        // Naive: interpolating the distance linearly undershoots zero for
+        // Catmull–Rom between 1 and 1e-12; in log space it cannot.
+        let text = "(fps: 10, frames: 41, size: (8, 6), tracks: { \"camera.distance\": (keys: [(time: 0, value: 1), (time: 2, value: 1e-6), (time: 4, value: 1e-12)]) })";
+        let t = parse(text).unwrap();
+        let mut previous = Real::INFINITY;
+        for frame in 0..41 {
+            let s = t.scene_at(frame);
+            let d = (s.camera.position - s.camera.target).length();
+            assert!(
+                d.is_finite() && d > 0.0 && d <= previous * (1.0 + 1e-12),
+                "frame {frame}: {d}"
+            );
+            previous = d;
+        }
+        assert!((previous / 1e-12 - 1.0).abs() < 1e-3, "{previous}");
+    }
+
+    #[test]
+    fn iterations_interpolating_below_one_are_rejected() {
+        // Catmull–Rom from 1 through 1 to 30 dips below 0.5 between the first
+        // keys: the frame where iterations would round to 0 is named.
+        let e = error_of(&with_track(
+            "\"fractal.iterations\": (keys: [(time: 0, value: 1), (time: 0.5, value: 1), (time: 0.6, value: 30)])",
+        ));
+        assert!(
+            e.contains("fractal.iterations") && e.contains("frame"),
+            "{e}"
+        );
     }
 }

@@ -6,4 +6,5 @@ mod accuracy;
 mod cli;
 mod formats;
 mod resume;
+mod stability;
 mod validation;

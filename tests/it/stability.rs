@@ -1,0 +1,148 @@
+//! Hard cases through the binary: whole frames that must come out finite,
+//! quickly, and with a clear message where the scene is odd.
+
+use crate::util::{stderr, Dir};
+
+/// Every channel of an EXR frame, checked finite; returns (alpha, depth).
+fn finite_channels(d: &Dir, rel: &str) -> (Vec<f32>, Vec<f32>) {
+    let image = exr::prelude::read_all_flat_layers_from_file(d.path().join(rel)).unwrap();
+    let layer = &image.layer_data[0];
+    let mut alpha = Vec::new();
+    let mut depth = Vec::new();
+    for ch in &layer.channel_data.list {
+        let v: Vec<f32> = ch.sample_data.values_as_f32().collect();
+        assert!(
+            v.iter().all(|x| x.is_finite()),
+            "{rel}: {} not finite",
+            ch.name
+        );
+        match ch.name.to_string().as_str() {
+            "A" => alpha = v,
+            "Z" => depth = v,
+            _ => {}
+        }
+    }
+    (alpha, depth)
+}
+
+fn scene(body: &str) -> String {
+    format!("(fps: 24, frames: 1, size: (32, 18), scene: ({body}))")
+}
+
+#[test]
+fn camera_inside_the_bulb_renders_with_a_warning() {
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        &scene("camera: (position: (0, 0.1, 0), target: (0, 0, 1))"),
+    );
+    let out = d.ok(&["render", "t.ron", "--format", "exr"]);
+    assert!(
+        stderr(&out).contains("camera is inside the fractal"),
+        "{}",
+        stderr(&out)
+    );
+    let (alpha, depth) = finite_channels(&d, "out/t/frame_00000.exr");
+    assert!(alpha.iter().all(|&a| a == 1.0));
+    assert!(depth.iter().all(|&z| z == 0.0));
+}
+
+/// Renders a Julia set with constant `c` and returns (alpha, evaluations per sample).
+fn julia_frame(c: &str) -> (Vec<f32>, f64) {
+    let d = Dir::new();
+    d.write("t.ron", &scene(&format!("fractal: (julia: {c})")));
+    let out = d.ok(&["render", "t.ron", "--format", "exr", "--stats"]);
+    let (alpha, _) = finite_channels(&d, "out/t/frame_00000.exr");
+    let err = stderr(&out);
+    let per_sample: f64 = err
+        .split(" per sample")
+        .next()
+        .and_then(|s| s.rsplit('(').next())
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| panic!("no stats in {err}"));
+    (alpha, per_sample)
+}
+
+#[test]
+fn empty_and_dust_julia_sets_render_fast_without_hanging() {
+    // |c| far beyond the bulb's reach: nothing stays bounded inside the
+    // bounding sphere, so the frame is background, at a few estimates a ray.
+    let (alpha, per_sample) = julia_frame("(100, 100, 100)");
+    assert!(
+        alpha.iter().all(|&a| a == 0.0),
+        "an empty set shows no surface"
+    );
+    assert!(per_sample < 10.0, "{per_sample} evaluations per sample");
+    // c = (2, 2, 2) leaves Cantor dust near radius 1.17: sparse specks at
+    // most, still a handful of estimates per ray, not a crawl to the step limit.
+    let (alpha, per_sample) = julia_frame("(2, 2, 2)");
+    let covered = alpha.iter().filter(|&&a| a > 0.0).count();
+    assert!(
+        covered < alpha.len() / 2,
+        "dust covers {covered} of {} pixels",
+        alpha.len()
+    );
+    assert!(per_sample < 20.0, "{per_sample} evaluations per sample");
+}
+
+#[test]
+fn extreme_but_valid_cameras_render_finite_frames() {
+    for camera in [
+        "camera: (fov_degrees: 1e-6)",
+        "camera: (fov_degrees: 178.9)",
+        "camera: (roll_degrees: 1e9)",
+        "camera: (position: (0, 40, 0.001), target: (0, 0, 0))",
+    ] {
+        let d = Dir::new();
+        d.write("t.ron", &scene(camera));
+        d.ok(&["render", "t.ron", "--format", "exr"]);
+        finite_channels(&d, "out/t/frame_00000.exr");
+    }
+}
+
+#[test]
+fn degenerate_cameras_are_rejected_before_rendering() {
+    for (camera, field) in [
+        (
+            "camera: (position: (0, 3, 0), target: (0, 0, 0), up: (0, 1, 0))",
+            "camera.up",
+        ),
+        (
+            "camera: (position: (1, 1, 1), target: (1, 1, 1))",
+            "camera.target",
+        ),
+        ("camera: (fov_degrees: 180)", "camera.fov_degrees"),
+        ("camera: (up: (0, 0, 0))", "camera.up"),
+    ] {
+        let d = Dir::new();
+        d.write("t.ron", &scene(camera));
+        let out = d.run(&["render", "t.ron"]);
+        assert_eq!(out.status.code(), Some(3), "{camera}");
+        assert!(stderr(&out).contains(field), "{camera}: {}", stderr(&out));
+        assert!(!d.path().join("out").exists());
+    }
+}
+
+#[test]
+fn zoom_to_1e_minus_12_renders_finite_distinct_depths() {
+    // The example zoom's target, approached to 1e-12 with iterations raised.
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        "(fps: 24, frames: 1, size: (24, 16), scene: (
+            camera: (position: (0.2372, 0.4442, 4.0), target: (0.237207564481, 0.444190855613, 0.882531801629), fov_degrees: 40),
+            fractal: (iterations: 40),
+        ), tracks: { \"camera.distance\": (keys: [(time: 0, value: 1e-12)]) })",
+    );
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let (alpha, depth) = finite_channels(&d, "out/t/frame_00000.exr");
+    assert!(alpha.iter().all(|&a| a == 1.0), "all pixels see surface");
+    let mut distinct: Vec<u32> = depth.iter().map(|z| z.to_bits()).collect();
+    distinct.sort();
+    distinct.dedup();
+    assert!(
+        distinct.len() > depth.len() / 2,
+        "only {} distinct depths",
+        distinct.len()
+    );
+}
