@@ -57,17 +57,45 @@ pub struct Measurement {
     pub pareto: bool,
 }
 
-/// The scene with every marching knob set high: the shaded reference. The
-/// fractal (iterations, bailout, estimator, precision) stays the scene's, so
-/// sweeping those knobs shows what they change in the picture.
+/// The scene with every knob set high: the reference. Twice the iterations
+/// (at least 8 more), a bailout of at least 16, the analytic estimator in
+/// f64, hit threshold ÷ 8, fudge ≤ 0.5, 8× the steps, normal step ÷ 4 and at
+/// least 16 samples per pixel.
 pub fn reference_scene(scene: &Scene) -> Scene {
     let mut r = scene.clone();
+    let f = &scene.fractal;
+    r.fractal.iterations = (f.iterations.saturating_mul(2))
+        .max(f.iterations + 8)
+        .min(10_000);
+    r.fractal.bailout = f.bailout.max(16.0);
+    r.fractal.de = DeMethod::Analytic;
+    r.fractal.precision = Precision::F64;
     r.quality.hit_threshold = scene.quality.hit_threshold / 8.0;
     r.quality.fudge = scene.quality.fudge.min(0.5);
     r.quality.max_steps = scene.quality.max_steps.saturating_mul(8);
     r.quality.normal_step = scene.quality.normal_step / 4.0;
     r.samples_per_pixel = scene.samples_per_pixel.max(16);
     r
+}
+
+/// Membership steps of the reference depths, as a fraction of the footprint.
+pub const REFERENCE_STEP: Real = 1.0 / 16.0;
+
+/// How settled the reference depths are: the same pass at twice the step.
+#[derive(Clone, Debug, Serialize)]
+pub struct Convergence {
+    /// Mean |depth difference| in footprints, over pixels both passes hit.
+    pub depth_change_mean_px: f64,
+    /// Share of pixels whose hit/miss changes.
+    pub hit_change: f64,
+}
+
+/// Everything `accuracy` measured.
+#[derive(Clone, Debug)]
+pub struct Report {
+    pub rows: Vec<Measurement>,
+    pub reference: Scene,
+    pub convergence: Convergence,
 }
 
 fn scaled(v: u32, f: Real) -> u32 {
@@ -143,9 +171,14 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     out
 }
 
-/// Membership-reference hit distance for every pixel centre (None for a miss),
-/// with the number of membership tests spent.
-pub fn reference_depths(scene: &Scene, width: u32, height: u32) -> (Vec<Option<Real>>, u64) {
+/// Membership-reference hit distance for every pixel centre (None for a
+/// miss), stepping `step_fraction` of a footprint, with the tests spent.
+pub fn reference_depths(
+    scene: &Scene,
+    width: u32,
+    height: u32,
+    step_fraction: Real,
+) -> (Vec<Option<Real>>, u64) {
     let camera = scene.camera.frame();
     // Never step finer than a millionth of the camera–target distance: bounds the
     // work for rays that start right on the surface in deep zooms.
@@ -157,14 +190,15 @@ pub fn reference_depths(scene: &Scene, width: u32, height: u32) -> (Vec<Option<R
             let row = (0..width)
                 .map(|x| {
                     let ray = camera.ray(x as Real + 0.5, y as Real + 0.5, width, height);
-                    let t = march_by_membership(
+                    let (t, n) = march_by_membership(
                         &ray,
                         &scene.fractal,
                         &scene.quality,
+                        step_fraction,
                         min_step,
-                        200_000,
+                        1_000_000,
                     );
-                    tests += 1;
+                    tests += n as u64;
                     t
                 })
                 .collect();
@@ -198,13 +232,23 @@ struct Errors {
     rmse: f64,
 }
 
+/// The hits of a rendered film: its nearest depth where any sample hit.
+fn film_hits(film: &Film) -> Vec<Option<Real>> {
+    film.alpha
+        .iter()
+        .zip(&film.depth)
+        .map(|(&a, &d)| (a > 0.0).then_some(d as Real))
+        .collect()
+}
+
+/// Errors of `hits` and `image` against the reference.
 fn compare(
-    film: &Film,
+    hits: &[Option<Real>],
+    image: &[f32],
     reference_image: &[f32],
     reference_depth: &[Option<Real>],
     footprints: &[Real],
 ) -> Errors {
-    let image = srgb(film);
     let mse = image
         .iter()
         .zip(reference_image)
@@ -214,19 +258,17 @@ fn compare(
     let mut errors = Vec::new();
     let mut mismatches = 0usize;
     let mut overshoots = 0usize;
-    for (i, reference) in reference_depth.iter().enumerate() {
-        let hit = film.alpha[i] > 0.0;
-        match reference {
-            Some(t) if hit => {
-                let signed = (film.depth[i] as f64 - t) / footprints[i];
+    for (i, (hit, reference)) in hits.iter().zip(reference_depth).enumerate() {
+        match (hit, reference) {
+            (Some(t), Some(r)) => {
+                let signed = (t - r) / footprints[i];
                 if signed > 1.0 {
                     overshoots += 1;
                 }
                 errors.push(signed.abs())
             }
-            Some(_) => mismatches += 1,
-            None if hit => mismatches += 1,
-            None => {}
+            (None, None) => {}
+            _ => mismatches += 1,
         }
     }
     errors.sort_by(|a, b| a.total_cmp(b));
@@ -284,77 +326,109 @@ pub fn measure(
     width: u32,
     height: u32,
     progress: &dyn Fn(usize, usize, &Variant),
-) -> Vec<Measurement> {
+) -> Report {
     let all = variants(scene);
+    let reference = &all[0].scene;
     let camera = scene.camera.frame();
     let footprints: Vec<Real> = (0..height)
         .flat_map(|y| (0..width).map(move |x| (x, y)))
         .map(|(x, y)| camera.ray(x as Real + 0.5, y as Real + 0.5, width, height))
         .map(|ray| ray.footprint(1.0))
         .collect();
+    // Footprints scale with distance: per pixel, footprint(t) = t × footprint(1).
+    let footprints_at = |depths: &[Option<Real>]| -> Vec<Real> {
+        depths
+            .iter()
+            .zip(&footprints)
+            .map(|(t, f)| t.map_or(*f, |t| (t * f).max(1e-300)))
+            .collect()
+    };
 
     progress(0, all.len(), &all[0]);
     let started = Instant::now();
-    let (reference_depth, tests) = reference_depths(scene, width, height);
-    let reference_film = render_frame(&all[0].scene, frame_index, width, height, &|| {});
+    let (reference_depth, tests) = reference_depths(reference, width, height, REFERENCE_STEP);
+    let reference_film = render_frame(reference, frame_index, width, height, &|| {});
     let reference_seconds = started.elapsed().as_secs_f64();
     let reference_image = srgb(&reference_film);
-    // Footprints scale with distance: per pixel, footprint(t) = t × footprint(1).
-    let footprint_at_reference: Vec<Real> = reference_depth
-        .iter()
-        .zip(&footprints)
-        .map(|(t, f)| t.map_or(*f, |t| (t * f).max(1e-300)))
-        .collect();
+    let footprint_at_reference = footprints_at(&reference_depth);
 
-    let mut rows = vec![Measurement {
-        knob: all[0].knob,
-        setting: all[0].setting.clone(),
-        seconds: reference_seconds,
-        de_evaluations: tests + reference_film.stats.de_evaluations,
-        depth_error_mean_px: 0.0,
-        depth_error_p99_px: 0.0,
-        hit_mismatch: 0.0,
-        overshoot: 0.0,
-        image_rmse: 0.0,
-        psnr_db: f64::INFINITY,
+    // The same depths at twice the step: how far the reference itself has settled.
+    let (coarse, _) = reference_depths(reference, width, height, 2.0 * REFERENCE_STEP);
+    let settled = compare(
+        &coarse,
+        &reference_image,
+        &reference_image,
+        &reference_depth,
+        &footprint_at_reference,
+    );
+    let convergence = Convergence {
+        depth_change_mean_px: settled.depth_mean,
+        hit_change: settled.hit_mismatch,
+    };
+
+    let measurement = |variant: &Variant, seconds: f64, evaluations: u64, e: Errors| Measurement {
+        knob: variant.knob,
+        setting: variant.setting.clone(),
+        seconds,
+        de_evaluations: evaluations,
+        depth_error_mean_px: e.depth_mean,
+        depth_error_p99_px: e.depth_p99,
+        hit_mismatch: e.hit_mismatch,
+        overshoot: e.overshoot,
+        image_rmse: e.rmse,
+        psnr_db: psnr(e.rmse),
         pareto: false,
-    }];
+    };
+    // The reference against itself, through the same comparison as every variant.
+    let own = compare(
+        &reference_depth,
+        &reference_image,
+        &reference_image,
+        &reference_depth,
+        &footprint_at_reference,
+    );
+    let mut rows = vec![measurement(
+        &all[0],
+        reference_seconds,
+        tests + reference_film.stats.de_evaluations,
+        own,
+    )];
     for (i, variant) in all.iter().enumerate().skip(1) {
         progress(i, all.len(), variant);
         let (film, seconds) = timed_render(&variant.scene, frame_index, width, height);
         let e = compare(
-            &film,
+            &film_hits(&film),
+            &srgb(&film),
             &reference_image,
             &reference_depth,
             &footprint_at_reference,
         );
-        rows.push(Measurement {
-            knob: variant.knob,
-            setting: variant.setting.clone(),
-            seconds,
-            de_evaluations: film.stats.de_evaluations,
-            depth_error_mean_px: e.depth_mean,
-            depth_error_p99_px: e.depth_p99,
-            hit_mismatch: e.hit_mismatch,
-            overshoot: e.overshoot,
-            image_rmse: e.rmse,
-            psnr_db: psnr(e.rmse),
-            pareto: false,
-        });
+        rows.push(measurement(variant, seconds, film.stats.de_evaluations, e));
     }
     mark_pareto(&mut rows);
-    rows
+    Report {
+        rows,
+        reference: reference.clone(),
+        convergence,
+    }
 }
 
-/// Marks the rows no other row beats on both time and image error.
+/// Marks the variants no other variant beats on both time and image error.
+/// The reference is the yardstick, not a candidate, and is never marked.
 pub fn mark_pareto(rows: &mut [Measurement]) {
-    let points: Vec<(f64, f64)> = rows.iter().map(|r| (r.seconds, r.image_rmse)).collect();
+    let candidate = |r: &Measurement| r.knob != "reference";
+    let points: Vec<Option<(f64, f64)>> = rows
+        .iter()
+        .map(|r| candidate(r).then_some((r.seconds, r.image_rmse)))
+        .collect();
     for (i, row) in rows.iter_mut().enumerate() {
-        let (t, e) = points[i];
-        row.pareto = !points
-            .iter()
-            .enumerate()
-            .any(|(j, &(tj, ej))| j != i && tj <= t && ej <= e && (tj < t || ej < e));
+        let Some((t, e)) = points[i] else {
+            row.pareto = false;
+            continue;
+        };
+        row.pareto = !points.iter().enumerate().any(|(j, p)| {
+            p.is_some_and(|(tj, ej)| j != i && tj <= t && ej <= e && (tj < t || ej < e))
+        });
     }
 }
 
@@ -383,7 +457,9 @@ pub fn to_csv(rows: &[Measurement]) -> String {
 }
 
 /// The table as Markdown, with times relative to the scene's own settings.
-pub fn to_markdown(rows: &[Measurement], title: &str) -> String {
+pub fn to_markdown(report: &Report, title: &str) -> String {
+    let rows = &report.rows;
+    let r = &report.reference;
     let base = rows
         .iter()
         .find(|r| r.knob == "scene")
@@ -391,7 +467,17 @@ pub fn to_markdown(rows: &[Measurement], title: &str) -> String {
         .unwrap_or(1.0)
         .max(1e-9);
     let mut out = format!(
-        "{title}\n\n| knob | setting | time (s) | × scene | DE evals | depth err mean (px) | depth err p99 (px) | hit/miss differ | overshoot | PSNR (dB) | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n"
+        "{title}\n\nReference: {} iterations, bailout {}, Analytic f64, hit threshold {}, fudge {}, {} steps, normal step {}, {} samples per pixel; depths by membership steps of 1/{} footprint. Against steps twice as long, its depths move by {:.2} px on average and {:.2}% of pixels change hit/miss: differences below that are within the reference's own uncertainty.\n\n| knob | setting | time (s) | × scene | DE evals | depth err mean (px) | depth err p99 (px) | hit/miss differ | overshoot | PSNR (dB) | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n",
+        r.fractal.iterations,
+        r.fractal.bailout,
+        r.quality.hit_threshold,
+        r.quality.fudge,
+        r.quality.max_steps,
+        r.quality.normal_step,
+        r.samples_per_pixel,
+        (1.0 / REFERENCE_STEP).round(),
+        report.convergence.depth_change_mean_px,
+        100.0 * report.convergence.hit_change,
     );
     for r in rows {
         out += &format!(
@@ -559,6 +645,9 @@ mod tests {
             row("d", 0.5, 0.3),
             row("e", 3.0, 0.05), // as good as b but slower
         ];
+        // The reference (zero error) is the yardstick: never on the front, and
+        // it does not push others off it.
+        rows.push(row("reference", 50.0, 0.0));
         mark_pareto(&mut rows);
         let front: Vec<_> = rows.iter().filter(|r| r.pareto).map(|r| r.knob).collect();
         assert_eq!(front, ["a", "b", "d"]);

@@ -647,7 +647,7 @@ fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     let scene = t.scene_at(args.frame);
     let quiet = args.quiet;
-    let rows = crate::accuracy::measure(&scene, args.frame, width, height, &|i, n, v| {
+    let report = crate::accuracy::measure(&scene, args.frame, width, height, &|i, n, v| {
         if !quiet {
             eprintln!("[{}/{}] {} = {}", i + 1, n, v.knob, v.setting);
         }
@@ -661,10 +661,10 @@ fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
     let csv = out_dir.join("accuracy.csv");
     let md = out_dir.join("accuracy.md");
     let png = out_dir.join("accuracy.png");
-    let table = crate::accuracy::to_markdown(&rows, &format!("## {title}"));
-    std::fs::write(&csv, crate::accuracy::to_csv(&rows)).map_err(|e| Error::io(&csv, e))?;
+    let table = crate::accuracy::to_markdown(&report, &format!("## {title}"));
+    std::fs::write(&csv, crate::accuracy::to_csv(&report.rows)).map_err(|e| Error::io(&csv, e))?;
     std::fs::write(&md, &table).map_err(|e| Error::io(&md, e))?;
-    crate::accuracy::write_chart(&rows, &title, &png)?;
+    crate::accuracy::write_chart(&report.rows, &title, &png)?;
     println!("{table}");
     eprintln!(
         "wrote {}, {} and {}",

@@ -315,7 +315,33 @@ impl Fractal {
 
     fn estimate_in<T: Number>(&self, p: DVec3, scale: Real) -> Estimate {
         let at = |q: DVec3| [T::from_real(q.x), T::from_real(q.y), T::from_real(q.z)];
-        let centre: Orbit<T> = self.orbit(at(p), self.iterations, true);
+        // The Jacobian method runs its one orbit in dual numbers: their values
+        // are the plain orbit, so no second orbit is needed.
+        let (centre, jacobian): (Orbit<T>, Option<glam::DMat3>) = if self.de == DeMethod::Jacobian {
+            let dual: Orbit<Dual<T>> = self.orbit(
+                [
+                    Dual::variable(T::from_real(p.x), 0),
+                    Dual::variable(T::from_real(p.y), 1),
+                    Dual::variable(T::from_real(p.z), 2),
+                ],
+                self.iterations,
+                true,
+            );
+            let jacobian = glam::DMat3::from_cols_array_2d(
+                &[0, 1, 2].map(|col| [0, 1, 2].map(|row| dual.z[row].d[col].value())),
+            );
+            let plain = Orbit {
+                z: dual.z.map(|c| c.v),
+                r: dual.r.v,
+                dr: dual.dr.v,
+                traps: dual.traps,
+                iterations: dual.iterations,
+                escaped: dual.escaped,
+            };
+            (plain, Some(jacobian))
+        } else {
+            (self.orbit(at(p), self.iterations, true), None)
+        };
         let mut orbits = 1;
         let distance = if !centre.escaped {
             0.0
@@ -331,19 +357,14 @@ impl Fractal {
             let d = match self.de {
                 DeMethod::Analytic => 0.5 * r.ln() * r / centre.dr.value(),
                 DeMethod::Jacobian => {
-                    let dual: Orbit<Dual<T>> = self.orbit(
-                        [
-                            Dual::variable(T::from_real(p.x), 0),
-                            Dual::variable(T::from_real(p.y), 1),
-                            Dual::variable(T::from_real(p.z), 2),
-                        ],
-                        self.iterations,
-                        true,
-                    );
-                    let jacobian = glam::DMat3::from_cols_array_2d(
-                        &[0, 1, 2].map(|col| [0, 1, 2].map(|row| dual.z[row].d[col].value())),
-                    );
-                    let norm = spectral_norm(jacobian);
+                    let jacobian = jacobian.expect("computed above for this method");
+                    let mut norm = spectral_norm(jacobian);
+                    if !(norm.is_finite() && norm > 0.0) {
+                        // On the pole axis the dual numbers meet acos'(±1) = ∞. There
+                        // the azimuthal stretch is n²·r^(n−1) against the scalar
+                        // n·r^(n−1), so bound the norm by n·dr: conservative.
+                        norm = self.power * centre.dr.value();
+                    }
                     0.5 * r.ln() * r / norm
                 }
                 DeMethod::Potential | DeMethod::SinhPotential | DeMethod::EscapeLength => {
@@ -726,6 +747,17 @@ mod tests {
 
     #[test]
     fn every_method_and_precision_is_finite_and_positive_outside() {
+        // Near the bulb (radius ≤ 1.5) no true distance exceeds 1.5: an estimate
+        // above that would be a step that jumps the surface (as an infinite
+        // estimate turned into a huge step once did). Points on and next to
+        // the axes are included, where derivatives blow up.
+        let mut probes = points(200, 1.2..1.5, 3);
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z, -DVec3::Y] {
+            for r in [1.2, 1.3, 1.45] {
+                probes.push(axis * r);
+                probes.push(axis * r + DVec3::new(1e-9, 0.0, 1e-9));
+            }
+        }
         for de in DeMethod::ALL {
             for precision in [Precision::F64, Precision::F32] {
                 let f = Fractal {
@@ -733,11 +765,11 @@ mod tests {
                     precision,
                     ..Fractal::default()
                 };
-                for p in points(200, 1.2..1.5, 3) {
+                for &p in &probes {
                     let e = f.estimate(p, 1e-3);
                     if e.escaped {
                         assert!(
-                            e.distance.is_finite() && e.distance > 0.0,
+                            e.distance.is_finite() && e.distance > 0.0 && e.distance < 1.5,
                             "{de:?} {precision:?} at {p}: {}",
                             e.distance
                         );
@@ -745,6 +777,30 @@ mod tests {
                 }
                 assert_eq!(f.estimate(DVec3::ZERO, 1e-3).distance, 0.0);
             }
+        }
+    }
+
+    #[test]
+    fn jacobian_on_the_pole_axis_is_conservative() {
+        // Naive: dual numbers through acos at ±1 give an infinite derivative,
+        // so ‖J‖ is NaN. Ours bounds it by n·dr there: no larger than analytic.
+        let one = Dual::variable(1.0f64, 0);
+        assert!(!one.acos().d[0].is_finite());
+        let jac = Fractal {
+            de: DeMethod::Jacobian,
+            ..Fractal::default()
+        };
+        let analytic = Fractal::default();
+        for r in [1.15, 1.3] {
+            let p = DVec3::Y * r;
+            let (j, a) = (
+                jac.estimate(p, 1e-4).distance,
+                analytic.estimate(p, 1e-4).distance,
+            );
+            assert!(
+                j.is_finite() && j > 0.0 && j <= a,
+                "r {r}: jacobian {j}, analytic {a}"
+            );
         }
     }
 

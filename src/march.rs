@@ -153,25 +153,32 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
 }
 
 /// Where `ray` first enters the set, found without trusting any distance
-/// estimate: steps of a quarter pixel footprint (never below `min_step`)
-/// testing membership (does the orbit stay under the bailout?), then bisection
-/// of the crossing to a thousandth of the footprint. The accuracy reference;
-/// far slower than `march`. Gives up after `max_tests` membership tests.
+/// estimate: steps of `step_fraction` of a pixel footprint (never below
+/// `min_step`) testing membership (does the orbit stay under the bailout?),
+/// then bisection of the crossing to a thousandth of the footprint. The
+/// accuracy reference; far slower than `march`. Gives up after `max_tests`
+/// membership tests. Returns the crossing and the tests spent.
 pub fn march_by_membership(
     ray: &Ray,
     fractal: &Fractal,
     settings: &MarchSettings,
+    step_fraction: Real,
     min_step: Real,
     max_tests: u32,
-) -> Option<Real> {
-    let (t_enter, t_exit) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)?;
+) -> (Option<Real>, u32) {
+    let Some((t_enter, t_exit)) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
+    else {
+        return (None, 0);
+    };
     let at = |t: Real| ray.origin + ray.dir * t;
+    let mut tests = 1;
     if fractal.contains(at(t_enter)) {
-        return Some(t_enter);
+        return (Some(t_enter), tests);
     }
     let mut t = t_enter;
-    for _ in 0..max_tests {
-        let next = t + (0.25 * ray.footprint(t)).max(min_step);
+    while tests < max_tests {
+        let next = t + (step_fraction * ray.footprint(t)).max(min_step);
+        tests += 1;
         if fractal.contains(at(next)) {
             let (mut lo, mut hi) = (t, next);
             while hi - lo > 1e-3 * ray.footprint(lo) {
@@ -179,20 +186,21 @@ pub fn march_by_membership(
                 if !(lo < mid && mid < hi) {
                     break;
                 }
+                tests += 1;
                 if fractal.contains(at(mid)) {
                     hi = mid;
                 } else {
                     lo = mid;
                 }
             }
-            return Some(lo);
+            return (Some(lo), tests);
         }
         if next > t_exit {
-            return None;
+            return (None, tests);
         }
         t = next;
     }
-    None
+    (None, tests)
 }
 
 /// Surface normal at `hit` from a tetrahedral central difference of the
@@ -288,8 +296,18 @@ mod tests {
     #[test]
     fn membership_reference_finds_the_unit_sphere() {
         let r = ray(DVec3::new(0.0, 0.0, 3.0), -DVec3::Z);
-        let t = march_by_membership(&r, &unit_ball(), &MarchSettings::default(), 1e-9, 1_000_000)
-            .unwrap();
+        let (t, tests) = march_by_membership(
+            &r,
+            &unit_ball(),
+            &MarchSettings::default(),
+            0.25,
+            1e-9,
+            1_000_000,
+        );
+        let t = t.unwrap();
+        // Quarter-footprint steps from the sphere (t = 1.5) to t = 2 number
+        // ln(2/1.5)/(0.25·1e-3) ≈ 1151, then about 11 bisections.
+        assert!((1140..1180).contains(&tests), "{tests} tests");
         // Bisected to a thousandth of the 2e-3 footprint, from the outside.
         assert!(t <= 2.0 && t > 2.0 - 2e-6, "{t}");
         let beside = ray(DVec3::new(0.0, 1.2, 3.0), -DVec3::Z);
@@ -297,9 +315,11 @@ mod tests {
             &beside,
             &unit_ball(),
             &MarchSettings::default(),
+            0.25,
             1e-9,
             1_000_000
         )
+        .0
         .is_none());
     }
 
@@ -365,7 +385,7 @@ mod tests {
                     dir: (aim - origin).normalize(),
                     pixel_angle: 2e-3,
                 };
-                let reference = march_by_membership(&r, &f, &settings, 1e-9, 1_000_000);
+                let (reference, _) = march_by_membership(&r, &f, &settings, 0.125, 1e-9, 1_000_000);
                 if let (Some(hit), Some(t)) = (march(&r, &f, &settings).hit, reference) {
                     assert!(
                         hit.t <= t + r.footprint(t),
