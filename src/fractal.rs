@@ -870,10 +870,27 @@ mod tests {
 
     #[test]
     fn dual_number_jacobian_matches_finite_differences() {
-        let f = Fractal {
-            iterations: 4,
-            ..Fractal::default()
-        };
+        // Power 8 in Quilez's form runs the polynomial; power 7 and the other
+        // conventions run the trigonometric form through the dual numbers.
+        let cases = [
+            (Formula::Quilez, 8.0),
+            (Formula::Quilez, 7.0),
+            (Formula::WhiteNylander, 3.0),
+            (Formula::Asin, 8.0),
+        ];
+        for (formula, power) in cases {
+            let f = Fractal {
+                formula,
+                power,
+                iterations: 4,
+                ..Fractal::default()
+            };
+            check_jacobian(&f);
+        }
+    }
+
+    fn check_jacobian(f: &Fractal) {
+        let mut checked = 0;
         for p in points(50, 0.3..1.1, 23) {
             let dual: Orbit<Dual<Real>> = f.orbit(
                 [
@@ -906,11 +923,19 @@ mod tests {
                     let ad = dual.z[row].d[axis];
                     assert!(
                         (fd - ad).abs() <= 1e-7 * (1.0 + ad.abs()),
-                        "{p} J[{row}][{axis}]: {ad} vs {fd}"
+                        "{:?} {p} J[{row}][{axis}]: {ad} vs {fd}",
+                        f.formula
                     );
                 }
             }
+            checked += 1;
         }
+        assert!(
+            checked >= 10,
+            "{:?} power {}: only {checked} bounded orbits",
+            f.formula,
+            f.power
+        );
     }
 
     // ---- The stability catalogue (README "Stability"): each case fails on the
