@@ -22,13 +22,16 @@ pub const EXIT_FAILURE: u8 = 1;
 pub const EXIT_USAGE: u8 = 2;
 /// Exit status: the timeline is malformed or invalid.
 pub const EXIT_INVALID_TIMELINE: u8 = 3;
+/// Exit status of `status`: the sequence is not complete yet.
+pub const EXIT_INCOMPLETE: u8 = 4;
 
 #[derive(Debug, Parser)]
 #[command(
     name = "mandelreel",
     version,
     about = "Render keyframed Mandelbulb timelines (RON) to numbered PNG/EXR frames",
-    after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline.\n\
+    after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline,\n\
+                  4 (status only) the sequence is not complete.\n\
                   Timeline format and examples: README.md and timelines/*.ron."
 )]
 pub struct Cli {
@@ -49,6 +52,9 @@ pub enum Command {
     Pick(PickArgs),
     /// Tile rendered PNG frames from a folder into one contact-sheet image.
     Sheet(SheetArgs),
+    /// Which frames of a sequence are complete, stale, missing or in progress; exit
+    /// status 0 only when every frame is complete and current (4 otherwise).
+    Status(StatusArgs),
     /// Measure what accuracy costs: sweep every quality knob, distance estimator and
     /// precision on one frame against a reference; write accuracy.csv, .md and .png.
     Accuracy(AccuracyArgs),
@@ -124,6 +130,42 @@ pub struct RenderArgs {
     /// Print distance-estimator evaluations per frame and in total.
     #[arg(long)]
     pub stats: bool,
+    /// Render only shard I of N: frames I, I+N, I+2N, … (`auto` takes I and N from
+    /// Slurm's SLURM_ARRAY_TASK_ID/_MIN/_COUNT or Kubernetes' JOB_COMPLETION_INDEX
+    /// with MANDELREEL_SHARD_COUNT).
+    #[arg(long, value_name = "I/N|auto", conflicts_with = "claim")]
+    pub shard: Option<String>,
+    /// Share the frames with any number of other `--claim` workers on the same
+    /// output folder, taking one frame at a time through claim files.
+    #[arg(long)]
+    pub claim: bool,
+    /// Seconds without a heartbeat after which another worker takes a claimed frame over.
+    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
+    pub claim_timeout: f64,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct StatusArgs {
+    /// An output folder (uses what it records), or a timeline (with the same
+    /// --out, --size, --format, --frames and --preview as its render).
+    pub target: PathBuf,
+    /// Output folder, when TARGET is a timeline [default: out/<timeline name>].
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<String>,
+    #[arg(long, value_name = "WxH")]
+    pub size: Option<String>,
+    #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
+    pub format: Vec<Format>,
+    #[arg(long)]
+    pub preview: bool,
+    /// Seconds without a heartbeat after which a claim counts as abandoned.
+    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
+    pub claim_timeout: f64,
+    /// Print one JSON object instead of text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -146,6 +188,9 @@ pub struct PickArgs {
 
 /// Exit code for an error chain: input errors are the user's to fix.
 pub fn exit_code(error: &anyhow::Error) -> u8 {
+    if error.downcast_ref::<Incomplete>().is_some() {
+        return EXIT_INCOMPLETE;
+    }
     match error.downcast_ref::<Error>() {
         Some(Error::Usage { .. }) => EXIT_USAGE,
         Some(e) if e.is_input_error() => EXIT_INVALID_TIMELINE,
@@ -159,6 +204,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Info { timeline } => info(&timeline),
         Command::Pick(args) => pick(args),
         Command::Sheet(args) => sheet(args),
+        Command::Status(args) => status(args),
         Command::Accuracy(args) => accuracy(args),
     }
 }
@@ -255,50 +301,235 @@ pub fn ffmpeg_command(
     )
 }
 
-fn render(args: RenderArgs) -> anyhow::Result<()> {
-    // Everything is checked before the output folder is touched.
-    let timeline = Timeline::load(&args.timeline)?;
-    let (mut width, mut height) = match &args.size {
-        Some(s) => parse_size("--size", s)?,
-        None => (timeline.width, timeline.height),
-    };
-    let range = match &args.frames {
-        Some(f) => parse_frames(f, timeline.frame_count)?,
-        None => 0..timeline.frame_count,
-    };
-    set_threads(args.threads)?;
-    let mut formats = args.format.clone();
-    formats.sort_by_key(|f| f.extension());
-    formats.dedup();
-    let mut out_dir = args
-        .out
-        .clone()
-        .unwrap_or_else(|| Path::new("out").join(&timeline.name));
-    if args.preview {
-        width = (width / 2).max(1);
-        height = (height / 2).max(1);
-        out_dir = out_dir.join("preview");
-    }
-    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
-    let stale = output::remove_stale_partials(&out_dir)?;
+/// A validated render job: what to render, how big, in which formats, where.
+struct Plan {
+    timeline: Timeline,
+    width: u32,
+    height: u32,
+    range: std::ops::Range<u32>,
+    formats: Vec<Format>,
+    out_dir: PathBuf,
+    preview: bool,
+}
 
-    // Decide which frames need work, so the progress bar and ETA count only those.
-    let mut todo = Vec::new();
-    for frame in range.clone() {
-        let mut scene = timeline.scene_at(frame);
-        if args.preview {
+impl Plan {
+    /// Checks every option; touches nothing on disk.
+    fn new(
+        timeline_path: &Path,
+        out: Option<&Path>,
+        frames: Option<&str>,
+        size: Option<&str>,
+        formats: &[Format],
+        preview: bool,
+    ) -> anyhow::Result<Plan> {
+        let timeline = Timeline::load(timeline_path)?;
+        Plan::for_timeline(timeline, out, frames, size, formats, preview)
+    }
+
+    fn for_timeline(
+        timeline: Timeline,
+        out: Option<&Path>,
+        frames: Option<&str>,
+        size: Option<&str>,
+        formats: &[Format],
+        preview: bool,
+    ) -> anyhow::Result<Plan> {
+        let (mut width, mut height) = match size {
+            Some(s) => parse_size("--size", s)?,
+            None => (timeline.width, timeline.height),
+        };
+        let range = match frames {
+            Some(f) => parse_frames(f, timeline.frame_count)?,
+            None => 0..timeline.frame_count,
+        };
+        let mut formats = formats.to_vec();
+        formats.sort_by_key(|f| f.extension());
+        formats.dedup();
+        let mut out_dir = out
+            .map(Path::to_path_buf)
+            .unwrap_or_else(|| Path::new("out").join(&timeline.name));
+        if preview {
+            width = (width / 2).max(1);
+            height = (height / 2).max(1);
+            out_dir = out_dir.join("preview");
+        }
+        Ok(Plan {
+            timeline,
+            width,
+            height,
+            range,
+            formats,
+            out_dir,
+            preview,
+        })
+    }
+
+    /// The plan an output folder records (see `output::JobRecord`).
+    fn from_folder(dir: &Path) -> anyhow::Result<Plan> {
+        let job = output::JobRecord::read(dir)?;
+        let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        let formats = job
+            .formats
+            .iter()
+            .map(|f| <Format as clap::ValueEnum>::from_str(f, true).map_err(|e| anyhow::anyhow!(e)))
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        Ok(Plan {
+            width: job.width,
+            height: job.height,
+            range: job.frames.0..job.frames.1.min(timeline.frame_count),
+            formats,
+            out_dir: dir.to_path_buf(),
+            preview: job.preview,
+            timeline,
+        })
+    }
+
+    fn record(&self) -> anyhow::Result<output::JobRecord> {
+        let text = std::fs::read_to_string(&self.timeline.source)
+            .map_err(|e| Error::io(&self.timeline.source, e))?;
+        Ok(output::JobRecord {
+            renderer: format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
+            timeline_path: std::fs::canonicalize(&self.timeline.source)
+                .unwrap_or_else(|_| self.timeline.source.clone()),
+            timeline_text: text,
+            width: self.width,
+            height: self.height,
+            formats: self
+                .formats
+                .iter()
+                .map(|f| f.extension().to_string())
+                .collect(),
+            frames: (self.range.start, self.range.end),
+            preview: self.preview,
+        })
+    }
+
+    /// The scene and content hash of one frame.
+    fn frame(&self, frame: u32) -> (crate::scene::Scene, String) {
+        let mut scene = self.timeline.scene_at(frame);
+        if self.preview {
             scene.samples_per_pixel = 1;
         }
-        let hash = output::frame_hash(&scene, frame, width, height);
-        let current = !args.force
-            && formats.iter().all(|&f| {
-                output::is_current(&out_dir.join(output::frame_file_name(frame, f)), f, &hash)
-            });
-        if !current {
+        let hash = output::frame_hash(&scene, frame, self.width, self.height);
+        (scene, hash)
+    }
+
+    fn path(&self, frame: u32, format: Format) -> PathBuf {
+        self.out_dir.join(output::frame_file_name(frame, format))
+    }
+
+    /// Whether every format of `frame` exists and was made from these inputs.
+    fn is_complete(&self, frame: u32, hash: &str) -> bool {
+        self.formats
+            .iter()
+            .all(|&f| output::is_current(&self.path(frame, f), f, hash))
+    }
+
+    /// Renders one frame and writes every format.
+    fn render_frame(
+        &self,
+        frame: u32,
+        scene: &crate::scene::Scene,
+        hash: &str,
+        on_row: &(dyn Fn() + Sync),
+    ) -> anyhow::Result<FrameStats> {
+        let film = render_frame(scene, frame, self.width, self.height, on_row);
+        for &f in &self.formats {
+            output::write_frame(&self.path(frame, f), f, &film, hash)?;
+        }
+        Ok(film.stats)
+    }
+}
+
+/// Parses `--shard I/N` or `auto` from the scheduler's environment.
+pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(u32, u32)> {
+    let bad = |why: String| Error::usage("--shard", why);
+    let number = |name: &str, v: String| -> Result<u32> {
+        v.trim()
+            .parse()
+            .map_err(|_| bad(format!("{name}={v:?} is not a whole number")))
+    };
+    let (index, count) = if text == "auto" {
+        if let (Some(id), Some(count)) = (env("SLURM_ARRAY_TASK_ID"), env("SLURM_ARRAY_TASK_COUNT"))
+        {
+            // Array indices need not start at 0 (--array=1-8): count from the minimum.
+            let min = env("SLURM_ARRAY_TASK_MIN")
+                .map(|m| number("SLURM_ARRAY_TASK_MIN", m))
+                .transpose()?
+                .unwrap_or(0);
+            let id = number("SLURM_ARRAY_TASK_ID", id)?;
+            (
+                id.checked_sub(min)
+                    .ok_or_else(|| bad(format!("task id {id} is below the array minimum {min}")))?,
+                number("SLURM_ARRAY_TASK_COUNT", count)?,
+            )
+        } else if let Some(index) = env("JOB_COMPLETION_INDEX") {
+            let count = env("MANDELREEL_SHARD_COUNT").ok_or_else(|| {
+                bad("JOB_COMPLETION_INDEX is set but MANDELREEL_SHARD_COUNT (the Job's completions) is not".into())
+            })?;
+            (
+                number("JOB_COMPLETION_INDEX", index)?,
+                number("MANDELREEL_SHARD_COUNT", count)?,
+            )
+        } else {
+            return Err(bad(
+                "auto needs SLURM_ARRAY_TASK_ID and SLURM_ARRAY_TASK_COUNT, or JOB_COMPLETION_INDEX and MANDELREEL_SHARD_COUNT".into(),
+            ));
+        }
+    } else {
+        let (i, n) = text
+            .split_once('/')
+            .ok_or_else(|| bad(format!("expected I/N such as 0/8, or auto; got {text:?}")))?;
+        (number("I", i.to_string())?, number("N", n.to_string())?)
+    };
+    if count == 0 || index >= count {
+        return Err(bad(format!(
+            "shard {index} of {count} does not exist (0 <= I < N)"
+        )));
+    }
+    Ok((index, count))
+}
+
+fn render(args: RenderArgs) -> anyhow::Result<()> {
+    // Everything is checked before the output folder is touched.
+    let plan = Plan::new(
+        &args.timeline,
+        args.out.as_deref(),
+        args.frames.as_deref(),
+        args.size.as_deref(),
+        &args.format,
+        args.preview,
+    )?;
+    set_threads(args.threads)?;
+    let shard = args
+        .shard
+        .as_deref()
+        .map(|s| parse_shard(s, &|k| std::env::var(k).ok()))
+        .transpose()?;
+    if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {
+        return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());
+    }
+    let claim_timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
+    let record = plan.record()?;
+    let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
+    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+    record.write(&out_dir)?;
+    let stale = output::remove_stale_partials(&out_dir)?;
+
+    let mine: Vec<u32> = plan
+        .range
+        .clone()
+        .filter(|f| shard.is_none_or(|(i, n)| f % n == i))
+        .collect();
+    // Decide which frames need work, so the progress bar and ETA count only those.
+    let mut todo = Vec::new();
+    for &frame in &mine {
+        let (scene, hash) = plan.frame(frame);
+        if args.force || !plan.is_complete(frame, &hash) {
             todo.push((frame, scene, hash));
         }
     }
-    let total = range.len();
+    let total = mine.len();
     let skipped = total - todo.len();
     let inside: Vec<u32> = todo
         .iter()
@@ -360,39 +591,73 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 
     let started = Instant::now();
     let mut totals = FrameStats::default();
-    for (i, (frame, scene, hash)) in todo.iter().enumerate() {
+    let mut rendered = 0usize;
+    let mut render_one = |frame: u32,
+                          scene: &crate::scene::Scene,
+                          hash: &str|
+     -> anyhow::Result<()> {
         current.reset();
         current.set_prefix(format!("#{frame}"));
         current.set_message(format!("{width}x{height}"));
         let t0 = Instant::now();
-        let film = render_frame(scene, *frame, width, height, &|| current.inc(1));
-        for &f in &formats {
-            output::write_frame(
-                &out_dir.join(output::frame_file_name(*frame, f)),
-                f,
-                &film,
-                hash,
-            )?;
-        }
-        totals = totals + film.stats;
+        let stats = plan.render_frame(frame, scene, hash, &|| current.inc(1))?;
+        totals = totals + stats;
+        rendered += 1;
         overall.inc(1);
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
             say(format!(
                 "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel), {} of {} samples hit, {} repaired",
-                film.stats.de_evaluations,
-                film.stats.de_evaluations as f64 / film.stats.samples.max(1) as f64,
-                film.stats.max_pixel_evaluations,
-                film.stats.hits,
-                film.stats.samples,
-                film.stats.repaired_samples
+                stats.de_evaluations,
+                stats.de_evaluations as f64 / stats.samples.max(1) as f64,
+                stats.max_pixel_evaluations,
+                stats.hits,
+                stats.samples,
+                stats.repaired_samples
             ));
         } else if log_lines {
             eprintln!(
-                "frame {frame} ({}/{}) rendered in {seconds:.2} s",
-                i + 1,
+                "frame {frame} ({rendered}/{}) rendered in {seconds:.2} s",
                 todo.len()
             );
+        }
+        Ok(())
+    };
+    if args.claim {
+        // Take frames one at a time; wait out frames other live workers hold,
+        // so a worker that dies has its frame taken over by one that did not.
+        let poll = (claim_timeout / 4).clamp(
+            std::time::Duration::from_millis(100),
+            std::time::Duration::from_secs(5),
+        );
+        loop {
+            let mut others_busy = false;
+            for (frame, scene, hash) in &todo {
+                if !args.force && plan.is_complete(*frame, hash) {
+                    continue;
+                }
+                match crate::claim::try_claim(&out_dir, *frame, claim_timeout)? {
+                    crate::claim::Attempt::Claimed(claim) => {
+                        // It may have been finished between the check and the claim.
+                        if args.force || !plan.is_complete(*frame, hash) {
+                            render_one(*frame, scene, hash)?;
+                        }
+                        drop(claim);
+                    }
+                    crate::claim::Attempt::Held(_) => others_busy = true,
+                }
+            }
+            let done = todo
+                .iter()
+                .all(|(frame, _, hash)| plan.is_complete(*frame, hash));
+            if done || (!others_busy && args.force) {
+                break;
+            }
+            std::thread::sleep(poll);
+        }
+    } else {
+        for (frame, scene, hash) in &todo {
+            render_one(*frame, scene, hash)?;
         }
     }
     current.finish_and_clear();
@@ -401,9 +666,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     if !args.quiet {
         let elapsed = started.elapsed().as_secs_f64();
         eprintln!(
-            "{} frames rendered in {elapsed:.1} s ({:.2} s/frame), {skipped} skipped; frames in {}",
-            todo.len(),
-            elapsed / todo.len().max(1) as f64,
+            "{rendered} frames rendered in {elapsed:.1} s ({:.2} s/frame), {skipped} skipped; frames in {}",
+            elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
         if args.stats {
@@ -412,19 +676,217 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 totals.de_evaluations, totals.repaired_samples
             );
         }
-        let video_format = if formats.contains(&Format::Png) {
-            Format::Png
-        } else {
-            Format::Exr
-        };
         eprintln!("encode the video with:");
-        println!(
-            "{}",
-            ffmpeg_command(&out_dir, &timeline.name, timeline.fps, &range, video_format)
-        );
     }
+    // On stdout even with --quiet: scripts can run it.
+    let video_format = if plan.formats.contains(&Format::Png) {
+        Format::Png
+    } else {
+        Format::Exr
+    };
+    println!(
+        "{}",
+        ffmpeg_command(
+            &out_dir,
+            &plan.timeline.name,
+            plan.timeline.fps,
+            &plan.range,
+            video_format
+        )
+    );
     Ok(())
 }
+
+/// The state of one frame in an output folder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FrameState {
+    /// Every format exists and carries the current hash.
+    Complete,
+    /// A file exists but was made from other inputs (the timeline changed).
+    Stale,
+    /// A live claim or a fresh temporary file: some worker is on it.
+    InProgress,
+    Missing,
+}
+
+/// `0-3, 7, 9-12` for sorted frame numbers.
+fn ranges(frames: &[u32]) -> String {
+    let mut parts = Vec::new();
+    let mut i = 0;
+    while i < frames.len() {
+        let mut j = i;
+        while j + 1 < frames.len() && frames[j + 1] == frames[j] + 1 {
+            j += 1;
+        }
+        parts.push(if i == j {
+            frames[i].to_string()
+        } else {
+            format!("{}-{}", frames[i], frames[j])
+        });
+        i = j + 1;
+    }
+    parts.join(", ")
+}
+
+fn status(args: StatusArgs) -> anyhow::Result<()> {
+    let plan = if args.target.is_dir() {
+        Plan::from_folder(&args.target)?
+    } else {
+        Plan::new(
+            &args.target,
+            args.out.as_deref(),
+            args.frames.as_deref(),
+            args.size.as_deref(),
+            &args.format,
+            args.preview,
+        )?
+    };
+    if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {
+        return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());
+    }
+    let timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
+    // Fresh temporary files, by frame: a writer is finishing that frame.
+    let mut writing = std::collections::HashSet::new();
+    if let Ok(entries) = std::fs::read_dir(&plan.out_dir) {
+        for e in entries.filter_map(|e| e.ok()) {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let fresh = e
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok())
+                .is_some_and(|age| age < output::STALE_PARTIAL_AGE);
+            if let (true, Some(rest)) = (
+                fresh && name.ends_with(".partial"),
+                name.strip_prefix(".frame_"),
+            ) {
+                if let Some(n) = rest
+                    .get(..output::FRAME_DIGITS)
+                    .and_then(|d| d.parse::<u32>().ok())
+                {
+                    writing.insert(n);
+                }
+            }
+        }
+    }
+    let mut by_state: std::collections::BTreeMap<&str, Vec<u32>> = Default::default();
+    let mut workers = std::collections::BTreeSet::new();
+    for frame in plan.range.clone() {
+        let (_, hash) = plan.frame(frame);
+        let state = if plan.is_complete(frame, &hash) {
+            FrameState::Complete
+        } else if let Some(claim) =
+            crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
+                .filter(|c| crate::claim::is_live(c, timeout))
+        {
+            workers.insert(format!("{}:{}", claim.host, claim.pid));
+            FrameState::InProgress
+        } else if writing.contains(&frame) {
+            FrameState::InProgress
+        } else if plan.formats.iter().any(|&f| plan.path(frame, f).exists()) {
+            FrameState::Stale
+        } else {
+            FrameState::Missing
+        };
+        let key = match state {
+            FrameState::Complete => "complete",
+            FrameState::Stale => "stale",
+            FrameState::InProgress => "in_progress",
+            FrameState::Missing => "missing",
+        };
+        by_state.entry(key).or_default().push(frame);
+    }
+    let total = plan.range.len();
+    let complete = by_state.get("complete").map_or(0, Vec::len);
+    let changed = std::fs::read_to_string(&plan.timeline.source)
+        .ok()
+        .zip(output::JobRecord::read(&plan.out_dir).ok())
+        .is_some_and(|(now, job)| now != job.timeline_text);
+    if args.json {
+        #[derive(Serialize)]
+        struct StatusReport<'a> {
+            folder: &'a Path,
+            timeline: &'a Path,
+            frames: (u32, u32),
+            total: usize,
+            complete: usize,
+            states: &'a std::collections::BTreeMap<&'a str, Vec<u32>>,
+            workers: Vec<String>,
+            timeline_changed_since_render: bool,
+        }
+        println!(
+            "{}",
+            serde_json::to_string(&StatusReport {
+                folder: &plan.out_dir,
+                timeline: &plan.timeline.source,
+                frames: (plan.range.start, plan.range.end),
+                total,
+                complete,
+                states: &by_state,
+                workers: workers.iter().cloned().collect(),
+                timeline_changed_since_render: changed,
+            })?
+        );
+    } else {
+        println!(
+            "{}: {complete} of {total} frames complete and current (frames {}..{} of {}, {}x{})",
+            plan.out_dir.display(),
+            plan.range.start,
+            plan.range.end,
+            plan.timeline.source.display(),
+            plan.width,
+            plan.height
+        );
+        for key in ["complete", "in_progress", "stale", "missing"] {
+            if let Some(frames) = by_state.get(key) {
+                println!(
+                    "  {:<12} {:>6}  {}",
+                    key.replace('_', " "),
+                    frames.len(),
+                    ranges(frames)
+                );
+            }
+        }
+        if !workers.is_empty() {
+            println!(
+                "  workers: {}",
+                workers.iter().cloned().collect::<Vec<_>>().join(", ")
+            );
+        }
+        if changed {
+            println!(
+                "  note: {} has changed since this folder's last render started",
+                plan.timeline.source.display()
+            );
+        }
+    }
+    if complete == total {
+        Ok(())
+    } else {
+        Err(Incomplete { complete, total }.into())
+    }
+}
+
+/// `status` found frames still to do: exit code 4, not an error message.
+#[derive(Debug)]
+pub struct Incomplete {
+    pub complete: usize,
+    pub total: usize,
+}
+
+impl std::fmt::Display for Incomplete {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} of {} frames are not complete",
+            self.total - self.complete,
+            self.total
+        )
+    }
+}
+
+impl std::error::Error for Incomplete {}
 
 fn info(path: &Path) -> anyhow::Result<()> {
     let t = Timeline::load(path)?;

@@ -6,6 +6,7 @@
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
+pub mod claim;
 pub mod cli;
 pub mod error;
 pub mod fractal;

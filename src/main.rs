@@ -9,7 +9,13 @@ fn main() -> ExitCode {
     match mandelreel::cli::run(cli) {
         Ok(()) => ExitCode::from(mandelreel::cli::EXIT_OK),
         Err(error) => {
-            eprintln!("error: {error:#}");
+            // `status` has already said what is incomplete; no "error:" for that.
+            if error
+                .downcast_ref::<mandelreel::cli::Incomplete>()
+                .is_none()
+            {
+                eprintln!("error: {error:#}");
+            }
             ExitCode::from(mandelreel::cli::exit_code(&error))
         }
     }

@@ -54,7 +54,7 @@ pub fn frame_pattern(format: Format) -> String {
 }
 
 /// The hidden name pattern a frame is written under until it is complete
-/// (`.frame_00042.png.<random>.partial` in practice, unique per writer). It
+/// (`.frame_00042.png.<host>.<pid>.<random>.partial` in practice, unique per writer). It
 /// never matches a final frame name, so a leftover one is never taken for a frame.
 pub fn temporary_path(final_path: &Path) -> PathBuf {
     let name = final_path
@@ -154,7 +154,8 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
     let prefix = hidden
         .file_name()
         .map(|n| n.to_string_lossy().trim_end_matches(".partial").to_string() + ".")
-        .unwrap_or_default();
+        .unwrap_or_default()
+        + &writer_tag();
     let mut builder = tempfile::Builder::new();
     builder.prefix(&prefix).suffix(".partial");
     #[cfg(unix)]
@@ -275,20 +276,113 @@ fn encode_exr(
         .map_err(|e| e.to_string())
 }
 
+/// The file in an output folder that records what it holds, so `status` can
+/// work from the folder alone.
+pub const JOB_FILE: &str = "mandelreel-job.json";
+
+/// What an output folder was rendered from: enough to recompute every
+/// frame's hash without the original timeline file.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct JobRecord {
+    pub renderer: String,
+    /// The timeline file as given, and its text when the render started.
+    pub timeline_path: PathBuf,
+    pub timeline_text: String,
+    pub width: u32,
+    pub height: u32,
+    pub formats: Vec<String>,
+    /// Half-open frame range the folder is meant to hold.
+    pub frames: (u32, u32),
+    pub preview: bool,
+}
+
+impl JobRecord {
+    /// Writes the record into `dir` atomically (concurrent workers of one job
+    /// write the same record; the last rename wins whole).
+    pub fn write(&self, dir: &Path) -> Result<()> {
+        let path = dir.join(JOB_FILE);
+        let mut temp = tempfile::Builder::new()
+            .prefix(&format!(".job.{}", writer_tag()))
+            .suffix(".partial")
+            .tempfile_in(dir)
+            .map_err(|e| Error::io(dir, e))?;
+        let json = serde_json::to_string_pretty(self).expect("a job record serialises");
+        temp.write_all(json.as_bytes())
+            .map_err(|e| Error::io(temp.path(), e))?;
+        temp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
+        Ok(())
+    }
+
+    pub fn read(dir: &Path) -> Result<JobRecord> {
+        let path = dir.join(JOB_FILE);
+        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+        serde_json::from_str(&text).map_err(|e| Error::Image {
+            path,
+            message: format!("not a mandelreel job record: {e}"),
+        })
+    }
+}
+
 /// How old a temporary `.partial` file must be to count as left behind by a
 /// killed render. A writer holds one only while encoding a finished frame
 /// (seconds), so anything this old belongs to no live process.
 pub const STALE_PARTIAL_AGE: std::time::Duration = std::time::Duration::from_secs(600);
 
-/// Deletes temporary frame files in `dir` older than `STALE_PARTIAL_AGE`;
-/// returns how many went. Younger ones may belong to a render running beside
-/// this one and are left alone.
+/// This machine's name, for temporary-file tags, claims and `status`.
+pub fn host_name() -> String {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .map(|s| s.trim().to_string())
+        .filter(|s| !s.is_empty())
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .unwrap_or_else(|| "unknown-host".into())
+}
+
+/// `host.pid.`: written into every temporary file's name so a later run on
+/// the same machine can tell whether its writer is still alive.
+pub fn writer_tag() -> String {
+    let host: String = host_name()
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '-'
+            }
+        })
+        .collect();
+    format!("{host}.{}.", std::process::id())
+}
+
+/// Whether the writer of temporary file `name` is a dead process on this
+/// machine (read from its `host.pid.` tag; Linux's /proc says who lives).
+fn writer_is_dead_here(name: &str) -> bool {
+    let mut parts = name.trim_end_matches(".partial").rsplit('.');
+    let (_random, pid, host) = (parts.next(), parts.next(), parts.next());
+    let ours = writer_tag();
+    let our_host = ours.split('.').next().unwrap_or_default();
+    match (host, pid.and_then(|p| p.parse::<u32>().ok())) {
+        (Some(h), Some(pid)) if h == our_host && Path::new("/proc/self").exists() => {
+            pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists()
+        }
+        _ => false,
+    }
+}
+
+/// Deletes temporary files in `dir` left by writers that are gone: those of
+/// dead processes on this machine at once, any other older than
+/// `STALE_PARTIAL_AGE`. Returns how many went. Fresh ones of live writers may
+/// belong to a render running beside this one and are left alone.
 pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
     let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
     let mut removed = 0;
     for entry in entries.filter_map(|e| e.ok()) {
         let name = entry.file_name().to_string_lossy().into_owned();
-        if !(name.starts_with(".frame_") && name.ends_with(".partial")) {
+        let temporary = name.ends_with(".partial")
+            && (name.starts_with(".frame_")
+                || name.starts_with(".claim.")
+                || name.starts_with(".job."));
+        if !temporary {
             continue;
         }
         let age = entry
@@ -296,8 +390,8 @@ pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
             .and_then(|m| m.modified())
             .ok()
             .and_then(|t| t.elapsed().ok());
-        if age.is_some_and(|a| a >= STALE_PARTIAL_AGE) && std::fs::remove_file(entry.path()).is_ok()
-        {
+        let stale = writer_is_dead_here(&name) || age.is_some_and(|a| a >= STALE_PARTIAL_AGE);
+        if stale && std::fs::remove_file(entry.path()).is_ok() {
             removed += 1;
         }
     }
@@ -444,6 +538,23 @@ mod tests {
             assert!(is_current(&path, format, "abc123"));
             assert!(!is_current(&path, format, "other"));
         }
+    }
+
+    #[test]
+    fn temporaries_of_dead_local_writers_go_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let host = writer_tag().split('.').next().unwrap().to_string();
+        // pid 4194304 is above Linux's pid_max: never alive.
+        let dead = format!(".frame_00003.png.{host}.4194304.Ab12Cd.partial");
+        let alive = format!(".frame_00004.png.{}Zz99Yy.partial", writer_tag());
+        let elsewhere = ".frame_00005.png.other-host.17.Qq11Ww.partial";
+        for name in [dead.as_str(), alive.as_str(), elsewhere] {
+            std::fs::write(dir.path().join(name), b"x").unwrap();
+        }
+        assert_eq!(remove_stale_partials(dir.path()).unwrap(), 1);
+        assert!(!dir.path().join(&dead).exists());
+        assert!(dir.path().join(&alive).exists());
+        assert!(dir.path().join(elsewhere).exists());
     }
 
     #[test]

@@ -4,6 +4,7 @@ mod util;
 
 mod accuracy;
 mod cli;
+mod farm;
 mod formats;
 mod resume;
 mod stability;

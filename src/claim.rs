@@ -1,0 +1,295 @@
+//! Claim files: how any number of `render --claim` workers on a shared output
+//! folder take frames one at a time, with no server between them.
+//!
+//! A worker claims frame N by creating `.frame_0000N.claim` exclusively (the
+//! file system decides the one winner) holding its host, pid, a unique token
+//! and a heartbeat time, which a background thread refreshes while the frame
+//! renders. A claim whose heartbeat is older than the timeout belongs to a dead
+//! worker; taking it over first needs `.frame_0000N.takeover-<its token>`,
+//! again created exclusively, so each dead claim is taken over exactly once.
+//! Heartbeats compare clocks across machines: cluster nodes must keep them in
+//! step (NTP), to well within the timeout.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::fs::OpenOptions;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::{Duration, SystemTime, UNIX_EPOCH};
+
+/// What a claim file holds.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct ClaimRecord {
+    pub host: String,
+    pub pid: u32,
+    /// Unique per claim: names the takeover marker of this claim.
+    pub token: String,
+    /// Last sign of life, milliseconds since the Unix epoch.
+    pub heartbeat_ms: u64,
+}
+
+/// `.frame_00042.claim` for frame 42.
+pub fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
+    dir.join(format!(
+        ".frame_{frame_index:0width$}.claim",
+        width = crate::output::FRAME_DIGITS
+    ))
+}
+
+fn takeover_path(dir: &Path, frame_index: u32, token: &str) -> PathBuf {
+    dir.join(format!(
+        ".frame_{frame_index:0width$}.takeover-{token}",
+        width = crate::output::FRAME_DIGITS
+    ))
+}
+
+fn now_ms() -> u64 {
+    SystemTime::now()
+        .duration_since(UNIX_EPOCH)
+        .map(|d| d.as_millis() as u64)
+        .unwrap_or(0)
+}
+
+/// Reads a claim file; `None` if it is missing or unreadable (a claim being
+/// replaced is renamed into place whole, so a reader never sees half of one).
+pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
+    let text = std::fs::read_to_string(path).ok()?;
+    serde_json::from_str(&text).ok()
+}
+
+/// Whether a claim's heartbeat is younger than `timeout`.
+pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
+    now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64
+}
+
+/// Replaces `path` with `record`, atomically (temporary file, then rename).
+fn write_record(path: &Path, record: &ClaimRecord) -> Result<()> {
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut temp = tempfile::Builder::new()
+        .prefix(&format!(".claim.{}", crate::output::writer_tag()))
+        .suffix(".partial")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
+    let json = serde_json::to_string(record).expect("a claim record always serialises");
+    temp.write_all(json.as_bytes())
+        .map_err(|e| Error::io(temp.path(), e))?;
+    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+/// Outcome of trying to claim a frame.
+pub enum Attempt {
+    /// The frame is ours until the guard is released or dropped.
+    Claimed(Claim),
+    /// Another live worker holds it.
+    Held(ClaimRecord),
+}
+
+/// A held claim; a thread keeps its heartbeat fresh until it is dropped,
+/// which also removes the claim file.
+pub struct Claim {
+    path: PathBuf,
+    dir: PathBuf,
+    frame_index: u32,
+    token: String,
+    stop: Arc<AtomicBool>,
+    heartbeat: Option<std::thread::JoinHandle<()>>,
+}
+
+impl Claim {
+    fn start(dir: &Path, frame_index: u32, record: ClaimRecord, interval: Duration) -> Claim {
+        let path = claim_path(dir, frame_index);
+        let stop = Arc::new(AtomicBool::new(false));
+        let heartbeat = {
+            let (path, stop, mut record) = (path.clone(), stop.clone(), record.clone());
+            std::thread::spawn(move || {
+                let tick = Duration::from_millis(50);
+                let mut waited = Duration::ZERO;
+                while !stop.load(Ordering::Relaxed) {
+                    std::thread::sleep(tick);
+                    waited += tick;
+                    if waited >= interval {
+                        waited = Duration::ZERO;
+                        // Only refresh a claim that is still ours.
+                        if read_claim(&path).is_some_and(|r| r.token == record.token) {
+                            record.heartbeat_ms = now_ms();
+                            let _ = write_record(&path, &record);
+                        }
+                    }
+                }
+            })
+        };
+        Claim {
+            path,
+            dir: dir.to_path_buf(),
+            frame_index,
+            token: record.token,
+            stop,
+            heartbeat: Some(heartbeat),
+        }
+    }
+}
+
+impl Drop for Claim {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        if let Some(h) = self.heartbeat.take() {
+            let _ = h.join();
+        }
+        if read_claim(&self.path).is_some_and(|r| r.token == self.token) {
+            let _ = std::fs::remove_file(&self.path);
+        }
+        // Takeover markers of this frame have served their purpose.
+        let prefix = format!(
+            ".frame_{:0width$}.takeover-",
+            self.frame_index,
+            width = crate::output::FRAME_DIGITS
+        );
+        if let Ok(entries) = std::fs::read_dir(&self.dir) {
+            for e in entries.filter_map(|e| e.ok()) {
+                if e.file_name().to_string_lossy().starts_with(&prefix) {
+                    let _ = std::fs::remove_file(e.path());
+                }
+            }
+        }
+    }
+}
+
+/// Tries to claim `frame_index` in `dir`. A claim older than `timeout` is
+/// taken over; the heartbeat is refreshed every quarter timeout.
+pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Attempt> {
+    let path = claim_path(dir, frame_index);
+    let record = ClaimRecord {
+        host: crate::output::host_name(),
+        pid: std::process::id(),
+        token: format!(
+            "{}-{}-{}",
+            crate::output::host_name(),
+            std::process::id(),
+            SystemTime::now()
+                .duration_since(UNIX_EPOCH)
+                .map(|d| d.as_nanos())
+                .unwrap_or(0)
+        ),
+        heartbeat_ms: now_ms(),
+    };
+    let interval = timeout / 4;
+    for _ in 0..3 {
+        match OpenOptions::new().write(true).create_new(true).open(&path) {
+            Ok(mut file) => {
+                let json = serde_json::to_string(&record).expect("serialises");
+                file.write_all(json.as_bytes())
+                    .map_err(|e| Error::io(&path, e))?;
+                return Ok(Attempt::Claimed(Claim::start(
+                    dir,
+                    frame_index,
+                    record,
+                    interval,
+                )));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
+            Err(e) => return Err(Error::io(&path, e)),
+        }
+        let Some(held) = read_claim(&path) else {
+            // Vanished, or being written this instant: look again.
+            std::thread::sleep(Duration::from_millis(20));
+            continue;
+        };
+        if is_live(&held, timeout) {
+            return Ok(Attempt::Held(held));
+        }
+        // A dead worker's claim: one takeover per dead claim, decided by who
+        // creates its marker first.
+        let marker = takeover_path(dir, frame_index, &held.token);
+        match OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&marker)
+        {
+            Ok(_) => {
+                write_record(&path, &record)?;
+                return Ok(Attempt::Claimed(Claim::start(
+                    dir,
+                    frame_index,
+                    record,
+                    interval,
+                )));
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                // Someone else is taking it over; their claim will show up live.
+                return Ok(Attempt::Held(held));
+            }
+            Err(e) => return Err(Error::io(&marker, e)),
+        }
+    }
+    // The claim kept vanishing and reappearing: treat it as held this round.
+    Ok(Attempt::Held(read_claim(&path).unwrap_or(record)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn one_claim_at_a_time_released_on_drop() {
+        let dir = tempfile::tempdir().unwrap();
+        let timeout = Duration::from_secs(60);
+        let Attempt::Claimed(claim) = try_claim(dir.path(), 3, timeout).unwrap() else {
+            panic!("a free frame can be claimed");
+        };
+        assert!(claim_path(dir.path(), 3).exists());
+        assert!(matches!(
+            try_claim(dir.path(), 3, timeout).unwrap(),
+            Attempt::Held(_)
+        ));
+        drop(claim);
+        assert!(!claim_path(dir.path(), 3).exists());
+        assert!(matches!(
+            try_claim(dir.path(), 3, timeout).unwrap(),
+            Attempt::Claimed(_)
+        ));
+    }
+
+    #[test]
+    fn a_dead_claim_is_taken_over_exactly_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = ClaimRecord {
+            host: "gone".into(),
+            pid: 1,
+            token: "dead-token".into(),
+            heartbeat_ms: now_ms() - 120_000,
+        };
+        write_record(&claim_path(dir.path(), 7), &dead).unwrap();
+        let timeout = Duration::from_secs(60);
+        let first = try_claim(dir.path(), 7, timeout).unwrap();
+        let Attempt::Claimed(ours) = first else {
+            panic!("a claim two minutes old is taken over");
+        };
+        // A second worker that also saw the dead claim loses the takeover.
+        assert!(matches!(
+            try_claim(dir.path(), 7, timeout).unwrap(),
+            Attempt::Held(_)
+        ));
+        let now = read_claim(&claim_path(dir.path(), 7)).unwrap();
+        assert_eq!(now.pid, std::process::id());
+        drop(ours);
+        assert!(!claim_path(dir.path(), 7).exists());
+    }
+
+    #[test]
+    fn heartbeat_keeps_a_long_claim_alive() {
+        let dir = tempfile::tempdir().unwrap();
+        let timeout = Duration::from_millis(400);
+        let Attempt::Claimed(_claim) = try_claim(dir.path(), 1, timeout).unwrap() else {
+            panic!("free frame");
+        };
+        let first = read_claim(&claim_path(dir.path(), 1)).unwrap();
+        std::thread::sleep(Duration::from_millis(900));
+        let later = read_claim(&claim_path(dir.path(), 1)).unwrap();
+        assert_eq!(later.token, first.token);
+        assert!(later.heartbeat_ms > first.heartbeat_ms);
+        assert!(is_live(&later, timeout));
+    }
+}

@@ -1,0 +1,328 @@
+//! Never losing a night's work, and sharing it out: crash-and-resume under
+//! repeated SIGKILL, `status`, `--shard`, `--claim` workers, a full disk.
+
+use crate::util::{stderr, stdout, tiny_timeline, Dir};
+use std::collections::BTreeMap;
+use std::time::{Duration, Instant};
+
+/// Frame numbers that `render` reported rendering, from its log lines.
+fn rendered_frames(log: &str) -> Vec<u32> {
+    log.lines()
+        .filter(|l| l.starts_with("frame ") && l.contains(" rendered in "))
+        .filter_map(|l| l.split_whitespace().nth(1)?.parse().ok())
+        .collect()
+}
+
+fn frames_in(d: &Dir, sub: &str) -> Vec<String> {
+    d.files(sub)
+        .into_iter()
+        .filter(|f| f.starts_with("frame_"))
+        .collect()
+}
+
+#[test]
+fn thirty_random_kills_then_resume_match_an_uninterrupted_render() {
+    let d = Dir::new();
+    let text = tiny_timeline(10, 6.0).replace("size: (48, 27)", "size: (96, 54)");
+    d.write("t.ron", &text);
+    d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
+    // A seeded generator: the same kill moments every run.
+    let mut state: u64 = 0x5eed_1234_abcd_0001;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 33) as u64
+    };
+    let mut kills = 0;
+    while kills < 30 {
+        let mut child = d
+            .command(&["render", "t.ron", "--quiet", "--threads", "1"])
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(next() % 60));
+        if child.try_wait().unwrap().is_none() {
+            child.kill().unwrap(); // SIGKILL
+            kills += 1;
+        }
+        child.wait().unwrap();
+        // Whatever sits under a final name is a whole, current frame.
+        for f in frames_in(&d, "out/t") {
+            image::open(d.path().join("out/t").join(&f))
+                .unwrap_or_else(|e| panic!("after kill {kills}, {f} is damaged: {e}"));
+        }
+        if frames_in(&d, "out/t").len() == 10 {
+            // Finished between kills: start over so every kill lands mid-sequence.
+            std::fs::remove_dir_all(d.path().join("out/t")).unwrap();
+        }
+    }
+    d.ok(&["render", "t.ron", "--quiet"]);
+    let finals = frames_in(&d, "out/t");
+    assert_eq!(finals.len(), 10);
+    for f in &finals {
+        assert!(
+            d.bytes(&format!("out/t/{f}")) == d.bytes(&format!("clean/{f}")),
+            "{f} differs from the uninterrupted render"
+        );
+    }
+    let leftovers: Vec<String> = d
+        .files("out/t")
+        .into_iter()
+        .filter(|f| f.ends_with(".partial"))
+        .collect();
+    assert!(leftovers.is_empty(), "temporary files left: {leftovers:?}");
+}
+
+#[test]
+fn status_reports_complete_stale_missing_and_in_progress() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(6, 6.0));
+    // Nothing rendered yet: everything missing, exit 4.
+    let out = d.run(&["status", "t.ron"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    assert!(
+        stdout(&out).contains("0 of 6 frames complete"),
+        "{}",
+        stdout(&out)
+    );
+    d.ok(&["render", "t.ron", "--frames", "0..4", "--quiet"]);
+    let out = d.run(&["status", "t.ron", "--json"]);
+    assert_eq!(out.status.code(), Some(4));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(v["complete"], 4);
+    assert_eq!(v["states"]["missing"], serde_json::json!([4, 5]));
+    // A live claim marks a frame in progress.
+    let claim = format!(
+        "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t1\",\"heartbeat_ms\":{}}}",
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_millis()
+    );
+    d.write("out/t/.frame_00004.claim", &claim);
+    let out = stdout(&d.run(&["status", "t.ron"]));
+    assert!(
+        out.contains("in progress") && out.contains("node7:42"),
+        "{out}"
+    );
+    std::fs::remove_file(d.path().join("out/t/.frame_00004.claim")).unwrap();
+    // Everything rendered: exit 0, from the timeline and from the folder alone.
+    d.ok(&["render", "t.ron", "--quiet"]);
+    assert!(stdout(&d.ok(&["status", "t.ron"])).contains("6 of 6 frames complete"));
+    assert!(stdout(&d.ok(&["status", "out/t"])).contains("6 of 6 frames complete"));
+    // The timeline changes: frames 1.. are stale against it, and the folder
+    // notices that its timeline changed since its render.
+    d.write("t.ron", &tiny_timeline(6, 5.0));
+    let out = d.run(&["status", "t.ron", "--json"]);
+    assert_eq!(out.status.code(), Some(4));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(v["states"]["stale"], serde_json::json!([1, 2, 3, 4, 5]));
+    let folder = stdout(&d.ok(&["status", "out/t"]));
+    assert!(folder.contains("has changed since"), "{folder}");
+    // The folder's own record is enough even when the timeline file is gone.
+    std::fs::remove_file(d.path().join("t.ron")).unwrap();
+    assert!(stdout(&d.ok(&["status", "out/t"])).contains("6 of 6 frames complete"));
+}
+
+#[test]
+fn shards_split_frames_by_index_and_from_the_scheduler() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(7, 6.0));
+    d.ok(&[
+        "render", "t.ron", "--shard", "1/3", "--out", "manual", "--quiet",
+    ]);
+    assert_eq!(
+        frames_in(&d, "manual"),
+        ["frame_00001.png", "frame_00004.png"]
+    );
+    // Slurm: --array=1-3 gives task ids 1..3; task 3 is shard 2 of 3.
+    let out = d
+        .command(&[
+            "render", "t.ron", "--shard", "auto", "--out", "slurm", "--quiet",
+        ])
+        .env("SLURM_ARRAY_TASK_ID", "3")
+        .env("SLURM_ARRAY_TASK_MIN", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "3")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        frames_in(&d, "slurm"),
+        ["frame_00002.png", "frame_00005.png"]
+    );
+    // Kubernetes Indexed Job: index 0 of 2.
+    let out = d
+        .command(&[
+            "render", "t.ron", "--shard", "auto", "--out", "k8s", "--quiet",
+        ])
+        .env("JOB_COMPLETION_INDEX", "0")
+        .env("MANDELREEL_SHARD_COUNT", "2")
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(
+        frames_in(&d, "k8s"),
+        [
+            "frame_00000.png",
+            "frame_00002.png",
+            "frame_00004.png",
+            "frame_00006.png"
+        ]
+    );
+    // Bad shards are usage errors, before anything is written.
+    for bad in ["3/3", "1/0", "x/2", "auto"] {
+        let out = d
+            .command(&["render", "t.ron", "--shard", bad, "--out", "bad"])
+            .env_remove("SLURM_ARRAY_TASK_ID")
+            .env_remove("JOB_COMPLETION_INDEX")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{bad}: {}", stderr(&out));
+        assert!(!d.path().join("bad").exists());
+    }
+}
+
+#[test]
+fn four_claim_workers_render_every_frame_exactly_once() {
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        &tiny_timeline(16, 6.0).replace("size: (48, 27)", "size: (64, 36)"),
+    );
+    let workers: Vec<_> = (0..4)
+        .map(|_| {
+            d.command(&["render", "t.ron", "--claim", "--threads", "1"])
+                .stderr(std::process::Stdio::piped())
+                .stdout(std::process::Stdio::null())
+                .spawn()
+                .unwrap()
+        })
+        .collect();
+    let mut counts: BTreeMap<u32, usize> = BTreeMap::new();
+    for w in workers {
+        let out = w.wait_with_output().unwrap();
+        assert!(out.status.success(), "{}", stderr(&out));
+        for f in rendered_frames(&stderr(&out)) {
+            *counts.entry(f).or_default() += 1;
+        }
+    }
+    assert_eq!(counts.len(), 16, "{counts:?}");
+    assert!(counts.values().all(|&n| n == 1), "{counts:?}");
+    for f in frames_in(&d, "out/t") {
+        image::open(d.path().join("out/t").join(f)).unwrap();
+    }
+    d.ok(&["status", "out/t"]);
+    assert!(!d.files("out/t").iter().any(|f| f.ends_with(".claim")));
+}
+
+#[test]
+fn a_killed_workers_claim_is_taken_over_after_the_timeout() {
+    let d = Dir::new();
+    // Frames slow enough that the kill lands while a claim is held.
+    d.write(
+        "t.ron",
+        &tiny_timeline(3, 6.0).replace("size: (48, 27)", "size: (480, 270)"),
+    );
+    let mut doomed = d
+        .command(&[
+            "render",
+            "t.ron",
+            "--claim",
+            "--claim-timeout",
+            "1",
+            "--threads",
+            "1",
+            "--quiet",
+        ])
+        .spawn()
+        .unwrap();
+    let started = Instant::now();
+    while !d.files("out/t").iter().any(|f| f.ends_with(".claim")) {
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "no claim appeared"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    doomed.kill().unwrap();
+    doomed.wait().unwrap();
+    let held: Vec<String> = d
+        .files("out/t")
+        .into_iter()
+        .filter(|f| f.ends_with(".claim"))
+        .collect();
+    assert_eq!(held.len(), 1, "the dead worker's claim stays behind");
+    let frame: u32 = held[0][7..12].parse().unwrap();
+    // A new worker waits out the dead claim's heartbeat, takes it over, and finishes.
+    let out = d.ok(&[
+        "render",
+        "t.ron",
+        "--claim",
+        "--claim-timeout",
+        "1",
+        "--threads",
+        "2",
+    ]);
+    assert!(
+        rendered_frames(&stderr(&out)).contains(&frame),
+        "{}",
+        stderr(&out)
+    );
+    d.ok(&["status", "out/t"]);
+}
+
+/// A tiny tmpfs, unmounted when dropped.
+struct SmallDisk(std::path::PathBuf);
+
+impl Drop for SmallDisk {
+    fn drop(&mut self) {
+        let _ = std::process::Command::new("umount").arg(&self.0).status();
+    }
+}
+
+#[test]
+fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
+    let d = Dir::new();
+    let mount = d.path().join("disk");
+    std::fs::create_dir(&mount).unwrap();
+    let mounted = std::process::Command::new("mount")
+        .args(["-t", "tmpfs", "-o", "size=48k", "tmpfs"])
+        .arg(&mount)
+        .output()
+        .is_ok_and(|o| o.status.success());
+    if !mounted {
+        // Mounting needs privileges; CI runs as root, where it works.
+        assert!(
+            std::env::var_os("CI").is_none() || ci_allows_skipping_mount(),
+            "cannot mount a tmpfs in CI"
+        );
+        eprintln!("skipping: cannot mount a small tmpfs here (not root?)");
+        return;
+    }
+    let _disk = SmallDisk(mount.clone());
+    // 40 frames of about 4 KB each cannot fit in 48 KB.
+    d.write("t.ron", &tiny_timeline(40, 6.0));
+    let out = d.run(&["render", "t.ron", "--out", "disk/seq", "--quiet"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    let err = stderr(&out);
+    assert!(
+        err.contains("No space left") || err.contains("space"),
+        "{err}"
+    );
+    let written = frames_in(&d, "disk/seq");
+    assert!(
+        !written.is_empty() && written.len() < 40,
+        "{} frames",
+        written.len()
+    );
+    for f in &written {
+        image::open(d.path().join("disk/seq").join(f)).unwrap_or_else(|e| panic!("{f}: {e}"));
+    }
+    assert!(!d.files("disk/seq").iter().any(|f| f.ends_with(".partial")));
+}
+
+/// CI machines without mount rights would fail the test above for the wrong
+/// reason; MANDELREEL_NO_MOUNT=1 lets such a CI skip it explicitly.
+fn ci_allows_skipping_mount() -> bool {
+    std::env::var_os("MANDELREEL_NO_MOUNT").is_some()
+}
