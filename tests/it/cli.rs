@@ -10,7 +10,12 @@ fn render_writes_numbered_frames_and_prints_the_ffmpeg_command() {
     let out = d.ok(&["render", "t.ron"]);
     assert_eq!(
         d.files("out/t"),
-        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+        [
+            "frame_00000.png",
+            "frame_00001.png",
+            "frame_00002.png",
+            "mandelreel-job.json"
+        ]
     );
     let cmd = stdout(&out);
     assert!(cmd.starts_with("ffmpeg "), "{cmd}");
@@ -32,7 +37,10 @@ fn frame_range_is_half_open_and_size_overrides() {
     let out = d.ok(&[
         "render", "t.ron", "--frames", "1..3", "--size", "20x10", "--out", "o",
     ]);
-    assert_eq!(d.files("o"), ["frame_00001.png", "frame_00002.png"]);
+    assert_eq!(
+        d.files("o"),
+        ["frame_00001.png", "frame_00002.png", "mandelreel-job.json"]
+    );
     let img = image::open(d.path().join("o/frame_00001.png")).unwrap();
     assert_eq!((img.width(), img.height()), (20, 10));
     assert!(stdout(&out).contains("-start_number 1 -i o/frame_%05d.png -frames:v 2"));

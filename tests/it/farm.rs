@@ -32,7 +32,7 @@ fn thirty_random_kills_then_resume_match_an_uninterrupted_render() {
         state = state
             .wrapping_mul(6364136223846793005)
             .wrapping_add(1442695040888963407);
-        (state >> 33) as u64
+        state >> 33
     };
     let mut kills = 0;
     while kills < 30 {

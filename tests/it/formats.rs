@@ -7,7 +7,10 @@ fn png_and_exr_decode_with_expected_channels() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(1, 8.0));
     d.ok(&["render", "t.ron", "--format", "png,exr"]);
-    assert_eq!(d.files("out/t"), ["frame_00000.exr", "frame_00000.png"]);
+    assert_eq!(
+        d.files("out/t"),
+        ["frame_00000.exr", "frame_00000.png", "mandelreel-job.json"]
+    );
 
     let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();
     assert_eq!((png.width(), png.height()), (48, 27));

@@ -7,6 +7,7 @@ use std::time::{Duration, Instant};
 fn mtimes(d: &Dir, sub: &str) -> Vec<std::time::SystemTime> {
     d.files(sub)
         .iter()
+        .filter(|f| f.starts_with("frame_"))
         .map(|f| {
             std::fs::metadata(d.path().join(sub).join(f))
                 .unwrap()
@@ -99,7 +100,8 @@ fn stale_temporary_and_foreign_files_are_not_taken_for_frames() {
         [
             ".frame_00001.png.a1b2c3.partial",
             "frame_00000.png",
-            "frame_00001.png"
+            "frame_00001.png",
+            "mandelreel-job.json"
         ]
     );
     for f in ["frame_00000.png", "frame_00001.png"] {
@@ -159,7 +161,7 @@ fn killed_render_resumes_to_identical_frames() {
     let finals: Vec<String> = d
         .files("out/t")
         .into_iter()
-        .filter(|f| !f.starts_with('.'))
+        .filter(|f| f.starts_with("frame_"))
         .collect();
     assert_eq!(finals.len(), 12);
     // The resumed sequence equals an uninterrupted render.
