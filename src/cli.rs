@@ -607,10 +607,14 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
             say(format!(
-                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel), {} of {} samples hit, {} repaired",
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}), {} of {} samples hit, {} repaired",
                 stats.de_evaluations,
                 stats.de_evaluations as f64 / stats.samples.max(1) as f64,
                 stats.max_pixel_evaluations,
+                stats.primary_evaluations,
+                stats.normal_evaluations,
+                stats.shadow_evaluations,
+                stats.occlusion_evaluations,
                 stats.hits,
                 stats.samples,
                 stats.repaired_samples
@@ -947,8 +951,49 @@ fn info(path: &Path) -> anyhow::Result<()> {
             println!("{line}");
         }
     }
+    let effects = &base.effects;
+    let enabled = effects.enabled();
     println!(
-        "effects:  none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
+        "effects:  {}",
+        if enabled.is_empty() {
+            "none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
+                .to_string()
+        } else {
+            enabled.join(", ")
+        }
+    );
+    // The render plan: which stages run per camera sample, and their cost in
+    // distance estimates relative to marching (about 20 per ray at this size).
+    println!("plan:     per sample: primary march; per hit: normal (4 estimates)");
+    if let Some(sh) = &effects.shadows {
+        println!(
+            "          + shadow march towards the light, up to {} estimates per lit hit ({})",
+            sh.max_steps,
+            if sh.softness > 0.0 {
+                format!("soft, k = {}", sh.softness)
+            } else {
+                "hard".into()
+            }
+        );
+    }
+    if let Some(ao) = &effects.ambient_occlusion {
+        println!(
+            "          + ambient occlusion, {} estimates per hit",
+            ao.samples
+        );
+    }
+    if effects.specular.is_some() {
+        println!("          + specular highlight (no estimates)");
+    }
+    if effects.fog.is_some() {
+        println!("          + fog over hit distance (no estimates)");
+    }
+    if effects.glow.is_some() {
+        println!("          + glow from the march's nearest approach (no estimates)");
+    }
+    println!(
+        "          {} sample(s) per pixel: {}x the per-sample work",
+        base.samples_per_pixel, base.samples_per_pixel
     );
     println!("output:   out/{}/ by default", t.name);
     Ok(())

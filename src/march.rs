@@ -68,6 +68,9 @@ pub struct Hit {
 pub struct MarchResult {
     pub hit: Option<Hit>,
     pub evaluations: u32,
+    /// Smallest estimate along the ray, in pixel footprints (∞ when nothing
+    /// was estimated): how near a miss came, for glow.
+    pub closest: Real,
 }
 
 /// Sphere-traces `ray` against `fractal` inside the bounding sphere.
@@ -80,11 +83,13 @@ pub struct MarchResult {
 /// the hit threshold.
 pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchResult {
     let mut evaluations = 0;
+    let mut closest = Real::INFINITY;
     let Some((t_enter, t_exit)) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
     else {
         return MarchResult {
             hit: None,
             evaluations,
+            closest,
         };
     };
     let at = |t: Real| ray.origin + ray.dir * t;
@@ -94,6 +99,7 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
         let point = at(t);
         let estimate = fractal.estimate(point, ray.footprint(t));
         evaluations += estimate.orbits;
+        closest = closest.min(estimate.distance / ray.footprint(t));
         if !estimate.escaped {
             if let Some(mut lo) = t_outside {
                 // Overshot: bisect [lo (outside), t (inside)] down to the threshold.
@@ -119,6 +125,7 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
                         estimate,
                     }),
                     evaluations,
+                    closest: 0.0,
                 };
             }
         }
@@ -126,6 +133,7 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
             return MarchResult {
                 hit: Some(Hit { t, point, estimate }),
                 evaluations,
+                closest,
             };
         }
         t_outside = Some(t);
@@ -134,6 +142,7 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
             return MarchResult {
                 hit: None,
                 evaluations,
+                closest,
             };
         }
     }
@@ -149,6 +158,7 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
             estimate,
         }),
         evaluations,
+        closest,
     }
 }
 

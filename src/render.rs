@@ -7,6 +7,7 @@
 use crate::march::{march, normal};
 use crate::math::{finite_or_zero, Real, Vec3};
 use crate::scene::Scene;
+use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
 use rayon::prelude::*;
 
 /// Depth written for pixels that see only background.
@@ -31,8 +32,13 @@ pub struct Film {
 /// Work counted while rendering one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FrameStats {
-    /// Distance-estimator evaluations (marching and normals).
+    /// Distance-estimator evaluations, every stage together.
     pub de_evaluations: u64,
+    /// The same by stage: primary marching, normals, shadow marches, occlusion.
+    pub primary_evaluations: u64,
+    pub normal_evaluations: u64,
+    pub shadow_evaluations: u64,
+    pub occlusion_evaluations: u64,
     pub samples: u64,
     pub hits: u64,
     /// The most evaluations any one pixel took.
@@ -43,11 +49,25 @@ pub struct FrameStats {
     pub repaired_samples: u64,
 }
 
+impl FrameStats {
+    /// Evaluations over every stage.
+    pub fn stage_total(&self) -> u64 {
+        self.primary_evaluations
+            + self.normal_evaluations
+            + self.shadow_evaluations
+            + self.occlusion_evaluations
+    }
+}
+
 impl std::ops::Add for FrameStats {
     type Output = FrameStats;
     fn add(self, o: FrameStats) -> FrameStats {
         FrameStats {
             de_evaluations: self.de_evaluations + o.de_evaluations,
+            primary_evaluations: self.primary_evaluations + o.primary_evaluations,
+            normal_evaluations: self.normal_evaluations + o.normal_evaluations,
+            shadow_evaluations: self.shadow_evaluations + o.shadow_evaluations,
+            occlusion_evaluations: self.occlusion_evaluations + o.occlusion_evaluations,
             samples: self.samples + o.samples,
             hits: self.hits + o.hits,
             max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
@@ -99,6 +119,8 @@ pub fn render_frame(
 ) -> Film {
     let camera = scene.camera.frame();
     let n = scene.samples_per_pixel.max(1);
+    // Fog is measured in camera–target distances, so zooms keep their haze.
+    let scale = (scene.camera.position - scene.camera.target).length();
     let (w, pixels) = (width as usize, width as usize * height as usize);
     let mut colour = vec![Vec3::ZERO; pixels];
     let mut alpha = vec![0.0f32; pixels];
@@ -119,23 +141,15 @@ pub fn render_frame(
                     let pixel = (y * w + x) as u64;
                     let mut sum = [0.0f64; 3];
                     let mut hits = 0u32;
-                    let mut pixel_evaluations = 0u64;
+                    let before = stats;
                     for s in 0..n {
                         let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
                         let ray = camera.ray(x as Real + ox, y as Real + oy, width, height);
-                        let result = march(&ray, &scene.fractal, &scene.quality);
-                        pixel_evaluations += result.evaluations as u64;
-                        let c = match result.hit {
-                            Some(hit) => {
-                                let (nrm, evals) =
-                                    normal(&ray, &hit, &scene.fractal, &scene.quality);
-                                pixel_evaluations += evals as u64;
-                                hits += 1;
-                                depth_row[x] = depth_row[x].min(hit.t as f32);
-                                scene.look.surface(nrm, &hit.estimate.traps)
-                            }
-                            None => scene.look.background(ray.dir, camera.up),
-                        };
+                        let (c, t) = trace(scene, &ray, camera.up, scale, &mut stats);
+                        if let Some(t) = t {
+                            hits += 1;
+                            depth_row[x] = depth_row[x].min(t as f32);
+                        }
                         debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
                         if !c.is_finite() {
                             stats.repaired_samples += 1;
@@ -152,10 +166,9 @@ pub fn render_frame(
                         (sum[2] * inv) as f32,
                     );
                     alpha_row[x] = hits as f32 / n as f32;
-                    evaluations_row[x] = pixel_evaluations.min(u32::MAX as u64) as u32;
-                    stats.de_evaluations += pixel_evaluations;
-                    stats.max_pixel_evaluations =
-                        stats.max_pixel_evaluations.max(pixel_evaluations);
+                    let spent = stats.stage_total() - before.stage_total();
+                    evaluations_row[x] = spent.min(u32::MAX as u64) as u32;
+                    stats.max_pixel_evaluations = stats.max_pixel_evaluations.max(spent);
                     stats.samples += n as u64;
                     stats.hits += hits as u64;
                 }
@@ -164,6 +177,10 @@ pub fn render_frame(
             },
         )
         .reduce(FrameStats::default, |a, b| a + b);
+    let stats = FrameStats {
+        de_evaluations: stats.stage_total(),
+        ..stats
+    };
     Film {
         width,
         height,
@@ -173,6 +190,51 @@ pub fn render_frame(
         evaluations,
         stats,
     }
+}
+
+/// One camera sample: its radiance and, if it met the surface, the distance.
+/// Only the stages of the scene's enabled effects run; `stats` counts each.
+fn trace(
+    scene: &Scene,
+    ray: &crate::march::Ray,
+    up: crate::math::DVec3,
+    scale: Real,
+    stats: &mut FrameStats,
+) -> (Vec3, Option<Real>) {
+    let result = march(ray, &scene.fractal, &scene.quality);
+    stats.primary_evaluations += result.evaluations as u64;
+    let Some(hit) = result.hit else {
+        let sky = scene.look.background(ray.dir, up);
+        return match &scene.effects.glow {
+            Some(g) => (sky + glow(g, result.closest), None),
+            None => (sky, None),
+        };
+    };
+    let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
+    stats.normal_evaluations += evals as u64;
+    let at = SurfacePoint {
+        point: hit.point,
+        normal: nrm,
+        view_dir: ray.dir,
+        t: hit.t,
+        footprint: ray.footprint(hit.t),
+        traps: hit.estimate.traps,
+    };
+    let mut stages = StageCounts::default();
+    let lit = scene.look.shade(
+        &scene.effects,
+        &scene.fractal,
+        &scene.quality,
+        &at,
+        &mut stages,
+    );
+    stats.shadow_evaluations += stages.shadows;
+    stats.occlusion_evaluations += stages.occlusion;
+    let c = match &scene.effects.fog {
+        Some(fog) => fogged(lit, fog, hit.t, scale),
+        None => lit,
+    };
+    (c, Some(hit.t))
 }
 
 #[cfg(test)]
@@ -233,5 +295,88 @@ mod tests {
         );
         assert!(film.evaluations[at(16, 12)] > film.evaluations[at(0, 0)]);
         assert_eq!(film.stats.samples, 32 * 24);
+    }
+
+    #[test]
+    fn each_effect_alone_moves_only_its_stage_and_changes_the_image() {
+        use crate::shade::{AmbientOcclusion, Effects, Fog, Glow, Shadows, Specular};
+        let plain_scene = Scene::default();
+        let plain = render_frame(&plain_scene, 0, 40, 30, &|| {});
+        let counters = |s: &FrameStats| {
+            [
+                s.primary_evaluations,
+                s.normal_evaluations,
+                s.shadow_evaluations,
+                s.occlusion_evaluations,
+            ]
+        };
+        // With every effect off nothing but marching and normals runs.
+        let p = counters(&plain.stats);
+        assert!(p[0] > 0 && p[1] > 0);
+        assert_eq!((p[2], p[3]), (0, 0));
+        assert_eq!(plain.stats.de_evaluations, p.iter().sum::<u64>());
+        let cases: [(&str, Effects, [bool; 4]); 5] = [
+            (
+                "shadows",
+                Effects {
+                    shadows: Some(Shadows::default()),
+                    ..Effects::default()
+                },
+                [false, false, true, false],
+            ),
+            (
+                "ambient_occlusion",
+                Effects {
+                    ambient_occlusion: Some(AmbientOcclusion::default()),
+                    ..Effects::default()
+                },
+                [false, false, false, true],
+            ),
+            (
+                "specular",
+                Effects {
+                    specular: Some(Specular::default()),
+                    ..Effects::default()
+                },
+                [false; 4],
+            ),
+            (
+                "fog",
+                Effects {
+                    fog: Some(Fog::default()),
+                    ..Effects::default()
+                },
+                [false; 4],
+            ),
+            (
+                "glow",
+                Effects {
+                    glow: Some(Glow::default()),
+                    ..Effects::default()
+                },
+                [false; 4],
+            ),
+        ];
+        for (name, effects, moves) in cases {
+            let scene = Scene {
+                effects,
+                ..Scene::default()
+            };
+            let film = render_frame(&scene, 0, 40, 30, &|| {});
+            let c = counters(&film.stats);
+            for k in 0..4 {
+                if moves[k] {
+                    assert!(c[k] > p[k], "{name}: stage {k} should run");
+                } else {
+                    assert_eq!(c[k], p[k], "{name}: stage {k} should not change");
+                }
+            }
+            assert_eq!(film.stats.de_evaluations, c.iter().sum::<u64>());
+            assert!(
+                film.colour != plain.colour,
+                "{name} changed nothing in the image"
+            );
+            assert!(film.colour.iter().all(|v| v.is_finite()));
+        }
     }
 }

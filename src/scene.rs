@@ -90,6 +90,8 @@ pub struct Scene {
     pub fractal: Fractal,
     pub quality: MarchSettings,
     pub look: crate::shade::Look,
+    /// Optional effects; each off unless declared.
+    pub effects: crate::shade::Effects,
     /// Anti-aliasing samples per pixel (1 = one ray through the pixel centre).
     pub samples_per_pixel: u32,
     /// Seed of the deterministic sample pattern.
@@ -103,6 +105,7 @@ impl Default for Scene {
             fractal: Fractal::default(),
             quality: MarchSettings::default(),
             look: crate::shade::Look::default(),
+            effects: crate::shade::Effects::default(),
             samples_per_pixel: 1,
             seed: 0,
         }

@@ -113,6 +113,16 @@ pub const PARAMETERS: &[(&str, usize)] = &[
     ("look.trap_occlusion", 1),
     ("look.background_top", 3),
     ("look.background_bottom", 3),
+    ("effects.shadows.softness", 1),
+    ("effects.ambient_occlusion.radius", 1),
+    ("effects.ambient_occlusion.strength", 1),
+    ("effects.specular.strength", 1),
+    ("effects.specular.shininess", 1),
+    ("effects.fog.density", 1),
+    ("effects.fog.colour", 3),
+    ("effects.glow.strength", 1),
+    ("effects.glow.width", 1),
+    ("effects.glow.colour", 3),
 ];
 
 /// The track that sets the camera–target distance, interpolated in log space.
@@ -158,6 +168,33 @@ fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
         "look.trap_occlusion" => l.trap_occlusion = v[0] as f32,
         "look.background_top" => l.background_top = colour(),
         "look.background_bottom" => l.background_bottom = colour(),
+        effect if effect.starts_with("effects.") => {
+            // Validation guarantees the effect is enabled in the base scene.
+            let e = &mut scene.effects;
+            match effect {
+                "effects.shadows.softness" => e.shadows.iter_mut().for_each(|x| x.softness = v[0]),
+                "effects.ambient_occlusion.radius" => {
+                    e.ambient_occlusion.iter_mut().for_each(|x| x.radius = v[0])
+                }
+                "effects.ambient_occlusion.strength" => e
+                    .ambient_occlusion
+                    .iter_mut()
+                    .for_each(|x| x.strength = v[0] as f32),
+                "effects.specular.strength" => {
+                    e.specular.iter_mut().for_each(|x| x.strength = v[0] as f32)
+                }
+                "effects.specular.shininess" => e
+                    .specular
+                    .iter_mut()
+                    .for_each(|x| x.shininess = v[0] as f32),
+                "effects.fog.density" => e.fog.iter_mut().for_each(|x| x.density = v[0]),
+                "effects.fog.colour" => e.fog.iter_mut().for_each(|x| x.colour = colour()),
+                "effects.glow.strength" => e.glow.iter_mut().for_each(|x| x.strength = v[0] as f32),
+                "effects.glow.width" => e.glow.iter_mut().for_each(|x| x.width = v[0]),
+                "effects.glow.colour" => e.glow.iter_mut().for_each(|x| x.colour = colour()),
+                other => unreachable!("track {other:?} passed validation but has no parameter"),
+            }
+        }
         other => unreachable!("track {other:?} passed validation but has no parameter"),
     }
 }
@@ -334,6 +371,18 @@ impl Timeline {
                     ),
                 ));
             };
+            if let Some(effect) = name
+                .strip_prefix("effects.")
+                .and_then(|r| r.split('.').next())
+            {
+                if !file.scene.effects.enabled().contains(&effect) {
+                    return Err(at(
+                        String::new(),
+                        None,
+                        format!("animates the {effect} effect, which the scene does not enable: add `{effect}: ()` to scene.effects"),
+                    ));
+                }
+            }
             if spec.keys.is_empty() {
                 return Err(at(
                     ".keys".into(),
@@ -623,6 +672,80 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         "look.trap_occlusion",
         format!("must be in [0, 1], got {}", l.trap_occlusion),
     )?;
+    let e = &s.effects;
+    if let Some(sh) = &e.shadows {
+        check(
+            sh.softness.is_finite() && sh.softness >= 0.0,
+            "effects.shadows.softness",
+            format!("must be 0 (hard) or positive, got {}", sh.softness),
+        )?;
+        check(
+            (1..=100_000).contains(&sh.max_steps),
+            "effects.shadows.max_steps",
+            format!("must be 1..=100000, got {}", sh.max_steps),
+        )?;
+    }
+    if let Some(ao) = &e.ambient_occlusion {
+        check(
+            (1..=64).contains(&ao.samples),
+            "effects.ambient_occlusion.samples",
+            format!("must be 1..=64, got {}", ao.samples),
+        )?;
+        check(
+            ao.radius.is_finite() && ao.radius > 0.0,
+            "effects.ambient_occlusion.radius",
+            format!("must be positive, got {}", ao.radius),
+        )?;
+        check(
+            ao.strength.is_finite() && (0.0..=1.0).contains(&ao.strength),
+            "effects.ambient_occlusion.strength",
+            format!("must be in [0, 1], got {}", ao.strength),
+        )?;
+    }
+    if let Some(sp) = &e.specular {
+        check(
+            sp.strength.is_finite() && sp.strength >= 0.0,
+            "effects.specular.strength",
+            format!("must be non-negative, got {}", sp.strength),
+        )?;
+        check(
+            sp.shininess.is_finite() && sp.shininess > 0.0,
+            "effects.specular.shininess",
+            format!("must be positive, got {}", sp.shininess),
+        )?;
+    }
+    if let Some(fog) = &e.fog {
+        check(
+            fog.density.is_finite() && fog.density >= 0.0,
+            "effects.fog.density",
+            format!("must be non-negative, got {}", fog.density),
+        )?;
+        check(
+            fog.colour.is_finite() && fog.colour.min_element() >= 0.0,
+            "effects.fog.colour",
+            format!(
+                "colours must be finite and non-negative, got {}",
+                fog.colour
+            ),
+        )?;
+    }
+    if let Some(g) = &e.glow {
+        check(
+            g.strength.is_finite() && g.strength >= 0.0,
+            "effects.glow.strength",
+            format!("must be non-negative, got {}", g.strength),
+        )?;
+        check(
+            g.width.is_finite() && g.width > 0.0,
+            "effects.glow.width",
+            format!("must be positive, got {}", g.width),
+        )?;
+        check(
+            g.colour.is_finite() && g.colour.min_element() >= 0.0,
+            "effects.glow.colour",
+            format!("colours must be finite and non-negative, got {}", g.colour),
+        )?;
+    }
     Ok(())
 }
 
@@ -862,13 +985,38 @@ mod tests {
 
     #[test]
     fn every_parameter_name_applies() {
+        let all_effects = Scene {
+            effects: crate::shade::Effects {
+                shadows: Some(Default::default()),
+                ambient_occlusion: Some(Default::default()),
+                specular: Some(Default::default()),
+                fog: Some(Default::default()),
+                glow: Some(Default::default()),
+            },
+            ..Scene::default()
+        };
         for &(name, arity) in PARAMETERS {
-            let mut scene = Scene::default();
+            let mut scene = all_effects.clone();
             let before = scene.clone();
             let v = vec![0.25; arity];
             apply(&mut scene, name, &v);
             assert_ne!(scene, before, "{name} changed nothing");
         }
+    }
+
+    #[test]
+    fn effect_tracks_need_the_effect_enabled() {
+        let e = error_of(&with_track(
+            "\"effects.fog.density\": (keys: [(time: 0, value: 0.5)])",
+        ));
+        assert!(e.contains("fog") && e.contains("does not enable"), "{e}");
+        let t = parse(
+            "(fps: 10, frames: 11, size: (8, 6), scene: (effects: (fog: (density: 0.1))), tracks: { \"effects.fog.density\": (interpolation: Linear, keys: [(time: 0, value: 0.1), (time: 1, value: 0.9)]) })",
+        )
+        .unwrap();
+        assert_eq!(t.scene_at(5).effects.fog.unwrap().density, 0.5);
+        let e = error_of("(fps: 10, frames: 1, size: (8, 6), scene: (effects: (ambient_occlusion: (samples: 0))))");
+        assert!(e.contains("effects.ambient_occlusion.samples"), "{e}");
     }
 
     #[test]

@@ -218,7 +218,7 @@ fn ffmpeg_encodes_the_frames_with_the_printed_command() {
 fn example_timelines_are_valid() {
     let d = Dir::new();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    for name in ["zoom.ron", "julia_morph.ron"] {
+    for name in ["zoom.ron", "julia_morph.ron", "effects.ron"] {
         let path = root.join("timelines").join(name);
         let out = d.ok(&["info", path.to_str().unwrap()]);
         assert!(stdout(&out).contains("frames:"), "{}", stderr(&out));
