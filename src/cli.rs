@@ -991,6 +991,13 @@ fn info(path: &Path) -> anyhow::Result<()> {
     if effects.glow.is_some() {
         println!("          + glow from the march's nearest approach (no estimates)");
     }
+    let lens = base.camera.frame();
+    if lens.has_lens() {
+        println!(
+            "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel > 1)",
+            lens.aperture_radius, lens.focus_distance
+        );
+    }
     println!(
         "          {} sample(s) per pixel: {}x the per-sample work",
         base.samples_per_pixel, base.samples_per_pixel

@@ -482,6 +482,7 @@ mod tests {
             up: DVec3::Y,
             roll_degrees: 0.0,
             fov_degrees: 40.0,
+            ..crate::scene::Camera::default()
         }
         .frame();
         let settings = MarchSettings::default();

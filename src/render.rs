@@ -144,7 +144,13 @@ pub fn render_frame(
                     let before = stats;
                     for s in 0..n {
                         let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
-                        let ray = camera.ray(x as Real + ox, y as Real + oy, width, height);
+                        let ray = if camera.has_lens() {
+                            let u = sample_1d(scene.seed, frame_index, pixel, s, 2);
+                            let v = sample_1d(scene.seed, frame_index, pixel, s, 3);
+                            camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
+                        } else {
+                            camera.ray(x as Real + ox, y as Real + oy, width, height)
+                        };
                         let (c, t) = trace(scene, &ray, camera.up, scale, &mut stats);
                         if let Some(t) = t {
                             hits += 1;
@@ -378,5 +384,26 @@ mod tests {
             );
             assert!(film.colour.iter().all(|v| v.is_finite()));
         }
+    }
+
+    #[test]
+    fn depth_of_field_blurs_only_when_the_lens_is_open() {
+        let sharp = Scene {
+            samples_per_pixel: 4,
+            ..Scene::default()
+        };
+        let mut blurred = sharp.clone();
+        blurred.camera.aperture_radius = 0.15;
+        blurred.camera.focus_distance = Some(1.0); // well in front of the bulb
+        let a = render_frame(&sharp, 0, 32, 24, &|| {});
+        let b = render_frame(&blurred, 0, 32, 24, &|| {});
+        assert!(a.colour != b.colour);
+        assert!(b.colour.iter().all(|c| c.is_finite()));
+        // A zero aperture is the pinhole exactly, whatever the focus.
+        let mut closed = sharp.clone();
+        closed.camera.focus_distance = Some(1.0);
+        assert!(render_frame(&closed, 0, 32, 24, &|| {}).colour == a.colour);
+        // The lens costs marching only through its extra rays' paths: same sample count.
+        assert_eq!(a.stats.samples, b.stats.samples);
     }
 }

@@ -20,6 +20,10 @@ pub struct Camera {
     pub roll_degrees: Real,
     /// Vertical field of view.
     pub fov_degrees: Real,
+    /// Radius of the thin lens; 0 (the default) is a pinhole with no depth of field.
+    pub aperture_radius: Real,
+    /// Distance along the view direction that is in focus [default: the target's].
+    pub focus_distance: Option<Real>,
 }
 
 impl Default for Camera {
@@ -30,6 +34,8 @@ impl Default for Camera {
             up: DVec3::Y,
             roll_degrees: 0.0,
             fov_degrees: 45.0,
+            aperture_radius: 0.0,
+            focus_distance: None,
         }
     }
 }
@@ -42,6 +48,8 @@ pub struct CameraFrame {
     pub right: DVec3,
     pub up: DVec3,
     pub tan_half_fov: Real,
+    pub aperture_radius: Real,
+    pub focus_distance: Real,
 }
 
 impl Camera {
@@ -62,6 +70,10 @@ impl Camera {
             right,
             up,
             tan_half_fov: (self.fov_degrees.to_radians() * 0.5).tan(),
+            aperture_radius: self.aperture_radius,
+            focus_distance: self
+                .focus_distance
+                .unwrap_or_else(|| (self.target - self.position).length()),
         }
     }
 }
@@ -78,6 +90,34 @@ impl CameraFrame {
             origin: self.origin,
             dir,
             pixel_angle: 2.0 * self.tan_half_fov / h,
+        }
+    }
+}
+
+impl CameraFrame {
+    /// Whether the camera has a lens (depth of field) rather than a pinhole.
+    pub fn has_lens(&self) -> bool {
+        self.aperture_radius > 0.0
+    }
+
+    /// The ray through image position (`x`, `y`) from lens position (`u`, `v`)
+    /// in [0, 1)²: a thin lens focused at `focus_distance`. Every lens position
+    /// of one image position meets the others on the plane of focus.
+    pub fn lens_ray(&self, x: Real, y: Real, width: u32, height: u32, u: Real, v: Real) -> Ray {
+        let pinhole = self.ray(x, y, width, height);
+        if !self.has_lens() {
+            return pinhole;
+        }
+        let focus =
+            pinhole.origin + pinhole.dir * (self.focus_distance / pinhole.dir.dot(self.forward));
+        // Uniform point on the disc (polar mapping; the sampler is stratified
+        // in u already, so the mapping's distortion matters little).
+        let (radius, angle) = (u.sqrt() * self.aperture_radius, std::f64::consts::TAU * v);
+        let origin = self.origin + (self.right * angle.cos() + self.up * angle.sin()) * radius;
+        Ray {
+            origin,
+            dir: (focus - origin).normalize(),
+            pixel_angle: pinhole.pixel_angle,
         }
     }
 }
@@ -123,6 +163,7 @@ mod tests {
             up: DVec3::Y,
             roll_degrees: 0.0,
             fov_degrees: 90.0,
+            ..Camera::default()
         }
     }
 
@@ -144,6 +185,31 @@ mod tests {
         assert!((right.dir.x / -right.dir.z - 2.0).abs() < 1e-12);
         let left = f.ray(0.0, 25.0, 100, 50);
         assert!(left.dir.x < 0.0);
+    }
+
+    #[test]
+    fn lens_rays_meet_on_the_plane_of_focus() {
+        let lens = Camera {
+            aperture_radius: 0.2,
+            focus_distance: Some(4.0),
+            ..camera()
+        }
+        .frame();
+        let pinhole = camera().frame();
+        // Without a lens, lens rays are the pinhole's.
+        let a = pinhole.lens_ray(30.0, 10.0, 100, 50, 0.7, 0.2);
+        assert_eq!(a.dir, pinhole.ray(30.0, 10.0, 100, 50).dir);
+        let through = |u: f64, v: f64| {
+            let r = lens.lens_ray(30.0, 10.0, 100, 50, u, v);
+            // Where the ray crosses the plane 4 in front of the camera (z = 1).
+            let t = (r.origin.z - 1.0) / -r.dir.z;
+            (r.origin, r.origin + r.dir * t)
+        };
+        let (o1, p1) = through(0.1, 0.3);
+        let (o2, p2) = through(0.9, 0.8);
+        assert!(o1 != o2, "different lens positions");
+        assert!((o1 - camera().position).length() <= 0.2 + 1e-12);
+        assert!((p1 - p2).length() < 1e-12, "{p1} vs {p2}");
     }
 
     #[test]

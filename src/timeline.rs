@@ -94,6 +94,8 @@ pub const PARAMETERS: &[(&str, usize)] = &[
     ("camera.roll_degrees", 1),
     ("camera.fov_degrees", 1),
     ("camera.distance", 1),
+    ("camera.aperture_radius", 1),
+    ("camera.focus_distance", 1),
     ("fractal.power", 1),
     ("fractal.iterations", 1),
     ("fractal.bailout", 1),
@@ -145,6 +147,8 @@ fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
         "camera.up" => c.up = triple(),
         "camera.roll_degrees" => c.roll_degrees = v[0],
         "camera.fov_degrees" => c.fov_degrees = v[0],
+        "camera.aperture_radius" => c.aperture_radius = v[0],
+        "camera.focus_distance" => c.focus_distance = Some(v[0]),
         ZOOM_TRACK => {
             let away = crate::math::normalize_or(c.position - c.target, DVec3::Z);
             c.position = c.target + away * v[0];
@@ -559,6 +563,21 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         "camera.fov_degrees",
         format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
     )?;
+    check(
+        c.aperture_radius.is_finite() && c.aperture_radius >= 0.0,
+        "camera.aperture_radius",
+        format!(
+            "must be 0 (a pinhole) or positive, got {}",
+            c.aperture_radius
+        ),
+    )?;
+    if let Some(f) = c.focus_distance {
+        check(
+            f.is_finite() && f > 0.0,
+            "camera.focus_distance",
+            format!("must be positive, got {f}"),
+        )?;
+    }
     let view = c.target - c.position;
     // Below a few ulps of the coordinates the view direction is noise.
     let scale = c
