@@ -5,7 +5,7 @@
 use crate::error::{Error, Result};
 use crate::march::{march, normal};
 use crate::output::{self, Format};
-use crate::render::{render_frame, FrameStats};
+use crate::render::FrameStats;
 use crate::timeline::{Timeline, ZOOM_TRACK};
 use clap::{Parser, Subcommand};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -405,13 +405,18 @@ impl Plan {
     }
 
     /// The scene and content hash of one frame.
-    fn frame(&self, frame: u32) -> (crate::scene::Scene, String) {
-        let mut scene = self.timeline.scene_at(frame);
-        if self.preview {
+    /// The scenes of one frame (one per sample under motion blur) and its content hash.
+    fn frame(&self, frame: u32) -> (Vec<crate::scene::Scene>, String) {
+        let scenes = if self.preview {
+            // A quick look: one sample, one instant.
+            let mut scene = self.timeline.scene_at(frame);
             scene.samples_per_pixel = 1;
-        }
-        let hash = output::frame_hash(&scene, frame, self.width, self.height);
-        (scene, hash)
+            vec![scene]
+        } else {
+            self.timeline.scenes_for_frame(frame)
+        };
+        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
+        (scenes, hash)
     }
 
     fn path(&self, frame: u32, format: Format) -> PathBuf {
@@ -429,11 +434,12 @@ impl Plan {
     fn render_frame(
         &self,
         frame: u32,
-        scene: &crate::scene::Scene,
+        scenes: &[crate::scene::Scene],
         hash: &str,
         on_row: &(dyn Fn() + Sync),
     ) -> anyhow::Result<FrameStats> {
-        let film = render_frame(scene, frame, self.width, self.height, on_row);
+        let film =
+            crate::render::render_frame_in_time(scenes, frame, self.width, self.height, on_row);
         for &f in &self.formats {
             output::write_frame(&self.path(frame, f), f, &film, hash)?;
         }
@@ -533,7 +539,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let skipped = total - todo.len();
     let inside: Vec<u32> = todo
         .iter()
-        .filter(|(_, scene, _)| scene.fractal.contains(scene.camera.position))
+        .filter(|(_, scenes, _)| scenes[0].fractal.contains(scenes[0].camera.position))
         .map(|(frame, _, _)| *frame)
         .collect();
 
@@ -593,7 +599,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let mut totals = FrameStats::default();
     let mut rendered = 0usize;
     let mut render_one = |frame: u32,
-                          scene: &crate::scene::Scene,
+                          scene: &[crate::scene::Scene],
                           hash: &str|
      -> anyhow::Result<()> {
         current.reset();
@@ -990,6 +996,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
     }
     if effects.glow.is_some() {
         println!("          + glow from the march's nearest approach (no estimates)");
+    }
+    if let Some(m) = &effects.motion_blur {
+        println!(
+            "          + motion blur: each of the {} samples sees the timeline at its own time over {} of the frame interval",
+            base.samples_per_pixel, m.shutter
+        );
     }
     let lens = base.camera.frame();
     if lens.has_lens() {

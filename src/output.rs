@@ -64,9 +64,10 @@ pub fn temporary_path(final_path: &Path) -> PathBuf {
     final_path.with_file_name(format!(".{name}.partial"))
 }
 
-/// Hash of everything that decides a frame's pixels: the effective scene, the
-/// frame index (it seeds the sampler), the size and the renderer's revision.
-pub fn frame_hash(scene: &Scene, frame_index: u32, width: u32, height: u32) -> String {
+/// Hash of everything that decides a frame's pixels: the effective scenes
+/// (one, or one per sample under motion blur), the frame index (it seeds the
+/// sampler), the size and the renderer's revision.
+pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
     #[derive(Serialize)]
     struct Inputs<'a> {
         renderer: &'a str,
@@ -74,7 +75,7 @@ pub fn frame_hash(scene: &Scene, frame_index: u32, width: u32, height: u32) -> S
         frame_index: u32,
         width: u32,
         height: u32,
-        scene: &'a Scene,
+        scenes: &'a [Scene],
     }
     let inputs = Inputs {
         renderer: env!("CARGO_PKG_VERSION"),
@@ -82,7 +83,7 @@ pub fn frame_hash(scene: &Scene, frame_index: u32, width: u32, height: u32) -> S
         frame_index,
         width,
         height,
-        scene,
+        scenes,
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);
@@ -515,14 +516,15 @@ mod tests {
     #[test]
     fn hash_changes_with_any_input() {
         let s = Scene::default();
-        let h = frame_hash(&s, 0, 4, 3);
+        let h = frame_hash(std::slice::from_ref(&s), 0, 4, 3);
         assert_eq!(h.len(), 64);
-        assert_eq!(h, frame_hash(&s, 0, 4, 3));
-        assert_ne!(h, frame_hash(&s, 1, 4, 3));
-        assert_ne!(h, frame_hash(&s, 0, 5, 3));
+        assert_eq!(h, frame_hash(std::slice::from_ref(&s), 0, 4, 3));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 1, 4, 3));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 0, 5, 3));
+        assert_ne!(h, frame_hash(&[s.clone(), s.clone()], 0, 4, 3));
         let mut t = s.clone();
         t.fractal.power = 8.000001;
-        assert_ne!(h, frame_hash(&t, 0, 4, 3));
+        assert_ne!(h, frame_hash(&[t], 0, 4, 3));
     }
 
     #[test]

@@ -117,10 +117,32 @@ pub fn render_frame(
     height: u32,
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
-    let camera = scene.camera.frame();
+    render_frame_in_time(
+        std::slice::from_ref(scene),
+        frame_index,
+        width,
+        height,
+        on_row,
+    )
+}
+
+/// Renders a frame whose samples see `scenes` in turn (sample s the scene
+/// s mod len): one scene for a still instant, one per sample for motion blur.
+pub fn render_frame_in_time(
+    scenes: &[Scene],
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    on_row: &(dyn Fn() + Sync),
+) -> Film {
+    let scene = &scenes[0];
+    let cameras: Vec<_> = scenes.iter().map(|s| s.camera.frame()).collect();
     let n = scene.samples_per_pixel.max(1);
     // Fog is measured in camera–target distances, so zooms keep their haze.
-    let scale = (scene.camera.position - scene.camera.target).length();
+    let scales: Vec<Real> = scenes
+        .iter()
+        .map(|s| (s.camera.position - s.camera.target).length())
+        .collect();
     let (w, pixels) = (width as usize, width as usize * height as usize);
     let mut colour = vec![Vec3::ZERO; pixels];
     let mut alpha = vec![0.0f32; pixels];
@@ -143,6 +165,8 @@ pub fn render_frame(
                     let mut hits = 0u32;
                     let before = stats;
                     for s in 0..n {
+                        let k = s as usize % scenes.len();
+                        let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
                         let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
                         let ray = if camera.has_lens() {
                             let u = sample_1d(scene.seed, frame_index, pixel, s, 2);

@@ -23,6 +23,21 @@ pub struct Effects {
     pub specular: Option<Specular>,
     pub fog: Option<Fog>,
     pub glow: Option<Glow>,
+    pub motion_blur: Option<MotionBlur>,
+}
+
+/// Samples spread over an open shutter, each seeing the timeline at its own time.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct MotionBlur {
+    /// How long the shutter is open, as a fraction of the frame interval (180° = 0.5).
+    pub shutter: Real,
+}
+
+impl Default for MotionBlur {
+    fn default() -> Self {
+        MotionBlur { shutter: 0.5 }
+    }
 }
 
 impl Effects {
@@ -43,6 +58,9 @@ impl Effects {
         }
         if self.glow.is_some() {
             v.push("glow");
+        }
+        if self.motion_blur.is_some() {
+            v.push("motion_blur");
         }
         v
     }

@@ -526,12 +526,33 @@ impl Timeline {
 
     /// The scene of frame `frame_index`: the base scene with every track applied.
     pub fn scene_at(&self, frame_index: u32) -> Scene {
-        let time = self.time_of(frame_index);
+        self.scene_at_time(self.time_of(frame_index))
+    }
+
+    /// The scene at any time in seconds, between frames too.
+    pub fn scene_at_time(&self, time_seconds: Real) -> Scene {
         let mut scene = self.base.clone();
         for track in &self.tracks {
-            apply(&mut scene, &track.name, &track.sample(time));
+            apply(&mut scene, &track.name, &track.sample(time_seconds));
         }
         scene
+    }
+
+    /// The scenes a frame's samples see: the frame's own, or with motion blur
+    /// one per sample spread evenly over the open shutter (sample s at
+    /// (s + ½)/n of it), so everything animated blurs as a camera would see it.
+    pub fn scenes_for_frame(&self, frame_index: u32) -> Vec<Scene> {
+        let scene = self.scene_at(frame_index);
+        let Some(blur) = &scene.effects.motion_blur else {
+            return vec![scene];
+        };
+        let n = scene.samples_per_pixel.max(1);
+        let open = blur.shutter / self.fps;
+        (0..n)
+            .map(|s| {
+                self.scene_at_time(self.time_of(frame_index) + open * (s as Real + 0.5) / n as Real)
+            })
+            .collect()
     }
 }
 
@@ -746,6 +767,13 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                 "colours must be finite and non-negative, got {}",
                 fog.colour
             ),
+        )?;
+    }
+    if let Some(m) = &e.motion_blur {
+        check(
+            m.shutter.is_finite() && m.shutter > 0.0 && m.shutter <= 1.0,
+            "effects.motion_blur.shutter",
+            format!("must be in (0, 1] of the frame interval, got {}", m.shutter),
         )?;
     }
     if let Some(g) = &e.glow {
@@ -1011,6 +1039,7 @@ mod tests {
                 specular: Some(Default::default()),
                 fog: Some(Default::default()),
                 glow: Some(Default::default()),
+                motion_blur: None,
             },
             ..Scene::default()
         };
@@ -1036,6 +1065,26 @@ mod tests {
         assert_eq!(t.scene_at(5).effects.fog.unwrap().density, 0.5);
         let e = error_of("(fps: 10, frames: 1, size: (8, 6), scene: (effects: (ambient_occlusion: (samples: 0))))");
         assert!(e.contains("effects.ambient_occlusion.samples"), "{e}");
+    }
+
+    #[test]
+    fn motion_blur_spreads_samples_over_the_shutter() {
+        let text = "(fps: 10, frames: 3, size: (8, 6), scene: (samples_per_pixel: 4, effects: (motion_blur: (shutter: 0.5))), tracks: { \"fractal.power\": (interpolation: Linear, keys: [(time: 0, value: 8), (time: 1, value: 9)]) })";
+        let t = parse(text).unwrap();
+        let scenes = t.scenes_for_frame(1);
+        assert_eq!(scenes.len(), 4);
+        // Frame 1 is at 0.1 s; the shutter is open 0.05 s; samples at 1/8, 3/8, 5/8, 7/8 of it.
+        for (s, scene) in scenes.iter().enumerate() {
+            let time = 0.1 + 0.05 * (s as f64 + 0.5) / 4.0;
+            assert!(
+                (scene.fractal.power - (8.0 + time)).abs() < 1e-12,
+                "sample {s}"
+            );
+        }
+        // Without motion blur a frame is one scene.
+        let still = parse(&text.replace("effects: (motion_blur: (shutter: 0.5))", "")).unwrap();
+        assert_eq!(still.scenes_for_frame(1), vec![still.scene_at(1)]);
+        assert!(error_of(&text.replace("shutter: 0.5", "shutter: 1.5")).contains("shutter"));
     }
 
     #[test]

@@ -66,8 +66,10 @@ fn same_frame_is_byte_identical_with_one_or_two_threads() {
         &tiny_timeline(2, 7.0)
             .replace(
                 "fractal: (iterations: 8)",
-                "fractal: (iterations: 8), samples_per_pixel: 4",
+                // Every sampled effect too: motion blur, a lens, shadows, occlusion.
+                "fractal: (iterations: 8), samples_per_pixel: 4, effects: (motion_blur: (shutter: 0.8), shadows: (), ambient_occlusion: ())",
             )
+            .replace("position: (0, 0.5, 3.0)", "position: (0, 0.5, 3.0), aperture_radius: 0.05")
             .replace("size: (48, 27)", "size: (160, 96)"),
     );
     d.ok(&[
