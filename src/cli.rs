@@ -613,7 +613,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let seconds = t0.elapsed().as_secs_f64();
         if args.stats && !args.quiet {
             say(format!(
-                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}), {} of {} samples hit, {} repaired",
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit, {} repaired",
                 stats.de_evaluations,
                 stats.de_evaluations as f64 / stats.samples.max(1) as f64,
                 stats.max_pixel_evaluations,
@@ -621,6 +621,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 stats.normal_evaluations,
                 stats.shadow_evaluations,
                 stats.occlusion_evaluations,
+                stats.bounce_evaluations,
+                stats.sun_evaluations,
                 stats.hits,
                 stats.samples,
                 stats.repaired_samples
@@ -996,6 +998,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
     }
     if effects.glow.is_some() {
         println!("          + glow from the march's nearest approach (no estimates)");
+    }
+    if let Some(pt) = &effects.path_tracing {
+        println!(
+            "          + path tracing per hit: up to {} bounces (Russian roulette from the third), each with a march and a normal, plus a ray to the {}° sun",
+            pt.max_bounces, pt.sun_angle_degrees
+        );
     }
     if let Some(m) = &effects.motion_blur {
         println!(

@@ -44,6 +44,10 @@ pub struct Ray {
     pub origin: DVec3,
     pub dir: DVec3,
     pub pixel_angle: Real,
+    /// Width of the cone where the ray starts: 0 for camera rays; for a ray
+    /// leaving a surface, the camera pixel's width there, so secondary rays
+    /// resolve no finer than the pixel they serve.
+    pub start_footprint: Real,
 }
 
 impl Ray {
@@ -51,7 +55,7 @@ impl Ray {
     #[inline]
     pub fn footprint(&self, t: Real) -> Real {
         // A floor keeps the threshold non-zero for a camera sitting on the surface.
-        (t * self.pixel_angle).max(1e-15)
+        (self.start_footprint + t * self.pixel_angle).max(1e-15)
     }
 }
 
@@ -252,6 +256,7 @@ mod tests {
             origin,
             dir: dir.normalize(),
             pixel_angle: 1e-3,
+            start_footprint: 0.0,
         }
     }
 
@@ -394,6 +399,7 @@ mod tests {
                     origin,
                     dir: (aim - origin).normalize(),
                     pixel_angle: 2e-3,
+                    start_footprint: 0.0,
                 };
                 let (reference, _) = march_by_membership(&r, &f, &settings, 0.125, 1e-9, 1_000_000);
                 if let (Some(hit), Some(t)) = (march(&r, &f, &settings).hit, reference) {
@@ -552,7 +558,7 @@ mod tests {
                     ..Fractal::default()
                 };
                 let settings = MarchSettings::default();
-                let r = Ray { origin: DVec3::new(ox, oy, oz), dir: dir.normalize(), pixel_angle };
+                let r = Ray { origin: DVec3::new(ox, oy, oz), dir: dir.normalize(), pixel_angle, start_footprint: 0.0 };
                 let m = march(&r, &f, &settings);
                 // Every step and bisection is bounded: 300 steps plus at most ~1100 bisections.
                 prop_assert!(m.evaluations <= settings.max_steps + 1200);

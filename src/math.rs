@@ -265,6 +265,20 @@ pub fn sphere_interval(origin: DVec3, dir: DVec3, radius: Real) -> Option<(Real,
     Some((t0.max(0.0), t1))
 }
 
+/// A uniform number in [0, 1) from (seed, frame, pixel, sample, dimension):
+/// a stateless hash, so samples never depend on evaluation order.
+pub fn sample_1d(seed: u64, frame: u32, pixel: u64, sample: u32, dim: u32) -> Real {
+    // SplitMix64 finaliser over a combined key.
+    let mut x = seed
+        ^ (frame as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+        ^ pixel.wrapping_mul(0xBF58_476D_1CE4_E5B9)
+        ^ ((sample as u64) << 32 | dim as u64).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^= x >> 31;
+    (x >> 11) as Real / (1u64 << 53) as Real
+}
+
 /// Converts a linear-light value to the sRGB transfer curve (IEC 61966-2-1).
 pub fn linear_to_srgb(x: f32) -> f32 {
     let x = if x.is_finite() {

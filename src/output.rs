@@ -189,12 +189,14 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
 
 fn stats_text(film: &Film) -> String {
     format!(
-        "de_evaluations={} primary={} normals={} shadows={} occlusion={} samples={} hits={} max_pixel_evaluations={} repaired_samples={}",
+        "de_evaluations={} primary={} normals={} shadows={} occlusion={} bounces={} sun={} samples={} hits={} max_pixel_evaluations={} repaired_samples={}",
         film.stats.de_evaluations,
         film.stats.primary_evaluations,
         film.stats.normal_evaluations,
         film.stats.shadow_evaluations,
         film.stats.occlusion_evaluations,
+        film.stats.bounce_evaluations,
+        film.stats.sun_evaluations,
         film.stats.samples,
         film.stats.hits,
         film.stats.max_pixel_evaluations,

@@ -7,7 +7,7 @@
 use crate::march::{march, normal};
 use crate::math::{finite_or_zero, Real, Vec3};
 use crate::scene::Scene;
-use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
+use crate::shade::{fogged, glow, trace_path, StageCounts, SurfacePoint};
 use rayon::prelude::*;
 
 /// Depth written for pixels that see only background.
@@ -39,6 +39,9 @@ pub struct FrameStats {
     pub normal_evaluations: u64,
     pub shadow_evaluations: u64,
     pub occlusion_evaluations: u64,
+    /// Path tracing: bounce rays (marching and normals) and rays towards the sun.
+    pub bounce_evaluations: u64,
+    pub sun_evaluations: u64,
     pub samples: u64,
     pub hits: u64,
     /// The most evaluations any one pixel took.
@@ -56,6 +59,8 @@ impl FrameStats {
             + self.normal_evaluations
             + self.shadow_evaluations
             + self.occlusion_evaluations
+            + self.bounce_evaluations
+            + self.sun_evaluations
     }
 }
 
@@ -68,6 +73,8 @@ impl std::ops::Add for FrameStats {
             normal_evaluations: self.normal_evaluations + o.normal_evaluations,
             shadow_evaluations: self.shadow_evaluations + o.shadow_evaluations,
             occlusion_evaluations: self.occlusion_evaluations + o.occlusion_evaluations,
+            bounce_evaluations: self.bounce_evaluations + o.bounce_evaluations,
+            sun_evaluations: self.sun_evaluations + o.sun_evaluations,
             samples: self.samples + o.samples,
             hits: self.hits + o.hits,
             max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
@@ -76,19 +83,7 @@ impl std::ops::Add for FrameStats {
     }
 }
 
-/// A uniform number in [0, 1) from (seed, frame, pixel, sample, dimension):
-/// a stateless hash, so samples never depend on evaluation order.
-pub fn sample_1d(seed: u64, frame: u32, pixel: u64, sample: u32, dim: u32) -> Real {
-    // SplitMix64 finaliser over a combined key.
-    let mut x = seed
-        ^ (frame as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
-        ^ pixel.wrapping_mul(0xBF58_476D_1CE4_E5B9)
-        ^ ((sample as u64) << 32 | dim as u64).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-    x ^= x >> 31;
-    (x >> 11) as Real / (1u64 << 53) as Real
-}
+pub use crate::math::sample_1d;
 
 /// Sub-pixel offset of sample `s` of `n`: the centre for one sample; a
 /// jittered point in cell `s` of a k×k grid when n = k²; otherwise stratified
@@ -175,7 +170,8 @@ pub fn render_frame_in_time(
                         } else {
                             camera.ray(x as Real + ox, y as Real + oy, width, height)
                         };
-                        let (c, t) = trace(scene, &ray, camera.up, scale, &mut stats);
+                        let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
+                        let (c, t) = trace(scene, &ray, camera.up, scale, &random, &mut stats);
                         if let Some(t) = t {
                             hits += 1;
                             depth_row[x] = depth_row[x].min(t as f32);
@@ -229,12 +225,16 @@ fn trace(
     ray: &crate::march::Ray,
     up: crate::math::DVec3,
     scale: Real,
+    random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
 ) -> (Vec3, Option<Real>) {
     let result = march(ray, &scene.fractal, &scene.quality);
     stats.primary_evaluations += result.evaluations as u64;
     let Some(hit) = result.hit else {
-        let sky = scene.look.background(ray.dir, up);
+        let sky = match &scene.effects.path_tracing {
+            Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up) * pt.sky_intensity,
+            None => scene.look.background(ray.dir, up),
+        };
         return match &scene.effects.glow {
             Some(g) => (sky + glow(g, result.closest), None),
             None => (sky, None),
@@ -251,15 +251,29 @@ fn trace(
         traps: hit.estimate.traps,
     };
     let mut stages = StageCounts::default();
-    let lit = scene.look.shade(
-        &scene.effects,
-        &scene.fractal,
-        &scene.quality,
-        &at,
-        &mut stages,
-    );
+    let lit = match &scene.effects.path_tracing {
+        Some(pt) => trace_path(
+            &scene.look,
+            pt,
+            &scene.fractal,
+            &scene.quality,
+            &at,
+            up,
+            random,
+            &mut stages,
+        ),
+        None => scene.look.shade(
+            &scene.effects,
+            &scene.fractal,
+            &scene.quality,
+            &at,
+            &mut stages,
+        ),
+    };
     stats.shadow_evaluations += stages.shadows;
     stats.occlusion_evaluations += stages.occlusion;
+    stats.bounce_evaluations += stages.bounces;
+    stats.sun_evaluations += stages.sun_rays;
     let c = match &scene.effects.fog {
         Some(fog) => fogged(lit, fog, hit.t, scale),
         None => lit,
@@ -329,7 +343,7 @@ mod tests {
 
     #[test]
     fn each_effect_alone_moves_only_its_stage_and_changes_the_image() {
-        use crate::shade::{AmbientOcclusion, Effects, Fog, Glow, Shadows, Specular};
+        use crate::shade::{AmbientOcclusion, Effects, Fog, Glow, PathTracing, Shadows, Specular};
         let plain_scene = Scene::default();
         let plain = render_frame(&plain_scene, 0, 40, 30, &|| {});
         let counters = |s: &FrameStats| {
@@ -338,21 +352,23 @@ mod tests {
                 s.normal_evaluations,
                 s.shadow_evaluations,
                 s.occlusion_evaluations,
+                s.bounce_evaluations,
+                s.sun_evaluations,
             ]
         };
         // With every effect off nothing but marching and normals runs.
         let p = counters(&plain.stats);
         assert!(p[0] > 0 && p[1] > 0);
-        assert_eq!((p[2], p[3]), (0, 0));
+        assert_eq!((p[2], p[3], p[4], p[5]), (0, 0, 0, 0));
         assert_eq!(plain.stats.de_evaluations, p.iter().sum::<u64>());
-        let cases: [(&str, Effects, [bool; 4]); 5] = [
+        let cases: [(&str, Effects, [bool; 6]); 6] = [
             (
                 "shadows",
                 Effects {
                     shadows: Some(Shadows::default()),
                     ..Effects::default()
                 },
-                [false, false, true, false],
+                [false, false, true, false, false, false],
             ),
             (
                 "ambient_occlusion",
@@ -360,7 +376,7 @@ mod tests {
                     ambient_occlusion: Some(AmbientOcclusion::default()),
                     ..Effects::default()
                 },
-                [false, false, false, true],
+                [false, false, false, true, false, false],
             ),
             (
                 "specular",
@@ -368,7 +384,7 @@ mod tests {
                     specular: Some(Specular::default()),
                     ..Effects::default()
                 },
-                [false; 4],
+                [false; 6],
             ),
             (
                 "fog",
@@ -376,7 +392,7 @@ mod tests {
                     fog: Some(Fog::default()),
                     ..Effects::default()
                 },
-                [false; 4],
+                [false; 6],
             ),
             (
                 "glow",
@@ -384,7 +400,15 @@ mod tests {
                     glow: Some(Glow::default()),
                     ..Effects::default()
                 },
-                [false; 4],
+                [false; 6],
+            ),
+            (
+                "path_tracing",
+                Effects {
+                    path_tracing: Some(PathTracing::default()),
+                    ..Effects::default()
+                },
+                [false, false, false, false, true, true],
             ),
         ];
         for (name, effects, moves) in cases {
@@ -394,7 +418,7 @@ mod tests {
             };
             let film = render_frame(&scene, 0, 40, 30, &|| {});
             let c = counters(&film.stats);
-            for k in 0..4 {
+            for k in 0..6 {
                 if moves[k] {
                     assert!(c[k] > p[k], "{name}: stage {k} should run");
                 } else {

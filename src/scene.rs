@@ -90,6 +90,7 @@ impl CameraFrame {
             origin: self.origin,
             dir,
             pixel_angle: 2.0 * self.tan_half_fov / h,
+            start_footprint: 0.0,
         }
     }
 }
@@ -117,7 +118,7 @@ impl CameraFrame {
         Ray {
             origin,
             dir: (focus - origin).normalize(),
-            pixel_angle: pinhole.pixel_angle,
+            ..pinhole
         }
     }
 }

@@ -769,6 +769,35 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             ),
         )?;
     }
+    if let Some(pt) = &e.path_tracing {
+        check(
+            e.shadows.is_none() && e.ambient_occlusion.is_none() && e.specular.is_none(),
+            "effects.path_tracing",
+            "path tracing computes shadows and occlusion itself: remove shadows, ambient_occlusion and specular".into(),
+        )?;
+        check(
+            (1..=1024).contains(&pt.max_bounces),
+            "effects.path_tracing.max_bounces",
+            format!("must be 1..=1024, got {}", pt.max_bounces),
+        )?;
+        check(
+            pt.sun_angle_degrees.is_finite() && (0.0..=30.0).contains(&pt.sun_angle_degrees),
+            "effects.path_tracing.sun_angle_degrees",
+            format!("must be 0..=30, got {}", pt.sun_angle_degrees),
+        )?;
+        check(
+            pt.sky_intensity.is_finite() && pt.sky_intensity >= 0.0,
+            "effects.path_tracing.sky_intensity",
+            format!("must be non-negative, got {}", pt.sky_intensity),
+        )?;
+        if let crate::shade::Sky::Constant(c) = pt.sky {
+            check(
+                c.is_finite() && c.min_element() >= 0.0,
+                "effects.path_tracing.sky",
+                format!("a constant sky must be finite and non-negative, got {c}"),
+            )?;
+        }
+    }
     if let Some(m) = &e.motion_blur {
         check(
             m.shutter.is_finite() && m.shutter > 0.0 && m.shutter <= 1.0,
@@ -1040,6 +1069,7 @@ mod tests {
                 fog: Some(Default::default()),
                 glow: Some(Default::default()),
                 motion_blur: None,
+                path_tracing: None,
             },
             ..Scene::default()
         };

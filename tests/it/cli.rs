@@ -106,6 +106,43 @@ fn same_frame_is_byte_identical_with_one_or_two_threads() {
 }
 
 #[test]
+fn path_traced_frame_is_byte_identical_with_one_or_two_threads() {
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        &tiny_timeline(1, 8.0).replace(
+            "fractal: (iterations: 8)",
+            "fractal: (iterations: 8), samples_per_pixel: 4, effects: (path_tracing: (max_bounces: 4))",
+        ),
+    );
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--threads",
+        "1",
+        "--out",
+        "one",
+        "--format",
+        "exr",
+    ]);
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--threads",
+        "2",
+        "--out",
+        "two",
+        "--format",
+        "exr",
+    ]);
+    assert!(d.bytes("one/frame_00000.exr") == d.bytes("two/frame_00000.exr"));
+    // And it is a different picture from the direct-lit one.
+    d.write("plain.ron", &tiny_timeline(1, 8.0));
+    d.ok(&["render", "plain.ron", "--out", "plain", "--format", "exr"]);
+    assert!(d.bytes("one/frame_00000.exr") != d.bytes("plain/frame_00000.exr"));
+}
+
+#[test]
 fn frames_have_no_nan_and_show_the_bulb() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(1, 8.0));
@@ -220,7 +257,12 @@ fn ffmpeg_encodes_the_frames_with_the_printed_command() {
 fn example_timelines_are_valid() {
     let d = Dir::new();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    for name in ["zoom.ron", "julia_morph.ron", "effects.ron"] {
+    for name in [
+        "zoom.ron",
+        "julia_morph.ron",
+        "effects.ron",
+        "path_traced.ron",
+    ] {
         let path = root.join("timelines").join(name);
         let out = d.ok(&["info", path.to_str().unwrap()]);
         assert!(stdout(&out).contains("frames:"), "{}", stderr(&out));
