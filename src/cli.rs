@@ -118,6 +118,9 @@ pub struct RenderArgs {
     /// Output formats, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
     pub format: Vec<Format>,
+    /// Extra EXR layers, comma-separated (needs --format exr): normal, albedo, traps, steps.
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<output::Aov>,
     /// Worker threads [default: all cores]. The image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -160,6 +163,8 @@ pub struct StatusArgs {
     pub format: Vec<Format>,
     #[arg(long)]
     pub preview: bool,
+    #[arg(long, value_enum, value_delimiter = ',')]
+    pub aov: Vec<output::Aov>,
     /// Seconds without a heartbeat after which a claim counts as abandoned.
     #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
     pub claim_timeout: f64,
@@ -310,6 +315,7 @@ struct Plan {
     formats: Vec<Format>,
     out_dir: PathBuf,
     preview: bool,
+    aovs: Vec<output::Aov>,
 }
 
 impl Plan {
@@ -321,9 +327,18 @@ impl Plan {
         size: Option<&str>,
         formats: &[Format],
         preview: bool,
+        aovs: &[output::Aov],
     ) -> anyhow::Result<Plan> {
         let timeline = Timeline::load(timeline_path)?;
-        Plan::for_timeline(timeline, out, frames, size, formats, preview)
+        let mut aovs = aovs.to_vec();
+        aovs.sort();
+        aovs.dedup();
+        if !aovs.is_empty() && !formats.contains(&Format::Exr) {
+            return Err(
+                Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
+            );
+        }
+        Plan::for_timeline(timeline, out, frames, size, formats, preview, aovs)
     }
 
     fn for_timeline(
@@ -333,6 +348,7 @@ impl Plan {
         size: Option<&str>,
         formats: &[Format],
         preview: bool,
+        aovs: Vec<output::Aov>,
     ) -> anyhow::Result<Plan> {
         let (mut width, mut height) = match size {
             Some(s) => parse_size("--size", s)?,
@@ -361,7 +377,12 @@ impl Plan {
             formats,
             out_dir,
             preview,
+            aovs,
         })
+    }
+
+    fn layers(&self) -> crate::render::Layers {
+        output::layers_for(&self.aovs)
     }
 
     /// The plan an output folder records (see `output::JobRecord`).
@@ -380,6 +401,7 @@ impl Plan {
             formats,
             out_dir: dir.to_path_buf(),
             preview: job.preview,
+            aovs: job.aovs,
             timeline,
         })
     }
@@ -401,6 +423,7 @@ impl Plan {
                 .collect(),
             frames: (self.range.start, self.range.end),
             preview: self.preview,
+            aovs: self.aovs.clone(),
         })
     }
 
@@ -415,7 +438,7 @@ impl Plan {
         } else {
             self.timeline.scenes_for_frame(frame)
         };
-        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
+        let hash = output::frame_hash(&scenes, frame, self.width, self.height, &self.aovs);
         (scenes, hash)
     }
 
@@ -438,10 +461,16 @@ impl Plan {
         hash: &str,
         on_row: &(dyn Fn() + Sync),
     ) -> anyhow::Result<FrameStats> {
-        let film =
-            crate::render::render_frame_in_time(scenes, frame, self.width, self.height, on_row);
+        let film = crate::render::render_frame_in_time(
+            scenes,
+            frame,
+            self.width,
+            self.height,
+            self.layers(),
+            on_row,
+        );
         for &f in &self.formats {
-            output::write_frame(&self.path(frame, f), f, &film, hash)?;
+            output::write_frame(&self.path(frame, f), f, &film, hash, &self.aovs)?;
         }
         Ok(film.stats)
     }
@@ -505,6 +534,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         args.size.as_deref(),
         &args.format,
         args.preview,
+        &args.aov,
     )?;
     set_threads(args.threads)?;
     let shard = args
@@ -752,6 +782,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             args.size.as_deref(),
             &args.format,
             args.preview,
+            &args.aov,
         )?
     };
     if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {

@@ -39,6 +39,41 @@ impl Format {
     }
 }
 
+/// Extra EXR layers (arbitrary output variables) a render can write.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    clap::ValueEnum,
+    Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Aov {
+    /// Surface normal: N.X, N.Y, N.Z.
+    Normal,
+    /// Orbit-trap albedo: albedo.R, albedo.G, albedo.B.
+    Albedo,
+    /// Orbit traps: trap.origin (smallest |z|²), trap.x, trap.y, trap.z.
+    Traps,
+    /// Distance estimates spent per pixel: DE (a cost heat map).
+    Steps,
+}
+
+/// The render layers `aovs` need.
+pub fn layers_for(aovs: &[Aov]) -> crate::render::Layers {
+    crate::render::Layers {
+        normal: aovs.contains(&Aov::Normal),
+        albedo: aovs.contains(&Aov::Albedo),
+        traps: aovs.contains(&Aov::Traps),
+    }
+}
+
 /// `frame_00042.png` for frame 42.
 pub fn frame_file_name(frame_index: u32, format: Format) -> String {
     format!(
@@ -67,7 +102,13 @@ pub fn temporary_path(final_path: &Path) -> PathBuf {
 /// Hash of everything that decides a frame's pixels: the effective scenes
 /// (one, or one per sample under motion blur), the frame index (it seeds the
 /// sampler), the size and the renderer's revision.
-pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
+pub fn frame_hash(
+    scenes: &[Scene],
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    aovs: &[Aov],
+) -> String {
     #[derive(Serialize)]
     struct Inputs<'a> {
         renderer: &'a str,
@@ -76,6 +117,7 @@ pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -
         width: u32,
         height: u32,
         scenes: &'a [Scene],
+        aovs: &'a [Aov],
     }
     let inputs = Inputs {
         renderer: env!("CARGO_PKG_VERSION"),
@@ -84,6 +126,7 @@ pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -
         width,
         height,
         scenes,
+        aovs,
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);
@@ -146,7 +189,13 @@ pub fn is_current(path: &Path, format: Format, hash: &str) -> bool {
 /// temporary file of a unique name in the same folder (so two renders into one
 /// folder never write into each other's file), are flushed to disk, and only
 /// then renamed over the final name.
-pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Result<()> {
+pub fn write_frame(
+    path: &Path,
+    format: Format,
+    film: &Film,
+    hash: &str,
+    aovs: &[Aov],
+) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -174,7 +223,7 @@ pub fn write_frame(path: &Path, format: Format, film: &Film, hash: &str) -> Resu
     let mut writer = BufWriter::new(temp);
     match format {
         Format::Png => encode_png(&mut writer, film, hash).map_err(image_error)?,
-        Format::Exr => encode_exr(&mut writer, film, hash).map_err(image_error)?,
+        Format::Exr => encode_exr(&mut writer, film, hash, aovs).map_err(image_error)?,
     }
     let temp = writer
         .into_inner()
@@ -237,6 +286,7 @@ fn encode_exr(
     out: &mut (impl Write + std::io::Seek),
     film: &Film,
     hash: &str,
+    aovs: &[Aov],
 ) -> std::result::Result<(), String> {
     use exr::prelude::*;
     let half = |f: &dyn Fn(usize) -> f32| -> Vec<f16> {
@@ -244,15 +294,47 @@ fn encode_exr(
             .map(|i| f16::from_f32(f(i)))
             .collect()
     };
-    let channels = AnyChannels::sort(SmallVec::from_vec(vec![
+    let mut list = vec![
         AnyChannel::new("R", FlatSamples::F16(half(&|i| film.colour[i].x))),
         AnyChannel::new("G", FlatSamples::F16(half(&|i| film.colour[i].y))),
         AnyChannel::new("B", FlatSamples::F16(half(&|i| film.colour[i].z))),
         AnyChannel::new("A", FlatSamples::F16(half(&|i| film.alpha[i]))),
         AnyChannel::new("Z", FlatSamples::F32(film.depth.clone())),
-        // Cost heat map: orbits computed per pixel.
-        AnyChannel::new("DE", FlatSamples::U32(film.evaluations.clone())),
-    ]));
+    ];
+    if let Some(n) = &film.normal {
+        for (name, k) in [("N.X", 0), ("N.Y", 1), ("N.Z", 2)] {
+            list.push(AnyChannel::new(
+                name,
+                FlatSamples::F32(n.iter().map(|v| v[k]).collect()),
+            ));
+        }
+    }
+    if let Some(a) = &film.albedo {
+        for (name, k) in [("albedo.R", 0), ("albedo.G", 1), ("albedo.B", 2)] {
+            list.push(AnyChannel::new(name, FlatSamples::F16(half(&|i| a[i][k]))));
+        }
+    }
+    if let Some(t) = &film.traps {
+        for (name, k) in [
+            ("trap.origin", 0),
+            ("trap.x", 1),
+            ("trap.y", 2),
+            ("trap.z", 3),
+        ] {
+            list.push(AnyChannel::new(
+                name,
+                FlatSamples::F32(t.iter().map(|v| v[k]).collect()),
+            ));
+        }
+    }
+    if aovs.contains(&Aov::Steps) {
+        // Cost heat map: distance estimates spent per pixel.
+        list.push(AnyChannel::new(
+            "DE",
+            FlatSamples::U32(film.evaluations.clone()),
+        ));
+    }
+    let channels = AnyChannels::sort(SmallVec::from_vec(list));
     let mut attributes = LayerAttributes::named("");
     attributes.software_name = Some(Text::from(
         format!("mandelreel {}", env!("CARGO_PKG_VERSION")).as_str(),
@@ -301,6 +383,8 @@ pub struct JobRecord {
     /// Half-open frame range the folder is meant to hold.
     pub frames: (u32, u32),
     pub preview: bool,
+    #[serde(default)]
+    pub aovs: Vec<Aov>,
 }
 
 impl JobRecord {
@@ -503,6 +587,9 @@ mod tests {
             alpha: vec![1.0; 6],
             depth: vec![2.5; 6],
             evaluations: vec![7; 6],
+            normal: None,
+            albedo: None,
+            traps: None,
             stats: FrameStats::default(),
         }
     }
@@ -518,15 +605,19 @@ mod tests {
     #[test]
     fn hash_changes_with_any_input() {
         let s = Scene::default();
-        let h = frame_hash(std::slice::from_ref(&s), 0, 4, 3);
+        let h = frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[]);
         assert_eq!(h.len(), 64);
-        assert_eq!(h, frame_hash(std::slice::from_ref(&s), 0, 4, 3));
-        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 1, 4, 3));
-        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 0, 5, 3));
-        assert_ne!(h, frame_hash(&[s.clone(), s.clone()], 0, 4, 3));
+        assert_eq!(h, frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[]));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 1, 4, 3, &[]));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 0, 5, 3, &[]));
+        assert_ne!(h, frame_hash(&[s.clone(), s.clone()], 0, 4, 3, &[]));
+        assert_ne!(
+            h,
+            frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[Aov::Normal])
+        );
         let mut t = s.clone();
         t.fractal.power = 8.000001;
-        assert_ne!(h, frame_hash(&[t], 0, 4, 3));
+        assert_ne!(h, frame_hash(&[t], 0, 4, 3, &[]));
     }
 
     #[test]
@@ -534,7 +625,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for format in [Format::Png, Format::Exr] {
             let path = dir.path().join(frame_file_name(0, format));
-            write_frame(&path, format, &film(), "abc123").unwrap();
+            write_frame(&path, format, &film(), "abc123", &[]).unwrap();
             assert!(path.exists());
             let leftovers: Vec<_> = std::fs::read_dir(dir.path())
                 .unwrap()
@@ -596,7 +687,7 @@ mod tests {
     fn a_png_cut_after_its_header_is_not_current() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
-        write_frame(&path, Format::Png, &film(), "abc").unwrap();
+        write_frame(&path, Format::Png, &film(), "abc", &[]).unwrap();
         assert!(is_current(&path, Format::Png, "abc"));
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 20]).unwrap();

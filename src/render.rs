@@ -26,7 +26,28 @@ pub struct Film {
     pub depth: Vec<f32>,
     /// Orbits computed for the pixel (all samples): where the frame's time went.
     pub evaluations: Vec<u32>,
+    /// Extra layers, present only when asked for (see `Layers`).
+    pub normal: Option<Vec<Vec3>>,
+    pub albedo: Option<Vec<Vec3>>,
+    /// Orbit traps: origin, then the x, y and z planes.
+    pub traps: Option<Vec<[f32; 4]>>,
     pub stats: FrameStats,
+}
+
+/// Which extra per-pixel layers to collect. Each is averaged over the
+/// pixel's samples that hit; a layer not asked for costs no memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layers {
+    pub normal: bool,
+    pub albedo: bool,
+    pub traps: bool,
+}
+
+/// What one camera sample met.
+struct SampleResult {
+    colour: Vec3,
+    /// Distance, normal, albedo and traps of the first hit.
+    hit: Option<(Real, crate::math::DVec3, Vec3, crate::fractal::OrbitTraps)>,
 }
 
 /// Work counted while rendering one frame.
@@ -117,6 +138,7 @@ pub fn render_frame(
         frame_index,
         width,
         height,
+        Layers::default(),
         on_row,
     )
 }
@@ -128,6 +150,7 @@ pub fn render_frame_in_time(
     frame_index: u32,
     width: u32,
     height: u32,
+    layers: Layers,
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
     let scene = &scenes[0];
@@ -143,6 +166,11 @@ pub fn render_frame_in_time(
     let mut alpha = vec![0.0f32; pixels];
     let mut depth = vec![BACKGROUND_DEPTH; pixels];
     let mut evaluations = vec![0u32; pixels];
+    let mut normal_layer = vec![Vec3::ZERO; if layers.normal { pixels } else { 0 }];
+    let mut albedo_layer = vec![Vec3::ZERO; if layers.albedo { pixels } else { 0 }];
+    let mut traps_layer = vec![[0.0f32; 4]; if layers.traps { pixels } else { 0 }];
+    // Chunks of a layer not asked for are empty slices.
+    let chunk = |on: bool| if on { w } else { usize::MAX };
     // One row per task; rayon spreads rows over threads and each pixel depends
     // only on its own samples, so the result is independent of the split.
     let stats = colour
@@ -150,9 +178,29 @@ pub fn render_frame_in_time(
         .zip(alpha.par_chunks_mut(w))
         .zip(depth.par_chunks_mut(w))
         .zip(evaluations.par_chunks_mut(w))
+        .zip(optional_rows(
+            &mut normal_layer,
+            chunk(layers.normal),
+            height,
+        ))
+        .zip(optional_rows(
+            &mut albedo_layer,
+            chunk(layers.albedo),
+            height,
+        ))
+        .zip(optional_rows(&mut traps_layer, chunk(layers.traps), height))
         .enumerate()
         .map(
-            |(y, (((colour_row, alpha_row), depth_row), evaluations_row))| {
+            |(
+                y,
+                (
+                    (
+                        ((((colour_row, alpha_row), depth_row), evaluations_row), mut normal_row),
+                        mut albedo_row,
+                    ),
+                    mut traps_row,
+                ),
+            )| {
                 let mut stats = FrameStats::default();
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
@@ -171,10 +219,28 @@ pub fn render_frame_in_time(
                             camera.ray(x as Real + ox, y as Real + oy, width, height)
                         };
                         let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
-                        let (c, t) = trace(scene, &ray, camera.up, scale, &random, &mut stats);
-                        if let Some(t) = t {
+                        let sample = trace(scene, &ray, camera.up, scale, &random, &mut stats);
+                        let c = sample.colour;
+                        if let Some((t, nrm, albedo, traps)) = sample.hit {
                             hits += 1;
                             depth_row[x] = depth_row[x].min(t as f32);
+                            if let Some(row) = normal_row.as_deref_mut() {
+                                row[x] += nrm.as_vec3();
+                            }
+                            if let Some(row) = albedo_row.as_deref_mut() {
+                                row[x] += albedo;
+                            }
+                            if let Some(row) = traps_row.as_deref_mut() {
+                                let v = [
+                                    traps.origin as f32,
+                                    traps.planes.x as f32,
+                                    traps.planes.y as f32,
+                                    traps.planes.z as f32,
+                                ];
+                                for k in 0..4 {
+                                    row[x][k] += v[k];
+                                }
+                            }
                         }
                         debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
                         if !c.is_finite() {
@@ -192,6 +258,18 @@ pub fn render_frame_in_time(
                         (sum[2] * inv) as f32,
                     );
                     alpha_row[x] = hits as f32 / n as f32;
+                    if hits > 0 {
+                        let inv_hits = 1.0 / hits as f32;
+                        if let Some(row) = normal_row.as_deref_mut() {
+                            row[x] = row[x].normalize_or_zero();
+                        }
+                        if let Some(row) = albedo_row.as_deref_mut() {
+                            row[x] *= inv_hits;
+                        }
+                        if let Some(row) = traps_row.as_deref_mut() {
+                            row[x] = row[x].map(|v| v * inv_hits);
+                        }
+                    }
                     let spent = stats.stage_total() - before.stage_total();
                     evaluations_row[x] = spent.min(u32::MAX as u64) as u32;
                     stats.max_pixel_evaluations = stats.max_pixel_evaluations.max(spent);
@@ -214,8 +292,26 @@ pub fn render_frame_in_time(
         alpha,
         depth,
         evaluations,
+        normal: layers.normal.then_some(normal_layer),
+        albedo: layers.albedo.then_some(albedo_layer),
+        traps: layers.traps.then_some(traps_layer),
         stats,
     }
+}
+
+/// Rows of an optional layer for the parallel zip: `Some(row)` per image row
+/// when the layer is collected, `None` for each row otherwise.
+fn optional_rows<T: Send>(
+    layer: &mut [T],
+    width: usize,
+    height: u32,
+) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
+    let rows: Vec<Option<&mut [T]>> = if layer.is_empty() {
+        (0..height).map(|_| None).collect()
+    } else {
+        layer.chunks_mut(width).map(Some).collect()
+    };
+    rows.into_par_iter()
 }
 
 /// One camera sample: its radiance and, if it met the surface, the distance.
@@ -227,7 +323,7 @@ fn trace(
     scale: Real,
     random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
-) -> (Vec3, Option<Real>) {
+) -> SampleResult {
     let result = march(ray, &scene.fractal, &scene.quality);
     stats.primary_evaluations += result.evaluations as u64;
     let Some(hit) = result.hit else {
@@ -235,10 +331,11 @@ fn trace(
             Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up) * pt.sky_intensity,
             None => scene.look.background(ray.dir, up),
         };
-        return match &scene.effects.glow {
-            Some(g) => (sky + glow(g, result.closest), None),
-            None => (sky, None),
+        let colour = match &scene.effects.glow {
+            Some(g) => sky + glow(g, result.closest),
+            None => sky,
         };
+        return SampleResult { colour, hit: None };
     };
     let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
     stats.normal_evaluations += evals as u64;
@@ -274,11 +371,14 @@ fn trace(
     stats.occlusion_evaluations += stages.occlusion;
     stats.bounce_evaluations += stages.bounces;
     stats.sun_evaluations += stages.sun_rays;
-    let c = match &scene.effects.fog {
+    let colour = match &scene.effects.fog {
         Some(fog) => fogged(lit, fog, hit.t, scale),
         None => lit,
     };
-    (c, Some(hit.t))
+    SampleResult {
+        colour,
+        hit: Some((hit.t, nrm, scene.look.albedo(&at.traps), at.traps)),
+    }
 }
 
 #[cfg(test)]
