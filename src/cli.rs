@@ -99,28 +99,36 @@ pub struct SheetArgs {
     pub out: Option<PathBuf>,
 }
 
+/// What a sequence is made of: shared by `render` and `status`, so both
+/// compute the same frames and hashes.
 #[derive(Debug, clap::Args)]
-pub struct RenderArgs {
-    /// The RON timeline file.
-    pub timeline: PathBuf,
+pub struct SequenceArgs {
     /// Output folder [default: out/<timeline name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Frames to render, half-open like a Rust range: 0..4 is frames 0 to 3; also A.., ..B, or N.
+    /// Frames, half-open like a Rust range: 0..4 is frames 0 to 3; also A.., ..B, or N.
     #[arg(long, value_name = "A..B")]
     pub frames: Option<String>,
     /// Override the timeline's output size (nothing else is scaled).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
-    /// Quick look: half width and height, one sample per pixel, written to <out>/preview.
-    #[arg(long)]
-    pub preview: bool,
     /// Output formats, comma-separated.
     #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
     pub format: Vec<Format>,
+    /// Quick look: half width and height, one sample per pixel, in <out>/preview.
+    #[arg(long)]
+    pub preview: bool,
     /// Extra EXR layers, comma-separated (needs --format exr): normal, albedo, traps, steps.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<output::Aov>,
+}
+
+#[derive(Debug, clap::Args)]
+pub struct RenderArgs {
+    /// The RON timeline file.
+    pub timeline: PathBuf,
+    #[command(flatten)]
+    pub sequence: SequenceArgs,
     /// Worker threads [default: all cores]. The image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -152,19 +160,8 @@ pub struct StatusArgs {
     /// An output folder (uses what it records), or a timeline (with the same
     /// --out, --size, --format, --frames and --preview as its render).
     pub target: PathBuf,
-    /// Output folder, when TARGET is a timeline [default: out/<timeline name>].
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    #[arg(long, value_name = "A..B")]
-    pub frames: Option<String>,
-    #[arg(long, value_name = "WxH")]
-    pub size: Option<String>,
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
-    pub format: Vec<Format>,
-    #[arg(long)]
-    pub preview: bool,
-    #[arg(long, value_enum, value_delimiter = ',')]
-    pub aov: Vec<output::Aov>,
+    #[command(flatten)]
+    pub sequence: SequenceArgs,
     /// Seconds without a heartbeat after which a claim counts as abandoned.
     #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
     pub claim_timeout: f64,
@@ -320,25 +317,25 @@ struct Plan {
 
 impl Plan {
     /// Checks every option; touches nothing on disk.
-    fn new(
-        timeline_path: &Path,
-        out: Option<&Path>,
-        frames: Option<&str>,
-        size: Option<&str>,
-        formats: &[Format],
-        preview: bool,
-        aovs: &[output::Aov],
-    ) -> anyhow::Result<Plan> {
+    fn new(timeline_path: &Path, args: &SequenceArgs) -> anyhow::Result<Plan> {
         let timeline = Timeline::load(timeline_path)?;
-        let mut aovs = aovs.to_vec();
+        let mut aovs = args.aov.clone();
         aovs.sort();
         aovs.dedup();
-        if !aovs.is_empty() && !formats.contains(&Format::Exr) {
+        if !aovs.is_empty() && !args.format.contains(&Format::Exr) {
             return Err(
                 Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
             );
         }
-        Plan::for_timeline(timeline, out, frames, size, formats, preview, aovs)
+        Plan::for_timeline(
+            timeline,
+            args.out.as_deref(),
+            args.frames.as_deref(),
+            args.size.as_deref(),
+            &args.format,
+            args.preview,
+            aovs,
+        )
     }
 
     fn for_timeline(
@@ -527,15 +524,7 @@ pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(
 
 fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Everything is checked before the output folder is touched.
-    let plan = Plan::new(
-        &args.timeline,
-        args.out.as_deref(),
-        args.frames.as_deref(),
-        args.size.as_deref(),
-        &args.format,
-        args.preview,
-        &args.aov,
-    )?;
+    let plan = Plan::new(&args.timeline, &args.sequence)?;
     set_threads(args.threads)?;
     let shard = args
         .shard
@@ -775,15 +764,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     let plan = if args.target.is_dir() {
         Plan::from_folder(&args.target)?
     } else {
-        Plan::new(
-            &args.target,
-            args.out.as_deref(),
-            args.frames.as_deref(),
-            args.size.as_deref(),
-            &args.format,
-            args.preview,
-            &args.aov,
-        )?
+        Plan::new(&args.target, &args.sequence)?
     };
     if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {
         return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());

@@ -247,6 +247,17 @@ pub struct Orbit<T> {
 }
 
 impl Fractal {
+    /// The Julia set of c = 0 in power 8: exactly the unit ball, a shape whose
+    /// true distance is known (|p| − 1), for checking marching and shading.
+    pub fn unit_ball() -> Fractal {
+        Fractal {
+            formula: Formula::Quilez,
+            julia: Some(DVec3::ZERO),
+            iterations: 40,
+            ..Fractal::default()
+        }
+    }
+
     /// Iterates the orbit of `p`: at most `limit` iterations, stopping at the
     /// bailout when `stop_at_bailout` (otherwise exactly `limit`, as the
     /// escape-length gradient needs). Pure and allocation-free: the innermost loop.

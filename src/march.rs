@@ -239,16 +239,9 @@ pub fn normal(ray: &Ray, hit: &Hit, fractal: &Fractal, settings: &MarchSettings)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fractal::Formula;
 
     fn unit_ball() -> Fractal {
-        // Julia set with c = 0: the unit ball, whose exact distance is known.
-        Fractal {
-            formula: Formula::Quilez,
-            julia: Some(DVec3::ZERO),
-            iterations: 40,
-            ..Fractal::default()
-        }
+        Fractal::unit_ball()
     }
 
     fn ray(origin: DVec3, dir: DVec3) -> Ray {

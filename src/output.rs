@@ -25,8 +25,8 @@ pub const FRAME_DIGITS: usize = 5;
 pub enum Format {
     /// 8-bit sRGB PNG.
     Png,
-    /// OpenEXR: linear half-float R, G, B, A, a float Z (camera distance) and a
-    /// u32 DE channel (orbits computed per pixel, a cost heat map).
+    /// OpenEXR: linear half-float R, G, B, A and a float Z (camera distance),
+    /// plus the layers --aov asks for.
     Exr,
 }
 

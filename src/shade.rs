@@ -344,13 +344,6 @@ impl Look {
         c * (1.0 - self.trap_occlusion + self.trap_occlusion * depth)
     }
 
-    /// Radiance of a surface point with `normal` and orbit `traps`, no effects.
-    pub fn surface(&self, normal: DVec3, traps: &OrbitTraps) -> Vec3 {
-        let to_light = normalize_or(self.light_direction, DVec3::Y);
-        let lambert = normal.dot(to_light).max(0.0) as f32;
-        self.albedo(traps) * (self.ambient + self.light_colour * lambert)
-    }
-
     /// Radiance of a hit with the scene's effects. Stages of effects that are
     /// off never run; `counts` hears what the others spent.
     pub fn shade(
@@ -534,15 +527,9 @@ pub fn glow(glow: &Glow, closest: Real) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::fractal::Formula;
 
     fn unit_ball() -> Fractal {
-        Fractal {
-            formula: Formula::Quilez,
-            julia: Some(DVec3::ZERO),
-            iterations: 40,
-            ..Fractal::default()
-        }
+        Fractal::unit_ball()
     }
 
     #[test]
@@ -764,8 +751,29 @@ mod tests {
     fn lambert_is_ambient_only_facing_away_and_brightest_facing_light() {
         let look = Look::default();
         let light = look.light_direction.normalize();
-        let lit = look.surface(light, &traps_far());
-        let unlit = look.surface(-light, &traps_far());
+        // With no effects, shading needs no estimates: the fractal is never asked.
+        let plain = |normal: DVec3| {
+            let at = SurfacePoint {
+                point: DVec3::new(0.0, 5.0, 0.0),
+                normal,
+                view_dir: -normal,
+                t: 1.0,
+                footprint: 1e-3,
+                traps: traps_far(),
+            };
+            let mut counts = StageCounts::default();
+            let c = look.shade(
+                &Effects::default(),
+                &Fractal::default(),
+                &MarchSettings::default(),
+                &at,
+                &mut counts,
+            );
+            assert_eq!(counts, StageCounts::default());
+            c
+        };
+        let lit = plain(light);
+        let unlit = plain(-light);
         let albedo = look.albedo(&traps_far());
         assert!((unlit - albedo * look.ambient).length() < 1e-6);
         assert!((lit - albedo * (look.ambient + look.light_colour)).length() < 1e-6);
