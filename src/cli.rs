@@ -153,6 +153,10 @@ pub struct RenderArgs {
     /// Seconds without a heartbeat after which another worker takes a claimed frame over.
     #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
     pub claim_timeout: f64,
+    /// Frames of several sample waves save their progress this often, so a killed
+    /// render resumes them mid-frame (0 = after every wave).
+    #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
+    pub checkpoint_seconds: f64,
 }
 
 #[derive(Debug, clap::Args)]
@@ -451,26 +455,48 @@ impl Plan {
     }
 
     /// Renders one frame and writes every format.
+    /// Renders one frame in waves of samples and writes every format. A frame
+    /// of several waves saves its accumulation every `checkpoint_every`, and
+    /// continues from a saved one for the same inputs; the result is
+    /// bit-identical either way. Returns the stats and the samples resumed from.
     fn render_frame(
         &self,
         frame: u32,
         scenes: &[crate::scene::Scene],
         hash: &str,
+        checkpoint_every: std::time::Duration,
         on_row: &(dyn Fn() + Sync),
-    ) -> anyhow::Result<FrameStats> {
-        let film = crate::render::render_frame_in_time(
-            scenes,
-            frame,
-            self.width,
-            self.height,
-            self.layers(),
-            on_row,
-        );
+    ) -> anyhow::Result<(FrameStats, u32)> {
+        let n = scenes[0].samples_per_pixel.max(1);
+        let layers = self.layers();
+        let checkpoint = output::checkpoint_path(&self.out_dir, frame);
+        let mut acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
+            .filter(|a| a.samples_done < n)
+            .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
+        let resumed = acc.samples_done;
+        let wave = wave_size(n);
+        let mut saved = Instant::now();
+        while acc.samples_done < n {
+            let until = (acc.samples_done + wave).min(n);
+            crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
+            if until < n && saved.elapsed() >= checkpoint_every {
+                output::write_checkpoint(&checkpoint, &acc, hash)?;
+                saved = Instant::now();
+            }
+        }
+        let film = acc.finish(n);
         for &f in &self.formats {
             output::write_frame(&self.path(frame, f), f, &film, hash, &self.aovs)?;
         }
-        Ok(film.stats)
+        let _ = std::fs::remove_file(&checkpoint);
+        Ok((film.stats, resumed))
     }
+}
+
+/// Samples per pixel in one wave: about 16 waves a frame, so a long frame
+/// can be checkpointed between them.
+fn wave_size(samples_per_pixel: u32) -> u32 {
+    samples_per_pixel.div_ceil(16).max(1)
 }
 
 /// Parses `--shard I/N` or `auto` from the scheduler's environment.
@@ -535,6 +561,14 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());
     }
     let claim_timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
+    if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds >= 0.0) {
+        return Err(Error::usage(
+            "--checkpoint-seconds",
+            "must be a number of seconds, 0 or more",
+        )
+        .into());
+    }
+    let checkpoint_every = std::time::Duration::from_secs_f64(args.checkpoint_seconds);
     let record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
@@ -625,7 +659,15 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         current.set_prefix(format!("#{frame}"));
         current.set_message(format!("{width}x{height}"));
         let t0 = Instant::now();
-        let stats = plan.render_frame(frame, scene, hash, &|| current.inc(1))?;
+        let n = scene[0].samples_per_pixel.max(1);
+        current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
+        let (stats, resumed) =
+            plan.render_frame(frame, scene, hash, checkpoint_every, &|| current.inc(1))?;
+        if resumed > 0 && !args.quiet {
+            say(format!(
+                "frame {frame}: resumed from a checkpoint at {resumed} of {n} samples per pixel"
+            ));
+        }
         totals = totals + stats;
         rendered += 1;
         overall.inc(1);

@@ -414,6 +414,133 @@ impl JobRecord {
     }
 }
 
+/// `.frame_00042.ckpt`: the saved accumulation of a frame still rendering.
+pub fn checkpoint_path(dir: &Path, frame_index: u32) -> PathBuf {
+    dir.join(format!(
+        ".frame_{frame_index:0width$}.ckpt",
+        width = FRAME_DIGITS
+    ))
+}
+
+const CHECKPOINT_MAGIC: &[u8] = b"mandelreel-checkpoint-1\n";
+
+#[derive(Serialize, serde::Deserialize)]
+struct CheckpointHeader {
+    hash: String,
+    width: u32,
+    height: u32,
+    samples_done: u32,
+    layers: [bool; 3],
+    stats: crate::render::FrameStats,
+}
+
+/// Saves `acc` for the frame with content `hash`, atomically.
+pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &str) -> Result<()> {
+    let header = CheckpointHeader {
+        hash: hash.to_string(),
+        width: acc.width,
+        height: acc.height,
+        samples_done: acc.samples_done,
+        layers: [
+            !acc.normal.is_empty(),
+            !acc.albedo.is_empty(),
+            !acc.traps.is_empty(),
+        ],
+        stats: acc.stats,
+    };
+    let mut bytes = CHECKPOINT_MAGIC.to_vec();
+    bytes.extend(serde_json::to_vec(&header).expect("a header serialises"));
+    bytes.push(b'\n');
+    // Raw little-endian arrays: exact bits, so a resumed frame ends identical.
+    for c in &acc.colour {
+        c.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
+    }
+    acc.hits.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
+    acc.depth.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
+    acc.spent.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
+    for v in acc.normal.iter().chain(&acc.albedo) {
+        v.to_array()
+            .iter()
+            .for_each(|x| bytes.extend(x.to_le_bytes()));
+    }
+    for v in &acc.traps {
+        v.iter().for_each(|x| bytes.extend(x.to_le_bytes()));
+    }
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut temp = tempfile::Builder::new()
+        .prefix(&format!(".ckpt.{}", writer_tag()))
+        .suffix(".partial")
+        .tempfile_in(dir)
+        .map_err(|e| Error::io(dir, e))?;
+    temp.write_all(&bytes)
+        .map_err(|e| Error::io(temp.path(), e))?;
+    temp.as_file()
+        .sync_all()
+        .map_err(|e| Error::io(temp.path(), e))?;
+    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    Ok(())
+}
+
+/// The saved accumulation at `path`, if it is whole and belongs to a frame
+/// with this `hash`, size and layers.
+pub fn read_checkpoint(
+    path: &Path,
+    hash: &str,
+    width: u32,
+    height: u32,
+    layers: crate::render::Layers,
+) -> Option<crate::render::Accumulation> {
+    let bytes = std::fs::read(path).ok()?;
+    let rest = bytes.strip_prefix(CHECKPOINT_MAGIC)?;
+    let newline = rest.iter().position(|&b| b == b'\n')?;
+    let header: CheckpointHeader = serde_json::from_slice(&rest[..newline]).ok()?;
+    let wanted = [layers.normal, layers.albedo, layers.traps];
+    if header.hash != hash
+        || header.width != width
+        || header.height != height
+        || header.layers != wanted
+    {
+        return None;
+    }
+    let mut acc = crate::render::Accumulation::new(width, height, layers);
+    let mut data = &rest[newline + 1..];
+    let mut take = |n: usize| -> Option<&[u8]> {
+        let (head, tail) = (data.get(..n)?, data.get(n..)?);
+        data = tail;
+        Some(head)
+    };
+    for c in acc.colour.iter_mut() {
+        for v in c.iter_mut() {
+            *v = f64::from_le_bytes(take(8)?.try_into().ok()?);
+        }
+    }
+    for v in acc.hits.iter_mut() {
+        *v = u32::from_le_bytes(take(4)?.try_into().ok()?);
+    }
+    for v in acc.depth.iter_mut() {
+        *v = f32::from_le_bytes(take(4)?.try_into().ok()?);
+    }
+    for v in acc.spent.iter_mut() {
+        *v = u64::from_le_bytes(take(8)?.try_into().ok()?);
+    }
+    for v in acc.normal.iter_mut().chain(acc.albedo.iter_mut()) {
+        for k in 0..3 {
+            v[k] = f32::from_le_bytes(take(4)?.try_into().ok()?);
+        }
+    }
+    for v in acc.traps.iter_mut() {
+        for x in v.iter_mut() {
+            *x = f32::from_le_bytes(take(4)?.try_into().ok()?);
+        }
+    }
+    if !data.is_empty() {
+        return None;
+    }
+    acc.samples_done = header.samples_done;
+    acc.stats = header.stats;
+    Some(acc)
+}
+
 /// How old a temporary `.partial` file must be to count as left behind by a
 /// killed render. A writer holds one only while encoding a finished frame
 /// (seconds), so anything this old belongs to no live process.
@@ -654,6 +781,36 @@ mod tests {
         assert!(!dir.path().join(&dead).exists());
         assert!(dir.path().join(&alive).exists());
         assert!(dir.path().join(elsewhere).exists());
+    }
+
+    #[test]
+    fn checkpoints_round_trip_exactly_and_refuse_other_frames() {
+        use crate::render::{render_samples, Accumulation, Layers};
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene {
+            samples_per_pixel: 4,
+            ..Scene::default()
+        };
+        let layers = Layers {
+            normal: true,
+            albedo: false,
+            traps: true,
+        };
+        let mut acc = Accumulation::new(12, 8, layers);
+        render_samples(std::slice::from_ref(&scene), 0, &mut acc, 2, &|| {});
+        let path = checkpoint_path(dir.path(), 0);
+        write_checkpoint(&path, &acc, "h1").unwrap();
+        assert_eq!(
+            read_checkpoint(&path, "h1", 12, 8, layers).as_ref(),
+            Some(&acc)
+        );
+        assert!(read_checkpoint(&path, "h2", 12, 8, layers).is_none());
+        assert!(read_checkpoint(&path, "h1", 12, 9, layers).is_none());
+        assert!(read_checkpoint(&path, "h1", 12, 8, Layers::default()).is_none());
+        // A cut-short file is refused, not half-read.
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
+        assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_none());
     }
 
     #[test]

@@ -51,7 +51,7 @@ struct SampleResult {
 }
 
 /// Work counted while rendering one frame.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FrameStats {
     /// Distance-estimator evaluations, every stage together.
     pub de_evaluations: u64,
@@ -153,49 +153,156 @@ pub fn render_frame_in_time(
     layers: Layers,
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
-    let scene = &scenes[0];
+    let n = scenes[0].samples_per_pixel.max(1);
+    let mut acc = Accumulation::new(width, height, layers);
+    render_samples(scenes, frame_index, &mut acc, n, on_row);
+    acc.finish(n)
+}
+
+/// A frame in progress: per-pixel running sums over the samples done so far,
+/// enough to continue it later. Samples are always added to a pixel in
+/// sample order, so a frame rendered in waves, or resumed from a saved
+/// accumulation, ends bit-identical to one rendered in one go.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Accumulation {
+    pub width: u32,
+    pub height: u32,
+    pub samples_done: u32,
+    pub colour: Vec<[f64; 3]>,
+    pub hits: Vec<u32>,
+    pub depth: Vec<f32>,
+    pub spent: Vec<u64>,
+    /// Layer sums; empty when the layer is not collected.
+    pub normal: Vec<Vec3>,
+    pub albedo: Vec<Vec3>,
+    pub traps: Vec<[f32; 4]>,
+    pub stats: FrameStats,
+}
+
+impl Accumulation {
+    pub fn new(width: u32, height: u32, layers: Layers) -> Accumulation {
+        let pixels = width as usize * height as usize;
+        let layer = |on: bool| if on { pixels } else { 0 };
+        Accumulation {
+            width,
+            height,
+            samples_done: 0,
+            colour: vec![[0.0; 3]; pixels],
+            hits: vec![0; pixels],
+            depth: vec![BACKGROUND_DEPTH; pixels],
+            spent: vec![0; pixels],
+            normal: vec![Vec3::ZERO; layer(layers.normal)],
+            albedo: vec![Vec3::ZERO; layer(layers.albedo)],
+            traps: vec![[0.0; 4]; layer(layers.traps)],
+            stats: FrameStats::default(),
+        }
+    }
+
+    /// The finished film, with `n` samples per pixel.
+    pub fn finish(self, n: u32) -> Film {
+        let inv = 1.0 / n as f64;
+        let colour = self
+            .colour
+            .iter()
+            .map(|s| {
+                Vec3::new(
+                    (s[0] * inv) as f32,
+                    (s[1] * inv) as f32,
+                    (s[2] * inv) as f32,
+                )
+            })
+            .collect();
+        let alpha = self.hits.iter().map(|&h| h as f32 / n as f32).collect();
+        let per_hit = |i: usize| 1.0 / self.hits[i].max(1) as f32;
+        let normal = (!self.normal.is_empty())
+            .then(|| self.normal.iter().map(|v| v.normalize_or_zero()).collect());
+        let albedo = (!self.albedo.is_empty()).then(|| {
+            self.albedo
+                .iter()
+                .enumerate()
+                .map(|(i, &v)| if self.hits[i] > 0 { v * per_hit(i) } else { v })
+                .collect()
+        });
+        let traps = (!self.traps.is_empty()).then(|| {
+            self.traps
+                .iter()
+                .enumerate()
+                .map(|(i, v)| {
+                    if self.hits[i] > 0 {
+                        v.map(|x| x * per_hit(i))
+                    } else {
+                        *v
+                    }
+                })
+                .collect()
+        });
+        let max_pixel = self.spent.iter().copied().max().unwrap_or(0);
+        let stats = FrameStats {
+            de_evaluations: self.stats.stage_total(),
+            max_pixel_evaluations: max_pixel,
+            ..self.stats
+        };
+        Film {
+            width: self.width,
+            height: self.height,
+            colour,
+            alpha,
+            depth: self.depth,
+            evaluations: self
+                .spent
+                .iter()
+                .map(|&e| e.min(u32::MAX as u64) as u32)
+                .collect(),
+            normal,
+            albedo,
+            traps,
+            stats,
+        }
+    }
+}
+
+/// Adds samples `acc.samples_done .. until` of every pixel to `acc`.
+pub fn render_samples(
+    scenes: &[Scene],
+    frame_index: u32,
+    acc: &mut Accumulation,
+    until: u32,
+    on_row: &(dyn Fn() + Sync),
+) {
+    let (width, height) = (acc.width, acc.height);
     let cameras: Vec<_> = scenes.iter().map(|s| s.camera.frame()).collect();
-    let n = scene.samples_per_pixel.max(1);
+    let n = scenes[0].samples_per_pixel.max(1);
+    let first = acc.samples_done;
     // Fog is measured in camera–target distances, so zooms keep their haze.
     let scales: Vec<Real> = scenes
         .iter()
         .map(|s| (s.camera.position - s.camera.target).length())
         .collect();
-    let (w, pixels) = (width as usize, width as usize * height as usize);
-    let mut colour = vec![Vec3::ZERO; pixels];
-    let mut alpha = vec![0.0f32; pixels];
-    let mut depth = vec![BACKGROUND_DEPTH; pixels];
-    let mut evaluations = vec![0u32; pixels];
-    let mut normal_layer = vec![Vec3::ZERO; if layers.normal { pixels } else { 0 }];
-    let mut albedo_layer = vec![Vec3::ZERO; if layers.albedo { pixels } else { 0 }];
-    let mut traps_layer = vec![[0.0f32; 4]; if layers.traps { pixels } else { 0 }];
-    // Chunks of a layer not asked for are empty slices.
+    let w = width as usize;
     let chunk = |on: bool| if on { w } else { usize::MAX };
+    let (normal_on, albedo_on, traps_on) = (
+        !acc.normal.is_empty(),
+        !acc.albedo.is_empty(),
+        !acc.traps.is_empty(),
+    );
     // One row per task; rayon spreads rows over threads and each pixel depends
     // only on its own samples, so the result is independent of the split.
-    let stats = colour
+    let stats = acc
+        .colour
         .par_chunks_mut(w)
-        .zip(alpha.par_chunks_mut(w))
-        .zip(depth.par_chunks_mut(w))
-        .zip(evaluations.par_chunks_mut(w))
-        .zip(optional_rows(
-            &mut normal_layer,
-            chunk(layers.normal),
-            height,
-        ))
-        .zip(optional_rows(
-            &mut albedo_layer,
-            chunk(layers.albedo),
-            height,
-        ))
-        .zip(optional_rows(&mut traps_layer, chunk(layers.traps), height))
+        .zip(acc.hits.par_chunks_mut(w))
+        .zip(acc.depth.par_chunks_mut(w))
+        .zip(acc.spent.par_chunks_mut(w))
+        .zip(optional_rows(&mut acc.normal, chunk(normal_on), height))
+        .zip(optional_rows(&mut acc.albedo, chunk(albedo_on), height))
+        .zip(optional_rows(&mut acc.traps, chunk(traps_on), height))
         .enumerate()
         .map(
             |(
                 y,
                 (
                     (
-                        ((((colour_row, alpha_row), depth_row), evaluations_row), mut normal_row),
+                        ((((colour_row, hits_row), depth_row), spent_row), mut normal_row),
                         mut albedo_row,
                     ),
                     mut traps_row,
@@ -204,10 +311,8 @@ pub fn render_frame_in_time(
                 let mut stats = FrameStats::default();
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
-                    let mut sum = [0.0f64; 3];
-                    let mut hits = 0u32;
-                    let before = stats;
-                    for s in 0..n {
+                    let before = stats.stage_total();
+                    for s in first..until {
                         let k = s as usize % scenes.len();
                         let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
                         let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
@@ -222,7 +327,8 @@ pub fn render_frame_in_time(
                         let sample = trace(scene, &ray, camera.up, scale, &random, &mut stats);
                         let c = sample.colour;
                         if let Some((t, nrm, albedo, traps)) = sample.hit {
-                            hits += 1;
+                            hits_row[x] += 1;
+                            stats.hits += 1;
                             depth_row[x] = depth_row[x].min(t as f32);
                             if let Some(row) = normal_row.as_deref_mut() {
                                 row[x] += nrm.as_vec3();
@@ -247,56 +353,20 @@ pub fn render_frame_in_time(
                             stats.repaired_samples += 1;
                         }
                         let c = finite_or_zero(c);
-                        sum[0] += c.x as f64;
-                        sum[1] += c.y as f64;
-                        sum[2] += c.z as f64;
+                        colour_row[x][0] += c.x as f64;
+                        colour_row[x][1] += c.y as f64;
+                        colour_row[x][2] += c.z as f64;
+                        stats.samples += 1;
                     }
-                    let inv = 1.0 / n as f64;
-                    colour_row[x] = Vec3::new(
-                        (sum[0] * inv) as f32,
-                        (sum[1] * inv) as f32,
-                        (sum[2] * inv) as f32,
-                    );
-                    alpha_row[x] = hits as f32 / n as f32;
-                    if hits > 0 {
-                        let inv_hits = 1.0 / hits as f32;
-                        if let Some(row) = normal_row.as_deref_mut() {
-                            row[x] = row[x].normalize_or_zero();
-                        }
-                        if let Some(row) = albedo_row.as_deref_mut() {
-                            row[x] *= inv_hits;
-                        }
-                        if let Some(row) = traps_row.as_deref_mut() {
-                            row[x] = row[x].map(|v| v * inv_hits);
-                        }
-                    }
-                    let spent = stats.stage_total() - before.stage_total();
-                    evaluations_row[x] = spent.min(u32::MAX as u64) as u32;
-                    stats.max_pixel_evaluations = stats.max_pixel_evaluations.max(spent);
-                    stats.samples += n as u64;
-                    stats.hits += hits as u64;
+                    spent_row[x] += stats.stage_total() - before;
                 }
                 on_row();
                 stats
             },
         )
         .reduce(FrameStats::default, |a, b| a + b);
-    let stats = FrameStats {
-        de_evaluations: stats.stage_total(),
-        ..stats
-    };
-    Film {
-        width,
-        height,
-        colour,
-        alpha,
-        depth,
-        evaluations,
-        normal: layers.normal.then_some(normal_layer),
-        albedo: layers.albedo.then_some(albedo_layer),
-        traps: layers.traps.then_some(traps_layer),
-        stats,
-    }
+    acc.stats = acc.stats + stats;
+    acc.samples_done = until;
 }
 
 /// Rows of an optional layer for the parallel zip: `Some(row)` per image row
@@ -553,5 +623,32 @@ mod tests {
         assert!(render_frame(&closed, 0, 32, 24, &|| {}).colour == a.colour);
         // The lens costs marching only through its extra rays' paths: same sample count.
         assert_eq!(a.stats.samples, b.stats.samples);
+    }
+
+    #[test]
+    fn a_frame_rendered_in_waves_equals_one_rendered_at_once() {
+        let scene = Scene {
+            samples_per_pixel: 6,
+            effects: crate::shade::Effects {
+                path_tracing: Some(Default::default()),
+                ..Default::default()
+            },
+            ..Scene::default()
+        };
+        let layers = Layers {
+            normal: true,
+            albedo: true,
+            traps: true,
+        };
+        let scenes = std::slice::from_ref(&scene);
+        let at_once = render_frame_in_time(scenes, 3, 24, 16, layers, &|| {});
+        let mut acc = Accumulation::new(24, 16, layers);
+        for until in [1, 2, 5, 6] {
+            render_samples(scenes, 3, &mut acc, until, &|| {});
+        }
+        let waves = acc.finish(6);
+        assert!(waves.colour == at_once.colour && waves.depth == at_once.depth);
+        assert!(waves.normal == at_once.normal && waves.traps == at_once.traps);
+        assert_eq!(waves.stats, at_once.stats);
     }
 }

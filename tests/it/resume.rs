@@ -173,3 +173,62 @@ fn killed_render_resumes_to_identical_frames() {
         );
     }
 }
+
+#[test]
+fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
+    let d = Dir::new();
+    // One path-traced frame of 64 samples per pixel: 16 waves of 4, a
+    // checkpoint after every wave.
+    let text = tiny_timeline(1, 8.0)
+        .replace("size: (48, 27)", "size: (120, 68)")
+        .replace(
+            "fractal: (iterations: 8)",
+            "fractal: (iterations: 8), samples_per_pixel: 64, effects: (path_tracing: ())",
+        );
+    d.write("t.ron", &text);
+    d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
+    let mut child = d
+        .command(&[
+            "render",
+            "t.ron",
+            "--checkpoint-seconds",
+            "0",
+            "--threads",
+            "1",
+            "--quiet",
+        ])
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !d.files("out/t").iter().any(|f| f.ends_with(".ckpt")) {
+        assert!(
+            start.elapsed() < Duration::from_secs(120),
+            "no checkpoint appeared"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "finished before a checkpoint"
+        );
+        std::thread::sleep(Duration::from_millis(2));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(
+        !d.files("out/t").contains(&"frame_00000.png".to_string()),
+        "killed before the end"
+    );
+    let out = d.ok(&["render", "t.ron"]);
+    assert!(
+        stderr(&out).contains("resumed from a checkpoint at"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(
+        d.bytes("out/t/frame_00000.png") == d.bytes("clean/frame_00000.png"),
+        "the resumed frame differs from the uninterrupted one"
+    );
+    assert!(
+        !d.files("out/t").iter().any(|f| f.ends_with(".ckpt")),
+        "checkpoint left behind"
+    );
+}
