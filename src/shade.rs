@@ -64,6 +64,10 @@ pub enum Sky {
     Gradient,
     /// The same radiance from every direction (a white furnace at (1, 1, 1)).
     Constant(Vec3),
+    /// The Preetham daylight model for the sun at `look.light_direction`,
+    /// +y up, with atmospheric turbidity (2 very clear … 10 hazy); zenith
+    /// luminance 1, below the horizon the horizon's colour at half brightness.
+    Preetham { turbidity: Real },
 }
 
 /// Samples spread over an open shutter, each seeing the timeline at its own time.
@@ -205,6 +209,29 @@ impl Default for Glow {
     }
 }
 
+/// A directional light: where it comes from and how bright it is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Light {
+    /// Direction towards the light (need not be unit length).
+    pub direction: DVec3,
+    pub colour: Vec3,
+    pub intensity: f32,
+}
+
+impl Default for Light {
+    fn default() -> Self {
+        Light {
+            direction: DVec3::new(-0.5, 0.3, -0.8),
+            colour: Vec3::new(0.45, 0.5, 0.6),
+            intensity: 1.0,
+        }
+    }
+}
+
+/// Most lights a scene may have (the key light and seven more).
+pub const MAX_LIGHTS: usize = 8;
+
 /// Estimates spent by the shading stages of one sample.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct StageCounts {
@@ -298,6 +325,8 @@ pub struct Look {
     /// Direction towards the light (need not be unit length).
     pub light_direction: DVec3,
     pub light_colour: Vec3,
+    /// More directional lights beside the key light above (fill, rim, a second sun).
+    pub extra_lights: Vec<Light>,
     /// Light that reaches every surface regardless of orientation.
     pub ambient: Vec3,
     /// Surface colour where no trap pulls.
@@ -318,6 +347,7 @@ impl Default for Look {
         Look {
             light_direction: DVec3::new(0.6, 0.8, 0.5),
             light_colour: Vec3::new(1.0, 0.95, 0.85),
+            extra_lights: Vec::new(),
             ambient: Vec3::new(0.12, 0.13, 0.16),
             base_colour: Vec3::new(0.75, 0.72, 0.68),
             trap_x_colour: Vec3::new(0.75, 0.28, 0.08),
@@ -331,6 +361,19 @@ impl Default for Look {
 }
 
 impl Look {
+    /// Every light as (unit direction towards it, brightness): the key light first.
+    pub fn lights(&self) -> impl Iterator<Item = (DVec3, Vec3)> + '_ {
+        std::iter::once((
+            normalize_or(self.light_direction, DVec3::Y),
+            self.light_colour,
+        ))
+        .chain(
+            self.extra_lights
+                .iter()
+                .map(|l| (normalize_or(l.direction, DVec3::Y), l.colour * l.intensity)),
+        )
+    }
+
     /// Albedo of the surface from its orbit traps.
     pub fn albedo(&self, traps: &OrbitTraps) -> Vec3 {
         // A plane trap pulls hardest when the orbit passed close to that plane.
@@ -354,28 +397,33 @@ impl Look {
         at: &SurfacePoint,
         counts: &mut StageCounts,
     ) -> Vec3 {
-        let to_light = normalize_or(self.light_direction, DVec3::Y);
-        let lambert = at.normal.dot(to_light).max(0.0) as f32;
-        let mut light = 1.0f32;
-        if let (Some(sh), true) = (&effects.shadows, lambert > 0.0) {
-            // Start a couple of footprints off the surface so it does not shadow itself.
-            let from = at.point + at.normal * (2.0 * at.footprint);
-            let (f, spent) = shadow(fractal, settings, sh, from, to_light, at.footprint);
-            light = f;
-            counts.shadows += spent;
-        }
         let mut ambient = 1.0f32;
         if let Some(ao) = &effects.ambient_occlusion {
             let (a, spent) = occlusion(fractal, ao, at.point, at.normal, at.t, at.footprint);
             ambient = a;
             counts.occlusion += spent;
         }
-        let mut c = self.albedo(&at.traps)
-            * (self.ambient * ambient + self.light_colour * (lambert * light));
-        if let (Some(sp), true) = (&effects.specular, lambert > 0.0) {
-            let half = normalize_or(to_light - at.view_dir, at.normal);
-            let highlight = (at.normal.dot(half).max(0.0) as f32).powf(sp.shininess);
-            c += self.light_colour * (sp.strength * highlight * light);
+        let albedo = self.albedo(&at.traps);
+        let mut c = albedo * self.ambient * ambient;
+        for (to_light, brightness) in self.lights() {
+            let lambert = at.normal.dot(to_light).max(0.0) as f32;
+            if lambert <= 0.0 {
+                continue;
+            }
+            let mut light = 1.0f32;
+            if let Some(sh) = &effects.shadows {
+                // Start a couple of footprints off the surface so it does not shadow itself.
+                let from = at.point + at.normal * (2.0 * at.footprint);
+                let (f, spent) = shadow(fractal, settings, sh, from, to_light, at.footprint);
+                light = f;
+                counts.shadows += spent;
+            }
+            c += albedo * brightness * (lambert * light);
+            if let Some(sp) = &effects.specular {
+                let half = normalize_or(to_light - at.view_dir, at.normal);
+                let highlight = (at.normal.dot(half).max(0.0) as f32).powf(sp.shininess);
+                c += brightness * (sp.strength * highlight * light);
+            }
         }
         c
     }
@@ -427,8 +475,82 @@ impl Sky {
         match self {
             Sky::Gradient => look.background(dir, up),
             Sky::Constant(c) => *c,
+            Sky::Preetham { turbidity } => preetham(
+                dir,
+                normalize_or(look.light_direction, DVec3::Y),
+                *turbidity,
+            ),
         }
     }
+}
+
+/// The Preetham, Shirley and Smits (1999) analytic daylight sky: the Perez
+/// distribution of luminance and chromaticity over the sky, fitted to
+/// turbidity. Linear sRGB, zenith luminance 1.
+pub fn preetham(dir: DVec3, to_sun: DVec3, turbidity: Real) -> Vec3 {
+    let t = turbidity;
+    let perez = |theta: Real, gamma: Real, c: [Real; 5]| {
+        (1.0 + c[0] * (c[1] / theta.cos().max(0.01)).exp())
+            * (1.0 + c[2] * (c[3] * gamma).exp() + c[4] * gamma.cos().powi(2))
+    };
+    let lum = [
+        0.1787 * t - 1.4630,
+        -0.3554 * t + 0.4275,
+        -0.0227 * t + 5.3251,
+        0.1206 * t - 2.5771,
+        -0.0670 * t + 0.3703,
+    ];
+    let cx = [
+        -0.0193 * t - 0.2592,
+        -0.0665 * t + 0.0008,
+        -0.0004 * t + 0.2125,
+        -0.0641 * t - 0.8989,
+        -0.0033 * t + 0.0452,
+    ];
+    let cy = [
+        -0.0167 * t - 0.2608,
+        -0.0950 * t + 0.0092,
+        -0.0079 * t + 0.2102,
+        -0.0441 * t - 1.6537,
+        -0.0109 * t + 0.0529,
+    ];
+    let theta_s = to_sun
+        .y
+        .clamp(-1.0, 1.0)
+        .acos()
+        .min(std::f64::consts::FRAC_PI_2);
+    let (s1, s2, s3) = (theta_s, theta_s * theta_s, theta_s * theta_s * theta_s);
+    let zenith_x = t * t * (0.00166 * s3 - 0.00375 * s2 + 0.00209 * s1)
+        + t * (-0.02903 * s3 + 0.06377 * s2 - 0.03202 * s1 + 0.00394)
+        + (0.11693 * s3 - 0.21196 * s2 + 0.06052 * s1 + 0.25886);
+    let zenith_y = t * t * (0.00275 * s3 - 0.00610 * s2 + 0.00317 * s1)
+        + t * (-0.04214 * s3 + 0.08970 * s2 - 0.04153 * s1 + 0.00516)
+        + (0.15346 * s3 - 0.26756 * s2 + 0.06670 * s1 + 0.26688);
+    // Below the horizon: the horizon's colour at half brightness.
+    let (d, dim) = if dir.y < 0.0 {
+        (
+            DVec3::new(dir.x, 0.0, dir.z)
+                .try_normalize()
+                .unwrap_or(DVec3::X),
+            0.5,
+        )
+    } else {
+        (dir, 1.0)
+    };
+    let theta = d.y.clamp(0.0, 1.0).acos().min(1.5608); // 89.4°: keeps 1/cos θ finite
+    let gamma = d.dot(to_sun).clamp(-1.0, 1.0).acos();
+    let relative = |c: [Real; 5]| perez(theta, gamma, c) / perez(0.0, theta_s, c);
+    let luminance = relative(lum) * dim;
+    let x = zenith_x * relative(cx);
+    let y = (zenith_y * relative(cy)).max(1e-6);
+    // xyY → XYZ → linear sRGB (D65).
+    let (cap_x, cap_z) = (x / y * luminance, (1.0 - x - y) / y * luminance);
+    let rgb = Vec3::new(
+        (3.2406 * cap_x - 1.5372 * luminance - 0.4986 * cap_z) as f32,
+        (-0.9689 * cap_x + 1.8758 * luminance + 0.0415 * cap_z) as f32,
+        (0.0557 * cap_x - 0.2040 * luminance + 1.0570 * cap_z) as f32,
+    );
+    crate::math::finite_or_zero(rgb.max(Vec3::ZERO))
 }
 
 /// Radiance of a path-traced camera sample that hit `at`. `random(d)` is the
@@ -445,15 +567,15 @@ pub fn trace_path(
     counts: &mut StageCounts,
 ) -> Vec3 {
     use crate::march::{march, normal, Ray};
-    let to_sun = normalize_or(look.light_direction, DVec3::Y);
     let sun_half_angle = 0.5 * pt.sun_angle_degrees.to_radians();
     let sky_scale = pt.sky_intensity;
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut here = *at;
     for bounce in 0..pt.max_bounces.max(1) {
-        // Dimensions 0–3 belong to the pixel and lens; 8 per bounce after that.
-        let dim = |k: u32| random(4 + 8 * bounce + k);
+        // Dimensions 0–3 belong to the pixel and lens; 32 per bounce after that:
+        // 0–2 the bounce and roulette, then two per light.
+        let dim = |k: u32| random(4 + 32 * bounce + k);
         let albedo = look.albedo(&here.traps);
         let leave = |dir: DVec3| Ray {
             origin: here.point + here.normal * (2.0 * here.footprint),
@@ -461,24 +583,27 @@ pub fn trace_path(
             pixel_angle: 0.0,
             start_footprint: here.footprint,
         };
-        // Next-event estimation: one ray towards a point on the sun's disc.
-        let sun_dir = if sun_half_angle > 0.0 {
-            cone_direction(to_sun, sun_half_angle, dim(0), dim(1))
-        } else {
-            to_sun
-        };
-        let cos_sun = here.normal.dot(sun_dir);
-        if cos_sun > 0.0 {
-            let shadow = march(&leave(sun_dir), fractal, settings);
-            counts.sun_rays += shadow.evaluations as u64;
-            if shadow.hit.is_none() {
-                // Lambert: albedo/π × irradiance × cos θ, with the irradiance
-                // spread over π so an albedo-1 plane facing the sun returns it.
-                radiance += throughput * albedo * look.light_colour * cos_sun as f32;
+        // Next-event estimation: one ray towards a point on each light's disc.
+        for (i, (to_light, brightness)) in look.lights().enumerate() {
+            let k = 3 + 2 * i as u32;
+            let dir = if sun_half_angle > 0.0 {
+                cone_direction(to_light, sun_half_angle, dim(k), dim(k + 1))
+            } else {
+                to_light
+            };
+            let cos_light = here.normal.dot(dir);
+            if cos_light > 0.0 {
+                let shadow = march(&leave(dir), fractal, settings);
+                counts.sun_rays += shadow.evaluations as u64;
+                if shadow.hit.is_none() {
+                    // Lambert: albedo/π × irradiance × cos θ, with the irradiance
+                    // spread over π so an albedo-1 plane facing the light returns it.
+                    radiance += throughput * albedo * brightness * cos_light as f32;
+                }
             }
         }
         // Bounce: cosine-weighted, so the throughput only takes the albedo.
-        let dir = cosine_direction(here.normal, dim(2), dim(3));
+        let dir = cosine_direction(here.normal, dim(0), dim(1));
         throughput *= albedo;
         let ray = leave(dir);
         let result = march(&ray, fractal, settings);
@@ -491,7 +616,7 @@ pub fn trace_path(
         // carry little light end early.
         if bounce >= 2 {
             let survive = throughput.max_element().clamp(0.05, 0.95);
-            if dim(4) as f32 >= survive {
+            if dim(2) as f32 >= survive {
                 break;
             }
             throughput /= survive;
@@ -717,6 +842,87 @@ mod tests {
         // the crevices trap light, so 0 < radiance < a.
         let dark = furnace(&grey(0.6), &Fractal::default(), 2000, 64);
         assert!(dark > 0.2 && dark < 0.6, "{dark}");
+    }
+
+    #[test]
+    fn every_light_adds_its_light_and_casts_its_shadow() {
+        let one = Look {
+            light_direction: DVec3::Y,
+            ..Look::default()
+        };
+        let two = Look {
+            extra_lights: vec![Light {
+                direction: DVec3::X,
+                colour: Vec3::ONE,
+                intensity: 0.5,
+            }],
+            ..one.clone()
+        };
+        // On top of the ball, facing up and out along x: both lights reach it.
+        let at = SurfacePoint {
+            point: DVec3::new(1.0, 1.0, 0.0).normalize(),
+            normal: DVec3::new(1.0, 1.0, 0.0).normalize(),
+            view_dir: -DVec3::Z,
+            t: 2.0,
+            footprint: 1e-3,
+            traps: OrbitTraps {
+                origin: 1.0,
+                planes: DVec3::splat(1.0),
+            },
+        };
+        let effects = Effects {
+            shadows: Some(Shadows::default()),
+            ..Effects::default()
+        };
+        let (mut c1, mut c2) = (StageCounts::default(), StageCounts::default());
+        let a = one.shade(
+            &effects,
+            &unit_ball(),
+            &MarchSettings::default(),
+            &at,
+            &mut c1,
+        );
+        let b = two.shade(
+            &effects,
+            &unit_ball(),
+            &MarchSettings::default(),
+            &at,
+            &mut c2,
+        );
+        let albedo = one.albedo(&at.traps);
+        let extra = albedo * Vec3::ONE * (0.5 * std::f32::consts::FRAC_1_SQRT_2);
+        assert!((b - a - extra).length() < 1e-5, "{b} vs {a} + {extra}");
+        // One shadow march per light that faces the surface.
+        assert!(c2.shadows > c1.shadows && c1.shadows > 0);
+    }
+
+    #[test]
+    fn preetham_sky_is_brightest_near_the_sun_and_one_at_the_zenith() {
+        let sun = DVec3::new(0.0, 0.5, 0.866).normalize();
+        let luminance = |c: Vec3| 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z;
+        let zenith = preetham(DVec3::Y, sun, 3.0);
+        assert!((luminance(zenith) - 1.0).abs() < 0.05, "{zenith}");
+        let near_sun = preetham(DVec3::new(0.0, 0.45, 0.89).normalize(), sun, 3.0);
+        let away = preetham(DVec3::new(0.0, 0.45, -0.89).normalize(), sun, 3.0);
+        assert!(
+            luminance(near_sun) > 2.0 * luminance(away),
+            "{near_sun} vs {away}"
+        );
+        // Clear skies are blue away from the sun.
+        assert!(away.z > away.x, "{away}");
+        // Finite everywhere, the ground and a sun at the zenith or below the horizon too.
+        for s in [DVec3::Y, DVec3::new(1.0, -0.2, 0.0).normalize(), sun] {
+            for d in [
+                DVec3::Y,
+                -DVec3::Y,
+                DVec3::X,
+                DVec3::new(0.3, -0.9, 0.1).normalize(),
+            ] {
+                for t in [2.0, 10.0] {
+                    assert!(preetham(d, s, t).is_finite());
+                }
+            }
+        }
     }
 
     #[test]

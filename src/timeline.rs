@@ -712,6 +712,33 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         "look.trap_occlusion",
         format!("must be in [0, 1], got {}", l.trap_occlusion),
     )?;
+    check(
+        l.extra_lights.len() < crate::shade::MAX_LIGHTS,
+        "look.extra_lights",
+        format!(
+            "at most {} extra lights, got {}",
+            crate::shade::MAX_LIGHTS - 1,
+            l.extra_lights.len()
+        ),
+    )?;
+    for (i, light) in l.extra_lights.iter().enumerate() {
+        check(
+            light.direction.is_finite() && light.direction.length() > 0.0,
+            &format!("look.extra_lights[{i}].direction"),
+            format!("must be a finite non-zero vector, got {}", light.direction),
+        )?;
+        check(
+            light.colour.is_finite()
+                && light.colour.min_element() >= 0.0
+                && light.intensity.is_finite()
+                && light.intensity >= 0.0,
+            &format!("look.extra_lights[{i}]"),
+            format!(
+                "colour and intensity must be finite and non-negative, got {} × {}",
+                light.colour, light.intensity
+            ),
+        )?;
+    }
     let e = &s.effects;
     if let Some(sh) = &e.shadows {
         check(
@@ -790,12 +817,18 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             "effects.path_tracing.sky_intensity",
             format!("must be non-negative, got {}", pt.sky_intensity),
         )?;
-        if let crate::shade::Sky::Constant(c) = pt.sky {
-            check(
+        match pt.sky {
+            crate::shade::Sky::Constant(c) => check(
                 c.is_finite() && c.min_element() >= 0.0,
                 "effects.path_tracing.sky",
                 format!("a constant sky must be finite and non-negative, got {c}"),
-            )?;
+            )?,
+            crate::shade::Sky::Preetham { turbidity } => check(
+                turbidity.is_finite() && (1.7..=12.0).contains(&turbidity),
+                "effects.path_tracing.sky",
+                format!("Preetham turbidity must be 1.7..=12, got {turbidity}"),
+            )?,
+            crate::shade::Sky::Gradient => {}
         }
     }
     if let Some(m) = &e.motion_blur {
@@ -1115,6 +1148,14 @@ mod tests {
         let still = parse(&text.replace("effects: (motion_blur: (shutter: 0.5))", "")).unwrap();
         assert_eq!(still.scenes_for_frame(1), vec![still.scene_at(1)]);
         assert!(error_of(&text.replace("shutter: 0.5", "shutter: 1.5")).contains("shutter"));
+    }
+
+    #[test]
+    fn extra_lights_are_checked() {
+        let ok = parse("(fps: 10, frames: 1, size: (8, 6), scene: (look: (extra_lights: [(direction: (0, 1, 0), colour: (1, 1, 1), intensity: 0.5)])))").unwrap();
+        assert_eq!(ok.base.look.extra_lights.len(), 1);
+        let e = error_of("(fps: 10, frames: 1, size: (8, 6), scene: (look: (extra_lights: [(), (direction: (0, 0, 0))])))");
+        assert!(e.contains("look.extra_lights[1].direction"), "{e}");
     }
 
     #[test]
