@@ -8,6 +8,7 @@
 pub mod accuracy;
 pub mod claim;
 pub mod cli;
+pub mod environment;
 pub mod error;
 pub mod fractal;
 pub mod march;

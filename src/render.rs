@@ -280,6 +280,12 @@ pub fn render_samples(
         .collect();
     let w = width as usize;
     let chunk = |on: bool| if on { w } else { usize::MAX };
+    // An environment map is looked up once per frame, not per ray.
+    let environment = scenes[0]
+        .effects
+        .path_tracing
+        .as_ref()
+        .and_then(|pt| pt.sky.environment());
     let (normal_on, albedo_on, traps_on) = (
         !acc.normal.is_empty(),
         !acc.albedo.is_empty(),
@@ -324,7 +330,15 @@ pub fn render_samples(
                             camera.ray(x as Real + ox, y as Real + oy, width, height)
                         };
                         let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
-                        let sample = trace(scene, &ray, camera.up, scale, &random, &mut stats);
+                        let sample = trace(
+                            scene,
+                            &ray,
+                            camera.up,
+                            scale,
+                            environment.as_deref(),
+                            &random,
+                            &mut stats,
+                        );
                         let c = sample.colour;
                         if let Some((t, nrm, albedo, traps)) = sample.hit {
                             hits_row[x] += 1;
@@ -391,15 +405,25 @@ fn trace(
     ray: &crate::march::Ray,
     up: crate::math::DVec3,
     scale: Real,
+    environment: Option<&crate::environment::EnvironmentMap>,
     random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
 ) -> SampleResult {
     let result = march(ray, &scene.fractal, &scene.quality);
     stats.primary_evaluations += result.evaluations as u64;
     let Some(hit) = result.hit else {
-        let sky = match &scene.effects.path_tracing {
-            Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up) * pt.sky_intensity,
-            None => scene.look.background(ray.dir, up),
+        let sky = match (&scene.effects.path_tracing, environment) {
+            (Some(pt), Some(map)) => {
+                let rotation = match &pt.sky {
+                    crate::shade::Sky::Environment {
+                        rotation_degrees, ..
+                    } => rotation_degrees.to_radians(),
+                    _ => 0.0,
+                };
+                map.radiance(ray.dir, rotation) * pt.sky_intensity
+            }
+            (Some(pt), None) => pt.sky.radiance(&scene.look, ray.dir, up) * pt.sky_intensity,
+            (None, _) => scene.look.background(ray.dir, up),
         };
         let colour = match &scene.effects.glow {
             Some(g) => sky + glow(g, result.closest),
@@ -426,6 +450,7 @@ fn trace(
             &scene.quality,
             &at,
             up,
+            environment,
             random,
             &mut stages,
         ),

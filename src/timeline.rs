@@ -291,7 +291,7 @@ impl Timeline {
     pub fn parse(text: &str, path: &Path) -> Result<Timeline> {
         let options = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-        let file: TimelineFile = options.from_str(text).map_err(|e| Error::Syntax {
+        let mut file: TimelineFile = options.from_str(text).map_err(|e| Error::Syntax {
             file: path.to_path_buf(),
             line: e.span.start.line,
             column: e.span.start.col,
@@ -346,6 +346,42 @@ impl Timeline {
                 n.round() as u32
             }
         };
+        // An environment map: found relative to the timeline, loaded once to
+        // check it, and fingerprinted so frames re-render if it changes.
+        if let Some(crate::shade::Sky::Environment {
+            path: map_path,
+            digest,
+            ..
+        }) = file
+            .scene
+            .effects
+            .path_tracing
+            .as_mut()
+            .map(|pt| &mut pt.sky)
+        {
+            let resolved = if map_path.is_relative() {
+                path.parent().unwrap_or(Path::new(".")).join(&*map_path)
+            } else {
+                map_path.clone()
+            };
+            let field = "scene.effects.path_tracing.sky".to_string();
+            let line = line_of(text, "Environment", 0);
+            let bytes = std::fs::read(&resolved).map_err(|e| {
+                invalid(
+                    line,
+                    field.clone(),
+                    format!("cannot read {}: {e}", resolved.display()),
+                )
+            })?;
+            use sha2::Digest;
+            *digest = sha2::Sha256::digest(&bytes)
+                .iter()
+                .map(|b| format!("{b:02x}"))
+                .collect();
+            crate::environment::cached(&resolved, digest)
+                .map_err(|e| invalid(line, field, format!("not a usable environment map: {e}")))?;
+            *map_path = resolved;
+        }
         if let Err((field, message)) = validate_scene(&file.scene) {
             let line = line_of(
                 text,
@@ -828,7 +864,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                 "effects.path_tracing.sky",
                 format!("Preetham turbidity must be 1.7..=12, got {turbidity}"),
             )?,
-            crate::shade::Sky::Gradient => {}
+            crate::shade::Sky::Gradient | crate::shade::Sky::Environment { .. } => {}
         }
     }
     if let Some(m) = &e.motion_blur {

@@ -146,3 +146,73 @@ fn zoom_to_1e_minus_12_renders_finite_distinct_depths() {
         distinct.len()
     );
 }
+
+/// Writes a small equirectangular EXR map: a dim blue sky with one bright texel.
+fn write_sky(path: &std::path::Path, bright: f32) {
+    use exr::prelude::*;
+    let (w, h) = (32usize, 16usize);
+    write_rgba_file(path, w, h, |x, y| {
+        if (x, y) == (20, 5) {
+            (bright, bright, bright * 0.9, 1.0)
+        } else {
+            (0.1, 0.15, 0.3, 1.0)
+        }
+    })
+    .unwrap();
+}
+
+#[test]
+fn environment_map_lights_a_path_traced_frame_deterministically() {
+    let d = Dir::new();
+    write_sky(&d.path().join("sky.exr"), 200.0);
+    let text = scene(
+        "effects: (path_tracing: (max_bounces: 3, sky: Environment(path: \"sky.exr\", rotation_degrees: 30))), samples_per_pixel: 4",
+    );
+    d.write("t.ron", &text);
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--format",
+        "exr",
+        "--threads",
+        "1",
+        "--out",
+        "one",
+    ]);
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--format",
+        "exr",
+        "--threads",
+        "2",
+        "--out",
+        "two",
+    ]);
+    assert!(d.bytes("one/frame_00000.exr") == d.bytes("two/frame_00000.exr"));
+    finite_channels(&d, "one/frame_00000.exr");
+    // A changed map changes what made the frame: it re-renders, to a new picture.
+    write_sky(&d.path().join("sky.exr"), 50.0);
+    let out = d.ok(&[
+        "render",
+        "t.ron",
+        "--format",
+        "exr",
+        "--threads",
+        "2",
+        "--out",
+        "two",
+    ]);
+    assert!(
+        !stderr(&out).contains("already complete"),
+        "{}",
+        stderr(&out)
+    );
+    assert!(d.bytes("one/frame_00000.exr") != d.bytes("two/frame_00000.exr"));
+    // A missing map is a clear timeline error, before anything is written.
+    d.write("missing.ron", &text.replace("sky.exr", "nope.exr"));
+    let out = d.run(&["render", "missing.ron", "--out", "never"]);
+    assert_eq!(out.status.code(), Some(3));
+    assert!(stderr(&out).contains("nope.exr"), "{}", stderr(&out));
+    assert!(!d.path().join("never").exists());
+}
