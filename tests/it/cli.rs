@@ -180,6 +180,11 @@ fn info_reports_frames_tracks_and_effects() {
         "{out}"
     );
     assert!(out.contains("effects:"), "{out}");
+    // No effects: the measured cost is exactly the plain render's.
+    assert!(
+        out.contains("1.00x the same frame without effects"),
+        "{out}"
+    );
     assert!(d.files("out").is_empty(), "info must not write anything");
 }
 
@@ -267,6 +272,15 @@ fn example_timelines_are_valid() {
         let out = d.ok(&["info", path.to_str().unwrap()]);
         assert!(stdout(&out).contains("frames:"), "{}", stderr(&out));
     }
+    // Declared effects show their measured price in `info`.
+    let fx = stdout(&d.ok(&["info", root.join("timelines/effects.ron").to_str().unwrap()]));
+    let ratio: f64 = fx
+        .split("estimates, ")
+        .nth(1)
+        .and_then(|r| r.split('x').next())
+        .and_then(|r| r.parse().ok())
+        .unwrap_or_else(|| panic!("no cost line in {fx}"));
+    assert!(ratio > 1.1, "{fx}");
     // The zoom spans at least four decades of scale.
     let zoom = stdout(&d.ok(&["info", root.join("timelines/zoom.ron").to_str().unwrap()]));
     let before = &zoom[..zoom.find(" decades").expect("zoom line in info")];
