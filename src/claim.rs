@@ -91,15 +91,21 @@ pub enum Attempt {
 /// which also removes the claim file.
 pub struct Claim {
     path: PathBuf,
-    dir: PathBuf,
-    frame_index: u32,
+    /// The takeover marker this claim created, if it took a dead claim over.
+    marker: Option<PathBuf>,
     token: String,
     stop: Arc<AtomicBool>,
     heartbeat: Option<std::thread::JoinHandle<()>>,
 }
 
 impl Claim {
-    fn start(dir: &Path, frame_index: u32, record: ClaimRecord, interval: Duration) -> Claim {
+    fn start(
+        dir: &Path,
+        frame_index: u32,
+        record: ClaimRecord,
+        interval: Duration,
+        marker: Option<PathBuf>,
+    ) -> Claim {
         let path = claim_path(dir, frame_index);
         let stop = Arc::new(AtomicBool::new(false));
         let heartbeat = {
@@ -123,8 +129,7 @@ impl Claim {
         };
         Claim {
             path,
-            dir: dir.to_path_buf(),
-            frame_index,
+            marker,
             token: record.token,
             stop,
             heartbeat: Some(heartbeat),
@@ -141,18 +146,10 @@ impl Drop for Claim {
         if read_claim(&self.path).is_some_and(|r| r.token == self.token) {
             let _ = std::fs::remove_file(&self.path);
         }
-        // Takeover markers of this frame have served their purpose.
-        let prefix = format!(
-            ".frame_{:0width$}.takeover-",
-            self.frame_index,
-            width = crate::output::FRAME_DIGITS
-        );
-        if let Ok(entries) = std::fs::read_dir(&self.dir) {
-            for e in entries.filter_map(|e| e.ok()) {
-                if e.file_name().to_string_lossy().starts_with(&prefix) {
-                    let _ = std::fs::remove_file(e.path());
-                }
-            }
+        // The marker of the dead claim this one replaced has served its purpose.
+        // (Only that one: another may guard a takeover still going on.)
+        if let Some(marker) = &self.marker {
+            let _ = std::fs::remove_file(marker);
         }
     }
 }
@@ -187,15 +184,37 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                     frame_index,
                     record,
                     interval,
+                    None,
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
             Err(e) => return Err(Error::io(&path, e)),
         }
-        let Some(held) = read_claim(&path) else {
-            // Vanished, or being written this instant: look again.
-            std::thread::sleep(Duration::from_millis(20));
-            continue;
+        let held = match read_claim(&path) {
+            Some(held) => held,
+            None => {
+                // Unreadable: being written this instant, or left empty by a
+                // worker that died between creating and filling it. Judge the
+                // latter by the file's age, under a token naming that age.
+                let age_ms = std::fs::metadata(&path)
+                    .and_then(|m| m.modified())
+                    .ok()
+                    .and_then(|t| t.duration_since(UNIX_EPOCH).ok())
+                    .map(|d| d.as_millis() as u64);
+                match age_ms {
+                    Some(modified) => ClaimRecord {
+                        host: "unknown".into(),
+                        pid: 0,
+                        token: format!("unreadable-{modified}"),
+                        heartbeat_ms: modified,
+                    },
+                    None => {
+                        // Vanished: look again.
+                        std::thread::sleep(Duration::from_millis(20));
+                        continue;
+                    }
+                }
+            }
         };
         if is_live(&held, timeout) {
             return Ok(Attempt::Held(held));
@@ -215,6 +234,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                     frame_index,
                     record,
                     interval,
+                    Some(marker),
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
@@ -276,6 +296,36 @@ mod tests {
         assert_eq!(now.pid, std::process::id());
         drop(ours);
         assert!(!claim_path(dir.path(), 7).exists());
+    }
+
+    #[test]
+    fn an_empty_claim_left_by_a_crash_is_taken_over_once_it_is_old() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = claim_path(dir.path(), 2);
+        std::fs::write(&path, b"").unwrap();
+        let timeout = Duration::from_secs(60);
+        // Fresh: it may be being written; leave it.
+        assert!(matches!(
+            try_claim(dir.path(), 2, timeout).unwrap(),
+            Attempt::Held(_)
+        ));
+        // Two minutes old: dead; taken over.
+        let old = SystemTime::now() - Duration::from_secs(120);
+        std::fs::File::options()
+            .write(true)
+            .open(&path)
+            .unwrap()
+            .set_modified(old)
+            .unwrap();
+        let Attempt::Claimed(claim) = try_claim(dir.path(), 2, timeout).unwrap() else {
+            panic!("an old empty claim is taken over");
+        };
+        assert_eq!(read_claim(&path).unwrap().pid, std::process::id());
+        drop(claim);
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "nothing left behind"
+        );
     }
 
     #[test]

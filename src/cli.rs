@@ -147,7 +147,8 @@ pub struct RenderArgs {
     #[arg(long, value_name = "I/N|auto", conflicts_with = "claim")]
     pub shard: Option<String>,
     /// Share the frames with any number of other `--claim` workers on the same
-    /// output folder, taking one frame at a time through claim files.
+    /// output folder, taking one frame at a time through claim files (with
+    /// --force, each worker makes a single pass over the frames).
     #[arg(long)]
     pub claim: bool,
     /// Seconds without a heartbeat after which another worker takes a claimed frame over.
@@ -704,7 +705,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             std::time::Duration::from_secs(5),
         );
         loop {
-            let mut others_busy = false;
             for (frame, scene, hash) in &todo {
                 if !args.force && plan.is_complete(*frame, hash) {
                     continue;
@@ -717,13 +717,16 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         }
                         drop(claim);
                     }
-                    crate::claim::Attempt::Held(_) => others_busy = true,
+                    // Another live worker has it: look again next round.
+                    crate::claim::Attempt::Held(_) => {}
                 }
             }
             let done = todo
                 .iter()
                 .all(|(frame, _, hash)| plan.is_complete(*frame, hash));
-            if done || (!others_busy && args.force) {
+            // With --force a worker makes one pass: "complete" cannot tell its
+            // own fresh frames from old ones, so waiting would re-render them.
+            if done || args.force {
                 break;
             }
             std::thread::sleep(poll);
@@ -780,6 +783,8 @@ pub enum FrameState {
     Stale,
     /// A live claim or a fresh temporary file: some worker is on it.
     InProgress,
+    /// A checkpoint holds part of its samples: a render will continue it.
+    Resumable,
     Missing,
 }
 
@@ -850,6 +855,8 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             FrameState::InProgress
         } else if writing.contains(&frame) {
             FrameState::InProgress
+        } else if output::checkpoint_path(&plan.out_dir, frame).exists() {
+            FrameState::Resumable
         } else if plan.formats.iter().any(|&f| plan.path(frame, f).exists()) {
             FrameState::Stale
         } else {
@@ -859,6 +866,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             FrameState::Complete => "complete",
             FrameState::Stale => "stale",
             FrameState::InProgress => "in_progress",
+            FrameState::Resumable => "resumable",
             FrameState::Missing => "missing",
         };
         by_state.entry(key).or_default().push(frame);
@@ -904,7 +912,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             plan.width,
             plan.height
         );
-        for key in ["complete", "in_progress", "stale", "missing"] {
+        for key in ["complete", "in_progress", "resumable", "stale", "missing"] {
             if let Some(frames) = by_state.get(key) {
                 println!(
                     "  {:<12} {:>6}  {}",

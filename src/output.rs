@@ -597,9 +597,9 @@ pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
     for entry in entries.filter_map(|e| e.ok()) {
         let name = entry.file_name().to_string_lossy().into_owned();
         let temporary = name.ends_with(".partial")
-            && (name.starts_with(".frame_")
-                || name.starts_with(".claim.")
-                || name.starts_with(".job."));
+            && [".frame_", ".claim.", ".job.", ".ckpt."]
+                .iter()
+                .any(|p| name.starts_with(p));
         if !temporary {
             continue;
         }

@@ -106,6 +106,11 @@ fn status_reports_complete_stale_missing_and_in_progress() {
         "{out}"
     );
     std::fs::remove_file(d.path().join("out/t/.frame_00004.claim")).unwrap();
+    // A checkpoint of a frame not yet finished marks it resumable.
+    d.write("out/t/.frame_00005.ckpt", "partial samples");
+    let out = stdout(&d.run(&["status", "t.ron"]));
+    assert!(out.contains("resumable") && out.contains(" 5"), "{out}");
+    std::fs::remove_file(d.path().join("out/t/.frame_00005.ckpt")).unwrap();
     // Everything rendered: exit 0, from the timeline and from the folder alone.
     d.ok(&["render", "t.ron", "--quiet"]);
     assert!(stdout(&d.ok(&["status", "t.ron"])).contains("6 of 6 frames complete"));
