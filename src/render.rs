@@ -46,8 +46,8 @@ pub struct Layers {
 /// What one camera sample met.
 struct SampleResult {
     colour: Vec3,
-    /// Distance, normal, albedo and traps of the first hit.
-    hit: Option<(Real, crate::math::DVec3, Vec3, crate::fractal::OrbitTraps)>,
+    /// Distance, normal and orbit traps of the hit.
+    hit: Option<(Real, crate::math::DVec3, crate::fractal::OrbitTraps)>,
 }
 
 /// Work counted while rendering one frame.
@@ -340,15 +340,16 @@ pub fn render_samples(
                             &mut stats,
                         );
                         let c = sample.colour;
-                        if let Some((t, nrm, albedo, traps)) = sample.hit {
+                        if let Some((t, nrm, traps)) = sample.hit {
                             hits_row[x] += 1;
                             stats.hits += 1;
                             depth_row[x] = depth_row[x].min(t as f32);
                             if let Some(row) = normal_row.as_deref_mut() {
                                 row[x] += nrm.as_vec3();
                             }
+                            // Only a requested albedo layer pays for the albedo.
                             if let Some(row) = albedo_row.as_deref_mut() {
-                                row[x] += albedo;
+                                row[x] += scene.look.albedo(&traps);
                             }
                             if let Some(row) = traps_row.as_deref_mut() {
                                 let v = [
@@ -412,18 +413,9 @@ fn trace(
     let result = march(ray, &scene.fractal, &scene.quality);
     stats.primary_evaluations += result.evaluations as u64;
     let Some(hit) = result.hit else {
-        let sky = match (&scene.effects.path_tracing, environment) {
-            (Some(pt), Some(map)) => {
-                let rotation = match &pt.sky {
-                    crate::shade::Sky::Environment {
-                        rotation_degrees, ..
-                    } => rotation_degrees.to_radians(),
-                    _ => 0.0,
-                };
-                map.radiance(ray.dir, rotation) * pt.sky_intensity
-            }
-            (Some(pt), None) => pt.sky.radiance(&scene.look, ray.dir, up) * pt.sky_intensity,
-            (None, _) => scene.look.background(ray.dir, up),
+        let sky = match &scene.effects.path_tracing {
+            Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
+            None => scene.look.background(ray.dir, up),
         };
         let colour = match &scene.effects.glow {
             Some(g) => sky + glow(g, result.closest),
@@ -472,7 +464,7 @@ fn trace(
     };
     SampleResult {
         colour,
-        hit: Some((hit.t, nrm, scene.look.albedo(&at.traps), at.traps)),
+        hit: Some((hit.t, nrm, at.traps)),
     }
 }
 

@@ -482,7 +482,13 @@ pub fn cone_direction(axis: DVec3, half_angle: Real, u: Real, v: Real) -> DVec3 
 
 impl Sky {
     /// Radiance arriving along `dir` (the sun is separate).
-    pub fn radiance(&self, look: &Look, dir: DVec3, up: DVec3) -> Vec3 {
+    pub fn radiance(
+        &self,
+        look: &Look,
+        dir: DVec3,
+        up: DVec3,
+        environment: Option<&crate::environment::EnvironmentMap>,
+    ) -> Vec3 {
         match self {
             Sky::Gradient => look.background(dir, up),
             Sky::Constant(c) => *c,
@@ -491,12 +497,20 @@ impl Sky {
                 normalize_or(look.light_direction, DVec3::Y),
                 *turbidity,
             ),
+            // The map is fetched once per frame by the caller, never per ray.
+            Sky::Environment { .. } => {
+                environment.map_or(Vec3::ZERO, |map| map.radiance(dir, self.rotation()))
+            }
+        }
+    }
+
+    /// Turn of an environment map about +y, in radians (0 for other skies).
+    pub fn rotation(&self) -> Real {
+        match self {
             Sky::Environment {
                 rotation_degrees, ..
-            } => match self.environment() {
-                Some(map) => map.radiance(dir, rotation_degrees.to_radians()),
-                None => Vec3::ZERO,
-            },
+            } => rotation_degrees.to_radians(),
+            _ => 0.0,
         }
     }
 
@@ -594,12 +608,7 @@ pub fn trace_path(
     counts: &mut StageCounts,
 ) -> Vec3 {
     use crate::march::{march, normal, Ray};
-    let rotation = match &pt.sky {
-        Sky::Environment {
-            rotation_degrees, ..
-        } => rotation_degrees.to_radians(),
-        _ => 0.0,
-    };
+    let rotation = pt.sky.rotation();
     // Multiple importance sampling (power heuristic) between the map's own
     // sampling and the cosine-weighted bounce, when the sky is a map.
     let power = |a: Real, b: Real| a * a / (a * a + b * b);
@@ -666,7 +675,7 @@ pub fn trace_path(
                     let cos_pdf = here.normal.dot(dir).max(0.0) / std::f64::consts::PI;
                     map.radiance(dir, rotation) * power(cos_pdf, map.pdf(dir, rotation)) as f32
                 }
-                None => pt.sky.radiance(look, dir, up),
+                None => pt.sky.radiance(look, dir, up, None),
             };
             radiance += throughput * sky * sky_scale;
             break;

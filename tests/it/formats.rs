@@ -16,24 +16,10 @@ fn png_and_exr_decode_with_expected_channels() {
     assert_eq!((png.width(), png.height()), (48, 27));
     assert_eq!(png.color(), image::ColorType::Rgb8);
 
-    let exr = exr::prelude::read_all_flat_layers_from_file(d.path().join("out/t/frame_00000.exr"))
-        .unwrap();
-    let layer = &exr.layer_data[0];
-    assert_eq!((layer.size.0, layer.size.1), (48, 27));
-    let names: Vec<String> = layer
-        .channel_data
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
-    assert_eq!(names, ["A", "B", "G", "R", "Z"]);
-    let channel = |name: &str| -> Vec<f32> {
-        let i = names.iter().position(|n| n == name).unwrap();
-        layer.channel_data.list[i]
-            .sample_data
-            .values_as_f32()
-            .collect()
-    };
+    let exr = d.exr("out/t/frame_00000.exr");
+    assert_eq!(exr.size, (48, 27));
+    assert_eq!(exr.names(), ["A", "B", "G", "R", "Z"]);
+    let channel = |name: &str| exr.channel(name);
     let z = channel("Z");
     // Z is the camera distance: about 2 in the middle (camera 3 from the centre), huge for background.
     assert!(
@@ -70,15 +56,8 @@ fn extra_layers_are_written_only_when_asked() {
         "--aov",
         "normal,albedo,traps,steps",
     ]);
-    let exr = exr::prelude::read_all_flat_layers_from_file(d.path().join("out/t/frame_00000.exr"))
-        .unwrap();
-    let layer = &exr.layer_data[0];
-    let names: Vec<String> = layer
-        .channel_data
-        .list
-        .iter()
-        .map(|c| c.name.to_string())
-        .collect();
+    let exr = d.exr("out/t/frame_00000.exr");
+    let names = exr.names();
     for n in [
         "N.X",
         "N.Y",
@@ -93,15 +72,9 @@ fn extra_layers_are_written_only_when_asked() {
         "DE",
         "Z",
     ] {
-        assert!(names.iter().any(|c| c == n), "{n} missing from {names:?}");
+        assert!(names.contains(&n), "{n} missing from {names:?}");
     }
-    let channel = |name: &str| -> Vec<f32> {
-        let i = names.iter().position(|n| n == name).unwrap();
-        layer.channel_data.list[i]
-            .sample_data
-            .values_as_f32()
-            .collect()
-    };
+    let channel = |name: &str| exr.channel(name);
     let centre = 13 * 48 + 24;
     // The centre pixel sees the bulb: a unit normal facing the camera (+z side),
     // an albedo in range, and a cost of several estimates; the corner sees sky.

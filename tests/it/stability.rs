@@ -5,24 +5,11 @@ use crate::util::{stderr, Dir};
 
 /// Every channel of an EXR frame, checked finite; returns (alpha, depth).
 fn finite_channels(d: &Dir, rel: &str) -> (Vec<f32>, Vec<f32>) {
-    let image = exr::prelude::read_all_flat_layers_from_file(d.path().join(rel)).unwrap();
-    let layer = &image.layer_data[0];
-    let mut alpha = Vec::new();
-    let mut depth = Vec::new();
-    for ch in &layer.channel_data.list {
-        let v: Vec<f32> = ch.sample_data.values_as_f32().collect();
-        assert!(
-            v.iter().all(|x| x.is_finite()),
-            "{rel}: {} not finite",
-            ch.name
-        );
-        match ch.name.to_string().as_str() {
-            "A" => alpha = v,
-            "Z" => depth = v,
-            _ => {}
-        }
+    let exr = d.exr(rel);
+    for (name, v) in &exr.channels {
+        assert!(v.iter().all(|x| x.is_finite()), "{rel}: {name} not finite");
     }
-    (alpha, depth)
+    (exr.channel("A").to_vec(), exr.channel("Z").to_vec())
 }
 
 fn scene(body: &str) -> String {

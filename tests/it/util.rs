@@ -79,6 +79,46 @@ impl Dir {
     }
 }
 
+/// An EXR frame's channels, in file (alphabetical) order, as f32.
+pub struct ExrFrame {
+    pub size: (usize, usize),
+    pub channels: Vec<(String, Vec<f32>)>,
+}
+
+impl ExrFrame {
+    pub fn names(&self) -> Vec<&str> {
+        self.channels.iter().map(|(n, _)| n.as_str()).collect()
+    }
+
+    /// The samples of channel `name`; panics if it is missing.
+    pub fn channel(&self, name: &str) -> &[f32] {
+        &self
+            .channels
+            .iter()
+            .find(|(n, _)| n == name)
+            .unwrap_or_else(|| panic!("no channel {name} in {:?}", self.names()))
+            .1
+    }
+}
+
+impl Dir {
+    /// Reads the EXR file at `rel`.
+    pub fn exr(&self, rel: &str) -> ExrFrame {
+        let image = exr::prelude::read_all_flat_layers_from_file(self.path().join(rel))
+            .unwrap_or_else(|e| panic!("read {rel}: {e}"));
+        let layer = &image.layer_data[0];
+        ExrFrame {
+            size: (layer.size.0, layer.size.1),
+            channels: layer
+                .channel_data
+                .list
+                .iter()
+                .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
+                .collect(),
+        }
+    }
+}
+
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
