@@ -1,9 +1,10 @@
 //! Kernel benchmarks: each distance estimator in f64 and f32, and one
-//! power-8 triplex iteration by trigonometry versus Quilez's polynomial.
+//! power-8 triplex iteration by trigonometry, by Quilez's expanded polynomial
+//! and by complex squaring (the path the renderer takes).
 //! Run with `cargo bench`; CI only builds them.
 
 use mandelreel::fractal::{
-    power8_polynomial, triplex_power_trig, DeMethod, Formula, Fractal, Precision,
+    power8_polynomial, triplex_power_int, triplex_power_trig, DeMethod, Formula, Fractal, Precision,
 };
 use mandelreel::math::DVec3;
 
@@ -44,11 +45,18 @@ fn estimate_f32(bencher: divan::Bencher, de: DeMethod) {
 }
 
 fn bench_estimate(bencher: divan::Bencher, de: DeMethod, precision: Precision) {
-    let f = Fractal {
-        de,
-        precision,
-        ..Fractal::default()
-    };
+    bench_fractal(
+        bencher,
+        Fractal {
+            de,
+            precision,
+            ..Fractal::default()
+        },
+    );
+}
+
+/// Analytic estimates of `f` at the benchmark points.
+fn bench_fractal(bencher: divan::Bencher, f: Fractal) {
     let pts = points();
     bencher
         .counter(divan::counter::ItemsCount::new(pts.len()))
@@ -59,29 +67,49 @@ fn bench_estimate(bencher: divan::Bencher, de: DeMethod, precision: Precision) {
         });
 }
 
-#[divan::bench(types = [f64, f32])]
-fn power8_trig<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
+/// One power-8 step at each benchmark point, by `power` (returning one component).
+fn bench_power<T: mandelreel::math::Number + Sync>(
+    bencher: divan::Bencher,
+    power: impl Fn([T; 3]) -> f64 + Sync,
+) {
     let pts = triplexes::<T>();
     bencher
         .counter(divan::counter::ItemsCount::new(pts.len()))
-        .bench(|| {
-            pts.iter()
-                .map(|&z| {
-                    let r = (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt();
-                    triplex_power_trig(Formula::Quilez, divan::black_box(z), r, 8.0)[1].value()
-                })
-                .sum::<f64>()
-        });
+        .bench(|| pts.iter().map(|&z| power(divan::black_box(z))).sum::<f64>());
+}
+
+#[divan::bench(types = [f64, f32])]
+fn power8_trig<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
+    bench_power::<T>(bencher, |z| {
+        let r = (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt();
+        triplex_power_trig(Formula::Quilez, z, r, 8.0)[1].value()
+    });
 }
 
 #[divan::bench(types = [f64, f32])]
 fn power8_polynomial_form<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
-    let pts = triplexes::<T>();
-    bencher
-        .counter(divan::counter::ItemsCount::new(pts.len()))
-        .bench(|| {
-            pts.iter()
-                .map(|&z| power8_polynomial(divan::black_box(z)).map_or(0.0, |w| w[1].value()))
-                .sum::<f64>()
-        });
+    bench_power::<T>(bencher, |z| {
+        power8_polynomial(z).map_or(0.0, |w| w[1].value())
+    });
+}
+
+#[divan::bench(types = [f64, f32])]
+fn power8_complex_squaring<T: mandelreel::math::Number + Sync>(bencher: divan::Bencher) {
+    bench_power::<T>(bencher, |z| {
+        triplex_power_int(Formula::Quilez, z, 8).map_or(0.0, |w| w[1].value())
+    });
+}
+
+const FORMULAS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+
+/// The analytic estimate in each convention (all take the whole-power path).
+#[divan::bench(args = FORMULAS)]
+fn estimate_formula(bencher: divan::Bencher, formula: Formula) {
+    bench_fractal(
+        bencher,
+        Fractal {
+            formula,
+            ..Fractal::default()
+        },
+    );
 }

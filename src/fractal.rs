@@ -181,10 +181,84 @@ pub fn triplex_power_trig<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: R
     }
 }
 
-/// Quilez's trig-free power 8 in the y-up convention (seed 000, "Optimizing"):
-/// the angle-doubling identities applied three times. Returns `None` within a
-/// relative 1e-6 of the pole axis (x = z = 0), where it divides by (x² + z²)^3.5;
-/// the caller then uses the trigonometric form, which is exact there.
+/// `x` to the integer power `n` ≥ 1 by repeated squaring: about 2·log₂(n)
+/// multiplications where `powf` calls `exp(n·ln x)`; with `n` a constant
+/// the loops unroll into straight-line code.
+#[inline(always)]
+pub fn powi<T: Copy>(x: T, n: u32, mul: impl Fn(T, T) -> T) -> T {
+    debug_assert!(n >= 1);
+    let (mut base, mut k) = (x, n.max(1));
+    while k & 1 == 0 {
+        base = mul(base, base);
+        k >>= 1;
+    }
+    let mut result = base;
+    k >>= 1;
+    while k > 0 {
+        base = mul(base, base);
+        if k & 1 == 1 {
+            result = mul(result, base);
+        }
+        k >>= 1;
+    }
+    result
+}
+
+/// The complex number (re, im) to the integer power `n` ≥ 1.
+#[inline(always)]
+fn complex_powi<T: Number>(re: T, im: T, n: u32) -> (T, T) {
+    powi((re, im), n, |(a, b), (c, d)| (a * c - b * d, a * d + b * c))
+}
+
+/// The integer power `n` of a point whose exponent is a whole number, with no
+/// trigonometry: the spherical power multiplies both angles by n, and an angle
+/// times n is the argument of a complex number to the n-th power (de Moivre).
+/// The polar angle comes from (pole, ρ) as one complex number, the azimuth
+/// from the unit vector of the equatorial pair as another, where ρ is the
+/// distance from the pole axis; multiplying them out gives the three
+/// conventions of seed 000 with the trigonometric form's exact result. For
+/// n = 8 that is three complex squarings each, cheaper than Quilez's
+/// expanded polynomial, which this replaces. Returns `None` within a relative
+/// 1e-6 of the pole axis, where the azimuth is undefined; the caller then
+/// uses the trigonometric form, which is exact there.
+#[inline(always)]
+pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> Option<Triplex<T>> {
+    let [x, y, zz] = z;
+    // The pole coordinate and the equatorial pair whose angle is the azimuth.
+    let (pole, (e1, e2)) = match formula {
+        Formula::Quilez => (y, (zz, x)),
+        Formula::WhiteNylander | Formula::Asin => (zz, (x, y)),
+    };
+    let rho2 = e1 * e1 + e2 * e2;
+    let r2 = rho2 + pole * pole;
+    let off_axis = rho2.value() > 1e-12 * r2.value();
+    if !off_axis || !r2.value().is_finite() {
+        return None;
+    }
+    let rho = rho2.sqrt();
+    let inv_rho = T::from_real(1.0) / rho;
+    // cos nφ + i sin nφ.
+    let (cp, sp) = complex_powi(e1 * inv_rho, e2 * inv_rho, n);
+    let out = match formula {
+        Formula::Quilez | Formula::WhiteNylander => {
+            // θ from the pole: rⁿ(cos nθ + i sin nθ) = (pole + iρ)ⁿ.
+            let (rc, rs) = complex_powi(pole, rho, n);
+            match formula {
+                Formula::Quilez => [rs * sp, rc, rs * cp],
+                _ => [rs * cp, rs * sp, rc],
+            }
+        }
+        Formula::Asin => {
+            // θ from the equator: rⁿ(cos nθ + i sin nθ) = (ρ + i·pole)ⁿ.
+            let (rc, rs) = complex_powi(rho, pole, n);
+            [rc * cp, rc * sp, rs]
+        }
+    };
+    out.iter().all(|v| v.value().is_finite()).then_some(out)
+}
+
+/// Quilez's expanded power-8 polynomial (seed 000, "Optimizing"), kept only
+/// so the kernel benchmark can compare it with `triplex_power_int`.
 #[inline]
 pub fn power8_polynomial<T: Number>(w: Triplex<T>) -> Option<Triplex<T>> {
     let [x, y, z] = w;
@@ -215,23 +289,36 @@ pub fn power8_polynomial<T: Number>(w: Triplex<T>) -> Option<Triplex<T>> {
     out.iter().all(|v| v.value().is_finite()).then_some(out)
 }
 
-/// The triplex power, taking the polynomial fast path for power 8 where one exists.
+/// The triplex power: the trigonometry-free path for whole exponents where it
+/// applies, the trigonometric form otherwise.
 #[inline]
 pub fn triplex_power<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: Real) -> Triplex<T> {
-    if n == 8.0 {
-        // White–Nylander is Quilez with axes relabelled: WN (x, y, z) = Quilez (y, z, x).
-        let fast = match formula {
-            Formula::Quilez => power8_polynomial(z),
-            Formula::WhiteNylander => {
-                power8_polynomial([z[1], z[2], z[0]]).map(|q| [q[2], q[0], q[1]])
-            }
-            Formula::Asin => None,
-        };
-        if let Some(w) = fast {
+    if let Some(k) = whole_power(n) {
+        if let Some(w) = triplex_power_int(formula, z, k) {
             return w;
         }
     }
     triplex_power_trig(formula, z, r, n)
+}
+
+/// `n` as a whole number in 2..=64, if it is one.
+#[inline]
+pub fn whole_power(n: Real) -> Option<u32> {
+    (n.fract() == 0.0 && (2.0..=64.0).contains(&n)).then_some(n as u32)
+}
+
+/// One power step for a whole exponent `n`: (zⁿ, rⁿ⁻¹), the second for the
+/// running derivative, both without `powf` or trigonometry off the pole axis.
+#[inline(always)]
+fn whole_power_step<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: u32) -> (Triplex<T>, T) {
+    let w = triplex_power_int(formula, z, n)
+        .unwrap_or_else(|| triplex_power_trig(formula, z, r, n as Real));
+    let r_n_minus_1 = if n > 1 {
+        powi(r, n - 1, |a, b| a * b)
+    } else {
+        T::from_real(1.0)
+    };
+    (w, r_n_minus_1)
 }
 
 /// The end of one orbit.
@@ -263,7 +350,32 @@ impl Fractal {
     /// escape-length gradient needs). Pure and allocation-free: the innermost loop.
     #[inline]
     pub fn orbit<T: Number>(&self, p: Triplex<T>, limit: u32, stop_at_bailout: bool) -> Orbit<T> {
-        let n = self.power;
+        let (formula, n) = (self.formula, self.power);
+        // One copy of the loop per kind of exponent, so the classic power 8
+        // unrolls into straight-line code.
+        match whole_power(n) {
+            Some(8) => self.orbit_with(p, limit, stop_at_bailout, |z, r| {
+                whole_power_step(formula, z, r, 8)
+            }),
+            Some(k) => self.orbit_with(p, limit, stop_at_bailout, |z, r| {
+                whole_power_step(formula, z, r, k)
+            }),
+            None => self.orbit_with(p, limit, stop_at_bailout, |z, r| {
+                (triplex_power_trig(formula, z, r, n), r.powf(n - 1.0))
+            }),
+        }
+    }
+
+    /// The orbit loop, given the power step: (z, |z|) ↦ (zⁿ, |z|ⁿ⁻¹).
+    #[inline(always)]
+    fn orbit_with<T: Number>(
+        &self,
+        p: Triplex<T>,
+        limit: u32,
+        stop_at_bailout: bool,
+        power: impl Fn(Triplex<T>, T) -> (Triplex<T>, T),
+    ) -> Orbit<T> {
+        let n = T::from_real(self.power);
         let (c, plus_one) = match self.julia {
             Some(k) => (
                 [T::from_real(k.x), T::from_real(k.y), T::from_real(k.z)],
@@ -271,6 +383,7 @@ impl Fractal {
             ),
             None => (p, 1.0),
         };
+        let plus_one = T::from_real(plus_one);
         let mut z = p;
         let mut dr = T::from_real(1.0);
         let mut r = length(z);
@@ -286,8 +399,8 @@ impl Fractal {
             let zv = DVec3::new(z[0].value(), z[1].value(), z[2].value());
             traps.origin = traps.origin.min(zv.length_squared());
             traps.planes = traps.planes.min(zv.abs());
-            dr = T::from_real(n) * r.powf(n - 1.0) * dr + T::from_real(plus_one);
-            let w = triplex_power(self.formula, z, r, n);
+            let (w, r_n_minus_1) = power(z, r);
+            dr = n * r_n_minus_1 * dr + plus_one;
             z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
             r = length(z);
             i += 1;
@@ -656,30 +769,47 @@ mod tests {
     }
 
     #[test]
-    fn power8_polynomial_matches_trigonometric_form_off_axis() {
-        for p in points(2000, 0.05..3.0, 11) {
+    fn whole_powers_match_the_trigonometric_form_in_every_convention() {
+        let formulas = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+        for (i, p) in points(1500, 0.05..3.0, 11).into_iter().enumerate() {
             let z = [p.x, p.y, p.z];
-            // Skip the cone within 1e-3 rad of the y axis, where the polynomial hands over.
-            if (p.x * p.x + p.z * p.z).sqrt() < 1e-3 * p.length() {
-                continue;
+            let r = p.length();
+            for formula in formulas {
+                for n in [2, 3, 5, 8, 9, 16] {
+                    let Some(fast) = triplex_power_int(formula, z, n) else {
+                        continue; // within 1e-6 of this convention's pole axis
+                    };
+                    let trig = triplex_power_trig(formula, z, r, n as Real);
+                    let scale = r.powi(n as i32);
+                    for k in 0..3 {
+                        assert!(
+                            (fast[k] - trig[k]).abs() <= 1e-12 * scale,
+                            "{formula:?} n={n} at {p}: {fast:?} vs {trig:?}"
+                        );
+                    }
+                }
             }
-            let fast = power8_polynomial(z).expect("off axis");
-            let trig = triplex_power_trig(Formula::Quilez, z, p.length(), 8.0);
-            let scale = p.length().powi(8);
-            for k in 0..3 {
-                assert!(
-                    (fast[k] - trig[k]).abs() <= 1e-12 * scale,
-                    "{p}: {fast:?} vs {trig:?}"
-                );
-            }
-            // White–Nylander's fast path through the axis relabelling agrees too.
-            let wn = triplex_power(Formula::WhiteNylander, [p.z, p.x, p.y], p.length(), 8.0);
-            let wn_trig =
-                triplex_power_trig(Formula::WhiteNylander, [p.z, p.x, p.y], p.length(), 8.0);
-            for k in 0..3 {
-                assert!((wn[k] - wn_trig[k]).abs() <= 1e-12 * scale);
+            // Quilez's expanded polynomial, kept for the benchmark, agrees too.
+            if i % 3 == 0 {
+                if let Some(poly) = power8_polynomial(z) {
+                    let fast = triplex_power_int(Formula::Quilez, z, 8).expect("off axis");
+                    for k in 0..3 {
+                        assert!((poly[k] - fast[k]).abs() <= 1e-12 * r.powi(8));
+                    }
+                }
             }
         }
+        // The integer power by squaring is exact for small integers.
+        for n in 1..=20 {
+            assert_eq!(
+                powi(3.0, n, |a, b| a * b),
+                Real::powi(3.0, n as i32),
+                "3^{n}"
+            );
+        }
+        assert_eq!(whole_power(8.0), Some(8));
+        assert_eq!(whole_power(7.5), None);
+        assert_eq!(whole_power(1.0), None);
     }
 
     #[test]
@@ -691,6 +821,20 @@ mod tests {
             assert!((w[1] - Real::powi(y, 8)).abs() < 1e-15, "{w:?}");
         }
         assert!(power8_polynomial([0.0, 0.5, 0.0]).is_none());
+        for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+            let pole: Triplex<Real> = if formula == Formula::Quilez {
+                [0.0, 0.5, 0.0]
+            } else {
+                [0.0, 0.0, 0.5]
+            };
+            assert!(triplex_power_int(formula, pole, 8).is_none(), "{formula:?}");
+            // The pole itself takes the trigonometric form, finite there.
+            let w = triplex_power(formula, pole, 0.5, 8.0);
+            assert!(w.iter().all(|v| v.is_finite()), "{formula:?}: {w:?}");
+            assert!(
+                (w.iter().map(|v| v * v).sum::<Real>().sqrt() - Real::powi(0.5, 8)).abs() < 1e-15
+            );
+        }
     }
 
     /// Distance from `p` to the set along `dir`, by dense membership stepping
