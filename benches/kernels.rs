@@ -113,3 +113,33 @@ fn estimate_formula(bencher: divan::Bencher, formula: Formula) {
         },
     );
 }
+
+/// The analytic estimate at the same points, `N` at a time through the lanes.
+#[divan::bench(consts = [1, 2, 4, 8])]
+fn estimate_lanes<const N: usize>(bencher: divan::Bencher) {
+    bench_lanes::<N>(bencher, points(), 1);
+}
+
+/// Orbits that never escape (points deep inside): the cost of 12 iterations,
+/// counted per iteration.
+#[divan::bench(consts = [1, 4])]
+fn inside_lanes<const N: usize>(bencher: divan::Bencher) {
+    bench_lanes::<N>(bencher, points().iter().map(|p| *p * 0.4).collect(), 12);
+}
+
+fn bench_lanes<const N: usize>(bencher: divan::Bencher, pts: Vec<DVec3>, items_per_point: usize) {
+    let f = Fractal::default();
+    bencher
+        .counter(divan::counter::ItemsCount::new(pts.len() * items_per_point))
+        .bench(|| {
+            pts.chunks_exact(N)
+                .map(|c| {
+                    let p: [DVec3; N] = std::array::from_fn(|k| c[k]);
+                    f.estimate_lanes(divan::black_box(p), [1e-4; N])
+                        .iter()
+                        .map(|e| e.distance)
+                        .sum::<f64>()
+                })
+                .sum::<f64>()
+        });
+}

@@ -59,8 +59,8 @@ pub struct Measurement {
 
 /// The scene with every knob set high: the reference. Twice the iterations
 /// (at least 8 more), a bailout of at least 16, the analytic estimator in
-/// f64, hit threshold ÷ 8, fudge ≤ 0.5, 8× the steps, normal step ÷ 4 and at
-/// least 16 samples per pixel.
+/// f64, hit threshold ÷ 8, fudge ≤ 0.5, no over-relaxation, 8× the steps,
+/// normal step ÷ 4 and at least 16 samples per pixel.
 pub fn reference_scene(scene: &Scene) -> Scene {
     let mut r = scene.clone();
     let f = &scene.fractal;
@@ -74,6 +74,7 @@ pub fn reference_scene(scene: &Scene) -> Scene {
     r.quality.fudge = scene.quality.fudge.min(0.5);
     r.quality.max_steps = scene.quality.max_steps.saturating_mul(8);
     r.quality.normal_step = scene.quality.normal_step / 4.0;
+    r.quality.over_relaxation = 1.0;
     r.samples_per_pixel = scene.samples_per_pixel.max(16);
     r
 }
@@ -144,6 +145,11 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     }
     for v in [0.5, 0.7, 1.0] {
         add("fudge", format!("{v}"), &|s| s.quality.fudge = v);
+    }
+    for v in [1.2, 1.5, 1.8] {
+        add("over_relaxation", format!("{v}"), &|s| {
+            s.quality.over_relaxation = v
+        });
     }
     for k in [0.25, 0.5, 2.0] {
         let v = scaled(q.max_steps, k);

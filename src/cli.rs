@@ -58,6 +58,51 @@ pub enum Command {
     /// Measure what accuracy costs: sweep every quality knob, distance estimator and
     /// precision on one frame against a reference; write accuracy.csv, .md and .png.
     Accuracy(AccuracyArgs),
+    /// Time the benchmark scenes (timelines/bench) against Mandelbulber2 where it is
+    /// installed, measure the kernel against the FMA peak, thread scaling and peak
+    /// memory; write bench/results/<machine>.csv and .md.
+    Bench(BenchArgs),
+    /// Run a program and print its wall time and peak memory as JSON (used by `bench`).
+    #[command(hide = true)]
+    Measure {
+        program: PathBuf,
+        #[arg(trailing_var_arg = true, allow_hyphen_values = true)]
+        args: Vec<String>,
+    },
+}
+
+#[derive(Debug, clap::Args)]
+pub struct BenchArgs {
+    /// Folder of benchmark timelines.
+    #[arg(long, default_value = "timelines/bench")]
+    pub scenes: PathBuf,
+    /// Folder of the matching Mandelbulber2 settings files (<timeline name>.fract).
+    #[arg(long, default_value = "bench/mandelbulber2")]
+    pub fract_dir: PathBuf,
+    /// The Mandelbulber2 program; compared only if it runs.
+    #[arg(long, default_value = "mandelbulber2")]
+    pub mandelbulber: PathBuf,
+    /// Skip Mandelbulber2 even if it is installed.
+    #[arg(long)]
+    pub no_mandelbulber: bool,
+    /// Runs of each renderer per scene (alternating); medians are reported.
+    #[arg(long, default_value_t = 5)]
+    pub runs: usize,
+    /// Thread counts for the scaling rows, comma-separated [default: 1, 2, 4, … up to all cores].
+    #[arg(long, value_delimiter = ',')]
+    pub threads: Vec<usize>,
+    /// Size of the peak-memory EXR render, or `none` to skip it.
+    #[arg(long, default_value = "3840x2160")]
+    pub memory_size: String,
+    /// Folder for <machine>.csv and <machine>.md.
+    #[arg(long, default_value = "bench/results")]
+    pub results: PathBuf,
+    /// Name of this machine in the results [default: cores and CPU model].
+    #[arg(long)]
+    pub machine: Option<String>,
+    /// No progress lines; the table is still printed.
+    #[arg(long, short)]
+    pub quiet: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -213,6 +258,15 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sheet(args) => sheet(args),
         Command::Status(args) => status(args),
         Command::Accuracy(args) => accuracy(args),
+        Command::Bench(args) => bench(args),
+        Command::Measure { program, args } => {
+            let m = crate::bench::measure_child(&program, &args)?;
+            println!(
+                "{}",
+                serde_json::to_string(&m).expect("a measurement serialises")
+            );
+            Ok(())
+        }
     }
 }
 
@@ -471,11 +525,25 @@ impl Plan {
         let n = scenes[0].samples_per_pixel.max(1);
         let layers = self.layers();
         let checkpoint = output::checkpoint_path(&self.out_dir, frame);
-        let mut acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
-            .filter(|a| a.samples_done < n)
+        let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
+            .filter(|a| a.samples_done < n);
+        let wave = wave_size(n);
+        if saved_acc.is_none() && wave >= n {
+            // One wave: nothing to checkpoint, so render band by band without
+            // the whole frame's running sums (the same pixels in less memory).
+            let film = crate::render::render_frame_in_time(
+                scenes,
+                frame,
+                self.width,
+                self.height,
+                layers,
+                on_row,
+            );
+            return self.write_film(frame, &film, hash).map(|stats| (stats, 0));
+        }
+        let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
         let resumed = acc.samples_done;
-        let wave = wave_size(n);
         let mut saved = Instant::now();
         while acc.samples_done < n {
             let until = (acc.samples_done + wave).min(n);
@@ -486,11 +554,22 @@ impl Plan {
             }
         }
         let film = acc.finish(n);
+        self.write_film(frame, &film, hash)
+            .map(|stats| (stats, resumed))
+    }
+
+    /// Writes every format of a finished frame and drops its checkpoint.
+    fn write_film(
+        &self,
+        frame: u32,
+        film: &crate::render::Film,
+        hash: &str,
+    ) -> anyhow::Result<FrameStats> {
         for &f in &self.formats {
-            output::write_frame(&self.path(frame, f), f, &film, hash, &self.aovs)?;
+            output::write_frame(&self.path(frame, f), f, film, hash, &self.aovs)?;
         }
-        let _ = std::fs::remove_file(&checkpoint);
-        Ok((film.stats, resumed))
+        let _ = std::fs::remove_file(output::checkpoint_path(&self.out_dir, frame));
+        Ok(film.stats)
     }
 }
 
@@ -1315,6 +1394,70 @@ fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         shown.len(),
         frames.len(),
         out.display()
+    );
+    Ok(())
+}
+
+/// `bench`: checks the options, runs the benchmark, prints the tables.
+fn bench(args: BenchArgs) -> anyhow::Result<()> {
+    let peak = crate::bench::Peak::detect();
+    let memory_size = match args.memory_size.as_str() {
+        "none" => None,
+        text => Some(parse_size("--memory-size", text)?),
+    };
+    if args.runs == 0 {
+        return Err(Error::usage("--runs", "must be at least 1").into());
+    }
+    let threads = if args.threads.is_empty() {
+        let mut t: Vec<usize> = std::iter::successors(Some(1), |n| Some(n * 2))
+            .take_while(|&n| n < peak.cores)
+            .collect();
+        t.push(peak.cores);
+        t
+    } else {
+        args.threads.clone()
+    };
+    if threads.contains(&0) {
+        return Err(Error::usage("--threads", "thread counts must be at least 1").into());
+    }
+    let mandelbulber = (!args.no_mandelbulber)
+        .then(|| {
+            std::process::Command::new(&args.mandelbulber)
+                .arg("--version")
+                .stdout(std::process::Stdio::null())
+                .stderr(std::process::Stdio::null())
+                .status()
+                .is_ok_and(|s| s.success())
+                .then(|| args.mandelbulber.clone())
+        })
+        .flatten();
+    if mandelbulber.is_none() && !args.quiet {
+        eprintln!(
+            "Mandelbulber2 not compared ({}): install it (Debian: apt-get install mandelbulber2) for the A/B rows",
+            if args.no_mandelbulber { "--no-mandelbulber" } else { "not found" }
+        );
+    }
+    let options = crate::bench::Options {
+        scenes: args.scenes,
+        fract_dir: args.fract_dir,
+        mandelbulber,
+        runs: args.runs,
+        threads,
+        memory_size,
+        results: args.results.clone(),
+        machine: args
+            .machine
+            .unwrap_or_else(|| crate::bench::default_machine_name(&peak)),
+        quiet: args.quiet,
+    };
+    let md = crate::bench::run_and_write(&options)?;
+    println!("{md}");
+    println!(
+        "written: {}",
+        options
+            .results
+            .join(format!("{}.csv", options.machine))
+            .display()
     );
     Ok(())
 }

@@ -1,11 +1,12 @@
 //! mandelreel: keyframed Mandelbulb films from RON timelines.
 //!
 //! Layers, each depending only on those after it:
-//! `cli → accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`.
+//! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`.
 
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
+pub mod bench;
 pub mod claim;
 pub mod cli;
 pub mod environment;
@@ -20,4 +21,4 @@ pub mod shade;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.
-pub const RENDERER_REVISION: u32 = 2;
+pub const RENDERER_REVISION: u32 = 3;

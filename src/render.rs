@@ -67,6 +67,9 @@ pub struct FrameStats {
     pub hits: u64,
     /// The most evaluations any one pixel took.
     pub max_pixel_evaluations: u64,
+    /// Orbit iterations over every stage: the kernel's unit of work.
+    #[serde(default)]
+    pub de_iterations: u64,
     /// Samples whose colour came out NaN or infinite and were replaced by
     /// black. Every known cause is guarded upstream, so this should stay 0;
     /// debug builds stop at the first one instead.
@@ -99,6 +102,7 @@ impl std::ops::Add for FrameStats {
             samples: self.samples + o.samples,
             hits: self.hits + o.hits,
             max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
+            de_iterations: self.de_iterations + o.de_iterations,
             repaired_samples: self.repaired_samples + o.repaired_samples,
         }
     }
@@ -154,10 +158,52 @@ pub fn render_frame_in_time(
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
     let n = scenes[0].samples_per_pixel.max(1);
-    let mut acc = Accumulation::new(width, height, layers);
-    render_samples(scenes, frame_index, &mut acc, n, on_row);
-    acc.finish(n)
+    // In bands of rows, so the running sums (f64 colour and counters, twice
+    // the film's size per pixel) exist for one band at a time, not the frame.
+    let pixels = width as usize * height as usize;
+    let mut film = Film {
+        width,
+        height,
+        colour: Vec::with_capacity(pixels),
+        alpha: Vec::with_capacity(pixels),
+        depth: Vec::with_capacity(pixels),
+        evaluations: Vec::with_capacity(pixels),
+        normal: layers.normal.then(|| Vec::with_capacity(pixels)),
+        albedo: layers.albedo.then(|| Vec::with_capacity(pixels)),
+        traps: layers.traps.then(|| Vec::with_capacity(pixels)),
+        stats: FrameStats::default(),
+    };
+    let mut first_row = 0;
+    while first_row < height {
+        let rows = BAND_ROWS.min(height - first_row);
+        let mut acc = Accumulation::new(width, rows, layers);
+        render_rows(scenes, frame_index, &mut acc, n, first_row, height, on_row);
+        let band = acc.finish(n);
+        film.colour.extend(band.colour);
+        film.alpha.extend(band.alpha);
+        film.depth.extend(band.depth);
+        film.evaluations.extend(band.evaluations);
+        for (all, part) in [
+            (&mut film.normal, band.normal),
+            (&mut film.albedo, band.albedo),
+        ] {
+            if let (Some(all), Some(part)) = (all.as_mut(), part) {
+                all.extend(part);
+            }
+        }
+        if let (Some(all), Some(part)) = (film.traps.as_mut(), band.traps) {
+            all.extend(part);
+        }
+        let max_pixel = film.stats.max_pixel_evaluations;
+        film.stats = film.stats + band.stats;
+        film.stats.max_pixel_evaluations = max_pixel.max(band.stats.max_pixel_evaluations);
+        first_row += rows;
+    }
+    film
 }
+
+/// Rows per band of a frame rendered in one go: a few per thread on 16 cores.
+const BAND_ROWS: u32 = 64;
 
 /// A frame in progress: per-pixel running sums over the samples done so far,
 /// enough to continue it later. Samples are always added to a pixel in
@@ -269,7 +315,23 @@ pub fn render_samples(
     until: u32,
     on_row: &(dyn Fn() + Sync),
 ) {
-    let (width, height) = (acc.width, acc.height);
+    let height = acc.height;
+    render_rows(scenes, frame_index, acc, until, 0, height, on_row);
+}
+
+/// Adds samples to `acc`, which holds the band of rows starting at image row
+/// `first_row` of an image `image_height` rows high.
+fn render_rows(
+    scenes: &[Scene],
+    frame_index: u32,
+    acc: &mut Accumulation,
+    until: u32,
+    first_row: u32,
+    image_height: u32,
+    on_row: &(dyn Fn() + Sync),
+) {
+    let (width, band_height) = (acc.width, acc.height);
+    let height = image_height;
     let cameras: Vec<_> = scenes.iter().map(|s| s.camera.frame()).collect();
     let n = scenes[0].samples_per_pixel.max(1);
     let first = acc.samples_done;
@@ -299,9 +361,17 @@ pub fn render_samples(
         .zip(acc.hits.par_chunks_mut(w))
         .zip(acc.depth.par_chunks_mut(w))
         .zip(acc.spent.par_chunks_mut(w))
-        .zip(optional_rows(&mut acc.normal, chunk(normal_on), height))
-        .zip(optional_rows(&mut acc.albedo, chunk(albedo_on), height))
-        .zip(optional_rows(&mut acc.traps, chunk(traps_on), height))
+        .zip(optional_rows(
+            &mut acc.normal,
+            chunk(normal_on),
+            band_height,
+        ))
+        .zip(optional_rows(
+            &mut acc.albedo,
+            chunk(albedo_on),
+            band_height,
+        ))
+        .zip(optional_rows(&mut acc.traps, chunk(traps_on), band_height))
         .enumerate()
         .map(
             |(
@@ -314,7 +384,11 @@ pub fn render_samples(
                     mut traps_row,
                 ),
             )| {
+                let y = y + first_row as usize;
                 let mut stats = FrameStats::default();
+                // A row runs start to end on one thread, so this thread's
+                // count of orbit iterations measures exactly the row's.
+                let iterations_before = crate::fractal::iterations_on_this_thread();
                 for x in 0..w {
                     let pixel = (y * w + x) as u64;
                     let before = stats.stage_total();
@@ -375,6 +449,8 @@ pub fn render_samples(
                     }
                     spent_row[x] += stats.stage_total() - before;
                 }
+                stats.de_iterations +=
+                    crate::fractal::iterations_on_this_thread() - iterations_before;
                 on_row();
                 stats
             },

@@ -105,6 +105,7 @@ pub const PARAMETERS: &[(&str, usize)] = &[
     ("quality.max_steps", 1),
     ("quality.normal_step", 1),
     ("quality.bounding_radius", 1),
+    ("quality.over_relaxation", 1),
     ("look.light_direction", 3),
     ("look.light_colour", 3),
     ("look.ambient", 3),
@@ -162,6 +163,7 @@ fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
         "quality.max_steps" => q.max_steps = count(),
         "quality.normal_step" => q.normal_step = v[0],
         "quality.bounding_radius" => q.bounding_radius = v[0],
+        "quality.over_relaxation" => q.over_relaxation = v[0],
         "look.light_direction" => l.light_direction = triple(),
         "look.light_colour" => l.light_colour = colour(),
         "look.ambient" => l.ambient = colour(),
@@ -707,6 +709,11 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
         "quality.fudge",
         format!("must be in (0, 1], got {}", q.fudge),
+    )?;
+    check(
+        q.over_relaxation.is_finite() && (1.0..2.0).contains(&q.over_relaxation),
+        "quality.over_relaxation",
+        format!("must be in [1, 2), got {}", q.over_relaxation),
     )?;
     check(
         (1..=1_000_000).contains(&q.max_steps),

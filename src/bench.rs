@@ -1,0 +1,788 @@
+//! `mandelreel bench`: whole renders timed against Mandelbulber2 on the same
+//! frames, the distance-estimator kernel measured against the machine's
+//! floating-point peak, thread scaling and peak memory; written to
+//! bench/results/<machine>.csv and a Markdown table for the README.
+//!
+//! Every render runs in its own process, timed from spawn to exit (start-up,
+//! parsing and PNG encoding included: what a user waits for), under a small
+//! `mandelreel measure` wrapper whose only child it is, so the wrapper's
+//! `getrusage(RUSAGE_CHILDREN)` is that render's peak resident memory.
+//! mandelreel and Mandelbulber2 runs alternate (A B, B A, …) so drift in the
+//! machine's speed falls on both alike; medians are reported.
+
+use crate::error::{Error, Result};
+use crate::render::{render_frame_in_time, FrameStats, Layers};
+use crate::timeline::Timeline;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+use std::time::Instant;
+
+/// Floating-point operations in one power-8 orbit iteration of the
+/// whole-power path (`Fractal::orbit`), counted from the code, with a
+/// multiply, add, divide or square root each one operation:
+/// orbit-trap update 5; triplex power 48 (radii 6, the axis test 1, the unit
+/// azimuth vector 3, two complex eighth powers by three squarings of 6 each
+/// 36, the output 2); r⁷ 4; running derivative 3; adding c 3; |z| 6.
+pub const FLOPS_PER_POWER8_ITERATION: u64 = 69;
+
+/// Pixels of the frame the memory measurement renders (4K UHD).
+pub const MEMORY_SIZE: (u32, u32) = (3840, 2160);
+
+/// What the bench is asked to do.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Folder of benchmark timelines (`timelines/bench`).
+    pub scenes: PathBuf,
+    /// Folder of the matching Mandelbulber2 settings (`bench/mandelbulber2`).
+    pub fract_dir: PathBuf,
+    /// The Mandelbulber2 program, when it is to be compared.
+    pub mandelbulber: Option<PathBuf>,
+    /// A/B pairs per scene.
+    pub runs: usize,
+    /// Thread counts for the scaling rows (on the first scene).
+    pub threads: Vec<usize>,
+    /// Size of the peak-memory render; `None` skips it.
+    pub memory_size: Option<(u32, u32)>,
+    /// Where `<machine>.csv` and `<machine>.md` go.
+    pub results: PathBuf,
+    pub machine: String,
+    pub quiet: bool,
+}
+
+/// The machine's floating-point peak, from what the CPU reports.
+#[derive(Clone, Debug, Serialize)]
+pub struct Peak {
+    pub cpu: String,
+    pub cores: usize,
+    pub clock_ghz: f64,
+    /// f64 lanes of the widest vector unit (8 with AVX-512, 4 with AVX2, 2 with SSE2).
+    pub lanes: u32,
+    /// FMA units per core (2 on current x86 server cores; an assumption).
+    pub fma_units: u32,
+}
+
+impl Peak {
+    /// cores × FMA units × lanes × 2 flops × clock, in GFLOP/s.
+    pub fn gflops(&self) -> f64 {
+        self.cores as f64 * self.fma_units as f64 * self.lanes as f64 * 2.0 * self.clock_ghz
+    }
+
+    /// Reads the CPU model, clock and vector width of this machine.
+    pub fn detect() -> Peak {
+        let cpuinfo = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+        let field = |name: &str| {
+            cpuinfo
+                .lines()
+                .find(|l| l.starts_with(name))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        };
+        let clock_ghz = field("cpu MHz")
+            .and_then(|v| v.parse::<f64>().ok())
+            .map_or(0.0, |mhz| mhz / 1000.0);
+        Peak {
+            cpu: field("model name").unwrap_or_else(|| std::env::consts::ARCH.to_string()),
+            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            clock_ghz,
+            lanes: vector_lanes(),
+            fma_units: 2,
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+fn vector_lanes() -> u32 {
+    if std::arch::is_x86_feature_detected!("avx512f") {
+        8
+    } else if std::arch::is_x86_feature_detected!("avx2") {
+        4
+    } else {
+        2
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+fn vector_lanes() -> u32 {
+    2 // 128-bit vectors (NEON and the like)
+}
+
+/// One timed process: wall seconds and peak resident memory.
+#[derive(Clone, Copy, Debug, Serialize, Deserialize)]
+pub struct Measurement {
+    pub wall_s: f64,
+    pub peak_rss_kib: u64,
+    pub exit_code: i32,
+}
+
+/// Runs `program args…` as the only child of this process and measures it:
+/// the body of the hidden `measure` subcommand.
+pub fn measure_child(program: &Path, args: &[String]) -> Result<Measurement> {
+    let start = Instant::now();
+    let status = Command::new(program)
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .status()
+        .map_err(|e| Error::io(program, e))?;
+    let wall_s = start.elapsed().as_secs_f64();
+    Ok(Measurement {
+        wall_s,
+        peak_rss_kib: children_peak_rss_kib(),
+        exit_code: status.code().unwrap_or(-1),
+    })
+}
+
+#[cfg(unix)]
+fn children_peak_rss_kib() -> u64 {
+    use nix::sys::resource::{getrusage, UsageWho};
+    // Linux reports ru_maxrss in KiB.
+    getrusage(UsageWho::RUSAGE_CHILDREN).map_or(0, |u| u.max_rss().max(0) as u64)
+}
+
+#[cfg(not(unix))]
+fn children_peak_rss_kib() -> u64 {
+    0
+}
+
+/// Times `program args…` through the `measure` wrapper (this executable).
+fn timed(program: &Path, args: &[String]) -> Result<Measurement> {
+    let exe = std::env::current_exe().map_err(|e| Error::io(Path::new("mandelreel"), e))?;
+    let output = Command::new(&exe)
+        .arg("measure")
+        .arg("--")
+        .arg(program)
+        .args(args)
+        .output()
+        .map_err(|e| Error::io(&exe, e))?;
+    let text = String::from_utf8_lossy(&output.stdout);
+    let m: Measurement = serde_json::from_str(text.trim()).map_err(|e| {
+        Error::io(
+            &exe,
+            std::io::Error::other(format!("measure wrapper: {e}: {text}")),
+        )
+    })?;
+    if m.exit_code != 0 {
+        return Err(Error::io(
+            program,
+            std::io::Error::other(format!(
+                "exited with status {} running {}",
+                m.exit_code,
+                args.join(" ")
+            )),
+        ));
+    }
+    Ok(m)
+}
+
+/// One benchmark scene: a timeline and, where there is one, its Mandelbulber2 twin.
+#[derive(Clone, Debug)]
+pub struct BenchScene {
+    pub name: String,
+    pub timeline: PathBuf,
+    pub fract: Option<PathBuf>,
+}
+
+/// The timelines in `dir` (sorted by name) with their `.fract` twins in `fract_dir`.
+pub fn scenes(dir: &Path, fract_dir: &Path) -> Result<Vec<BenchScene>> {
+    let mut found: Vec<BenchScene> = std::fs::read_dir(dir)
+        .map_err(|e| Error::io(dir, e))?
+        .filter_map(|entry| entry.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "ron"))
+        .map(|timeline| {
+            let name = timeline
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default();
+            let fract = fract_dir.join(format!("{name}.fract"));
+            BenchScene {
+                name,
+                fract: fract.is_file().then_some(fract),
+                timeline,
+            }
+        })
+        .collect();
+    found.sort_by(|a, b| a.name.cmp(&b.name));
+    if found.is_empty() {
+        return Err(Error::usage(
+            "--scenes",
+            format!("no .ron timelines in {}", dir.display()),
+        ));
+    }
+    Ok(found)
+}
+
+/// Work one render does, counted by rendering it in this process (the
+/// counts do not depend on threads or timing).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Work {
+    pub frames: u32,
+    pub pixels: u64,
+    pub stats: FrameStats,
+}
+
+/// Renders every frame of `timeline` at `size` in this process, keeping only the counts.
+pub fn count_work(timeline: &Timeline, size: (u32, u32)) -> Work {
+    let mut stats = FrameStats::default();
+    for frame in 0..timeline.frame_count {
+        let scenes = timeline.scenes_for_frame(frame);
+        let film = render_frame_in_time(&scenes, frame, size.0, size.1, Layers::default(), &|| {});
+        stats = stats + film.stats;
+    }
+    Work {
+        frames: timeline.frame_count,
+        pixels: size.0 as u64 * size.1 as u64 * timeline.frame_count as u64,
+        stats,
+    }
+}
+
+/// One row of results.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Row {
+    pub machine: String,
+    /// Scene name, `kernel`, or `<scene>@<W>x<H>` for the memory render.
+    pub scene: String,
+    pub renderer: String,
+    pub threads: usize,
+    pub runs: usize,
+    pub median_s: f64,
+    pub min_s: f64,
+    pub max_s: f64,
+    pub frames: u32,
+    pub pixels: u64,
+    pub mpixels_per_s: f64,
+    pub de_evaluations: u64,
+    pub de_evaluations_per_s: f64,
+    pub de_iterations: u64,
+    pub de_iterations_per_s: f64,
+    pub gflops: f64,
+    pub peak_gflops: f64,
+    pub fraction_of_peak: f64,
+    pub peak_rss_mib: f64,
+    /// Size of the frame's output buffers (RGB, alpha and depth as f32), MiB.
+    pub output_buffers_mib: f64,
+    /// Mandelbulber2's median over mandelreel's, on the mandelreel row.
+    pub speedup_vs_mandelbulber2: f64,
+    /// This row's median over the one-thread median, on scaling rows.
+    pub scaling_vs_one_thread: f64,
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        0.0
+    } else if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+const MIB: f64 = 1024.0 * 1024.0;
+
+/// Fills the timing columns of `row` from `runs`, and the rates from `work`.
+fn timing_row(mut row: Row, runs: &[Measurement], work: Option<&Work>, peak: &Peak) -> Row {
+    let walls: Vec<f64> = runs.iter().map(|m| m.wall_s).collect();
+    row.runs = runs.len();
+    row.median_s = median(walls.clone());
+    row.min_s = walls.iter().copied().fold(f64::INFINITY, f64::min);
+    row.max_s = walls.iter().copied().fold(0.0, f64::max);
+    row.peak_rss_mib = runs.iter().map(|m| m.peak_rss_kib).max().unwrap_or(0) as f64 / 1024.0;
+    if let Some(w) = work {
+        let t = row.median_s.max(1e-9);
+        row.frames = w.frames;
+        row.pixels = w.pixels;
+        row.mpixels_per_s = w.pixels as f64 / t / 1e6;
+        row.de_evaluations = w.stats.de_evaluations;
+        row.de_evaluations_per_s = w.stats.de_evaluations as f64 / t;
+        row.de_iterations = w.stats.de_iterations;
+        row.de_iterations_per_s = w.stats.de_iterations as f64 / t;
+        row.gflops = row.de_iterations_per_s * FLOPS_PER_POWER8_ITERATION as f64 / 1e9;
+        row.peak_gflops = peak.gflops() * row.threads as f64 / peak.cores as f64;
+        row.fraction_of_peak = row.gflops / row.peak_gflops.max(1e-9);
+    }
+    row
+}
+
+fn log(quiet: bool, message: &str) {
+    if !quiet {
+        eprintln!("{message}");
+    }
+}
+
+/// The arguments of a mandelreel render of `scene` into `out`.
+fn render_args(timeline: &Path, out: &Path, threads: usize, extra: &[&str]) -> Vec<String> {
+    let mut args: Vec<String> = vec![
+        "render".into(),
+        timeline.display().to_string(),
+        "--out".into(),
+        out.display().to_string(),
+        "--force".into(),
+        "--quiet".into(),
+        "--threads".into(),
+        threads.to_string(),
+    ];
+    args.extend(extra.iter().map(|s| s.to_string()));
+    args
+}
+
+/// The arguments of a Mandelbulber2 render of `fract` into `out` (a folder).
+fn mandelbulber_args(fract: &Path, out: &Path, keyframed: bool) -> Vec<String> {
+    let mut args: Vec<String> = vec!["-n".into(), "-C".into()];
+    if keyframed {
+        args.push("-K".into());
+    }
+    let target = if keyframed {
+        format!("{}/", out.display())
+    } else {
+        out.join("frame.png").display().to_string()
+    };
+    args.extend([
+        "-f".into(),
+        "png".into(),
+        "-o".into(),
+        target,
+        "-O".into(),
+        "opencl_enabled=0".into(),
+        fract.display().to_string(),
+    ]);
+    args
+}
+
+/// Runs the whole benchmark and returns its rows.
+pub fn run(options: &Options) -> Result<Vec<Row>> {
+    let exe = std::env::current_exe().map_err(|e| Error::io(Path::new("mandelreel"), e))?;
+    let peak = Peak::detect();
+    let all_threads = peak.cores;
+    let scenes = scenes(&options.scenes, &options.fract_dir)?;
+    let scratch = tempfile::tempdir().map_err(|e| Error::io(Path::new("temp"), e))?;
+    let base = || Row {
+        machine: options.machine.clone(),
+        ..Row::default()
+    };
+    let mut rows = Vec::new();
+    log(
+        options.quiet,
+        &format!(
+            "machine: {} ({}, {} cores, {:.2} GHz, {} f64 lanes: peak {:.1} GFLOP/s)",
+            options.machine,
+            peak.cpu,
+            peak.cores,
+            peak.clock_ghz,
+            peak.lanes,
+            peak.gflops()
+        ),
+    );
+
+    for scene in &scenes {
+        let timeline = Timeline::load(&scene.timeline)?;
+        let work = count_work(&timeline, (timeline.width, timeline.height));
+        let out_a = scratch.path().join(format!("{}-mandelreel", scene.name));
+        let out_b = scratch.path().join(format!("{}-mandelbulber2", scene.name));
+        std::fs::create_dir_all(&out_b).map_err(|e| Error::io(&out_b, e))?;
+        let ours = render_args(&scene.timeline, &out_a, all_threads, &[]);
+        let theirs = match (&options.mandelbulber, &scene.fract) {
+            (Some(program), Some(fract)) => {
+                let text = std::fs::read_to_string(fract).map_err(|e| Error::io(fract, e))?;
+                Some((
+                    program,
+                    mandelbulber_args(fract, &out_b, text.contains("[keyframes]")),
+                ))
+            }
+            _ => None,
+        };
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        for run in 0..options.runs {
+            log(
+                options.quiet,
+                &format!("{}: run {}/{}", scene.name, run + 1, options.runs),
+            );
+            // Alternate the order so a drifting machine favours neither side.
+            let first_ours = run % 2 == 0;
+            if first_ours {
+                a.push(timed(&exe, &ours)?);
+            }
+            if let Some((program, args)) = &theirs {
+                b.push(timed(program, args)?);
+            }
+            if !first_ours {
+                a.push(timed(&exe, &ours)?);
+            }
+        }
+        let mut ours_row = timing_row(
+            Row {
+                scene: scene.name.clone(),
+                renderer: "mandelreel".into(),
+                threads: all_threads,
+                ..base()
+            },
+            &a,
+            Some(&work),
+            &peak,
+        );
+        if !b.is_empty() {
+            let mut theirs_row = timing_row(
+                Row {
+                    scene: scene.name.clone(),
+                    renderer: "mandelbulber2".into(),
+                    threads: all_threads,
+                    frames: work.frames,
+                    pixels: work.pixels,
+                    ..base()
+                },
+                &b,
+                None,
+                &peak,
+            );
+            ours_row.speedup_vs_mandelbulber2 = theirs_row.median_s / ours_row.median_s.max(1e-9);
+            theirs_row.mpixels_per_s = work.pixels as f64 / theirs_row.median_s.max(1e-9) / 1e6;
+            rows.push(ours_row);
+            rows.push(theirs_row);
+        } else {
+            rows.push(ours_row);
+        }
+    }
+
+    // Thread scaling on the first scene, counts alternating low/high.
+    let first = &scenes[0];
+    let timeline = Timeline::load(&first.timeline)?;
+    let work = count_work(&timeline, (timeline.width, timeline.height));
+    let mut by_threads: Vec<(usize, Vec<Measurement>)> =
+        options.threads.iter().map(|&t| (t, Vec::new())).collect();
+    for run in 0..options.runs {
+        log(
+            options.quiet,
+            &format!("scaling: run {}/{}", run + 1, options.runs),
+        );
+        let order: Vec<usize> = if run % 2 == 0 {
+            (0..by_threads.len()).collect()
+        } else {
+            (0..by_threads.len()).rev().collect()
+        };
+        for i in order {
+            let threads = by_threads[i].0;
+            let out = scratch.path().join(format!("scaling-{threads}"));
+            let args = render_args(&first.timeline, &out, threads, &[]);
+            by_threads[i].1.push(timed(&exe, &args)?);
+        }
+    }
+    let one = by_threads
+        .iter()
+        .find(|(t, _)| *t == 1)
+        .map(|(_, m)| median(m.iter().map(|m| m.wall_s).collect()));
+    for (threads, runs) in by_threads {
+        let mut row = timing_row(
+            Row {
+                scene: format!("{} (scaling)", first.name),
+                renderer: "mandelreel".into(),
+                threads,
+                ..base()
+            },
+            &runs,
+            Some(&work),
+            &peak,
+        );
+        if let Some(one) = one {
+            row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
+        }
+        rows.push(row);
+    }
+
+    // The kernel alone: analytic estimates at points where marching spends its time.
+    rows.push(kernel_row(&timeline, &peak, base()));
+
+    // Peak memory of a big EXR frame against its output buffers.
+    if let Some((w, h)) = options.memory_size {
+        log(options.quiet, &format!("memory: {w}x{h} EXR"));
+        let out = scratch.path().join("memory");
+        let size = format!("{w}x{h}");
+        let args = render_args(
+            &first.timeline,
+            &out,
+            all_threads,
+            &["--size", &size, "--format", "exr", "--frames", "0..1"],
+        );
+        let m = timed(&exe, &args)?;
+        let mut row = timing_row(
+            Row {
+                scene: format!("{}@{w}x{h} exr", first.name),
+                renderer: "mandelreel".into(),
+                threads: all_threads,
+                ..base()
+            },
+            &[m],
+            None,
+            &peak,
+        );
+        row.frames = 1;
+        row.pixels = w as u64 * h as u64;
+        row.mpixels_per_s = row.pixels as f64 / row.median_s.max(1e-9) / 1e6;
+        row.output_buffers_mib = row.pixels as f64 * OUTPUT_BYTES_PER_PIXEL as f64 / MIB;
+        rows.push(row);
+    }
+    Ok(rows)
+}
+
+/// Bytes per pixel of a frame's output buffers: linear RGB, alpha and depth, f32 each.
+pub const OUTPUT_BYTES_PER_PIXEL: u64 = 20;
+
+/// Measures DE iterations per second of the analytic estimator on every
+/// thread, at points on a shell just outside the bulb of `timeline`'s first
+/// frame (where the marcher spends most of its estimates).
+pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
+    let fractal = timeline.scene_at(0).fractal;
+    let points: Vec<crate::math::DVec3> = (0..1u64 << 16)
+        .map(|i| {
+            let u = |d: u32| crate::math::sample_1d(7, 0, i, 0, d);
+            let z = 2.0 * u(0) - 1.0;
+            let phi = std::f64::consts::TAU * u(1);
+            let s = (1.0 - z * z).sqrt();
+            crate::math::DVec3::new(s * phi.cos(), s * phi.sin(), z) * (0.9 + 0.4 * u(2))
+        })
+        .collect();
+    let threads = rayon::current_num_threads();
+    let mut walls = Vec::new();
+    let mut iterations = 0;
+    for _ in 0..5 {
+        let start = Instant::now();
+        iterations = points
+            .par_chunks(1024)
+            .map(|chunk| {
+                let before = crate::fractal::iterations_on_this_thread();
+                let sum: f64 = chunk
+                    .iter()
+                    .map(|&p| fractal.estimate(p, 1e-4).distance)
+                    .sum();
+                std::hint::black_box(sum);
+                crate::fractal::iterations_on_this_thread() - before
+            })
+            .sum::<u64>();
+        walls.push(Measurement {
+            wall_s: start.elapsed().as_secs_f64(),
+            peak_rss_kib: 0,
+            exit_code: 0,
+        });
+    }
+    let work = Work {
+        frames: 0,
+        pixels: 0,
+        stats: FrameStats {
+            de_evaluations: points.len() as u64,
+            de_iterations: iterations,
+            ..FrameStats::default()
+        },
+    };
+    let mut row = timing_row(
+        Row {
+            scene: "kernel".into(),
+            renderer: "mandelreel".into(),
+            threads,
+            ..base
+        },
+        &walls,
+        Some(&work),
+        peak,
+    );
+    row.peak_rss_mib = 0.0;
+    row
+}
+
+/// The rows as CSV, one header line first.
+pub fn to_csv(rows: &[Row]) -> String {
+    let header = "machine,scene,renderer,threads,runs,median_s,min_s,max_s,frames,pixels,\
+mpixels_per_s,de_evaluations,de_evaluations_per_s,de_iterations,de_iterations_per_s,gflops,\
+peak_gflops,fraction_of_peak,peak_rss_mib,output_buffers_mib,speedup_vs_mandelbulber2,\
+scaling_vs_one_thread";
+    let mut out = format!("{header}\n");
+    for r in rows {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{},{},{:.3},{},{:.4e},{},{:.4e},{:.3},{:.1},{:.4},{:.1},{:.1},{:.2},{:.2}",
+            r.machine.replace(',', " "),
+            r.scene.replace(',', " "),
+            r.renderer,
+            r.threads,
+            r.runs,
+            r.median_s,
+            r.min_s,
+            r.max_s,
+            r.frames,
+            r.pixels,
+            r.mpixels_per_s,
+            r.de_evaluations,
+            r.de_evaluations_per_s,
+            r.de_iterations,
+            r.de_iterations_per_s,
+            r.gflops,
+            r.peak_gflops,
+            r.fraction_of_peak,
+            r.peak_rss_mib,
+            r.output_buffers_mib,
+            r.speedup_vs_mandelbulber2,
+            r.scaling_vs_one_thread,
+        );
+    }
+    out
+}
+
+/// The README's tables, made from the rows.
+pub fn to_markdown(rows: &[Row], peak: &Peak) -> String {
+    let mut md = String::new();
+    let machine = rows.first().map_or("", |r| r.machine.as_str());
+    let _ = writeln!(
+        md,
+        "Machine `{machine}`: {}, {} cores at {:.2} GHz, {} f64 lanes per vector, \
+nominal f64 FMA peak {:.1} GFLOP/s.\n",
+        peak.cpu,
+        peak.cores,
+        peak.clock_ghz,
+        peak.lanes,
+        peak.gflops()
+    );
+    md.push_str("| scene | mandelreel | Mandelbulber2 | speed-up | Mpixel/s | DE evals/s | DE iterations/s | peak RSS |\n");
+    md.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    let is_scene = |r: &Row| {
+        r.renderer == "mandelreel"
+            && r.scene != "kernel"
+            && !r.scene.contains('@')
+            && !r.scene.ends_with("(scaling)")
+    };
+    for r in rows.iter().filter(|r| is_scene(r)) {
+        let theirs = rows
+            .iter()
+            .find(|o| o.renderer == "mandelbulber2" && o.scene == r.scene);
+        let _ = writeln!(
+            md,
+            "| {} | {:.3} s | {} | {} | {:.2} | {:.3e} | {:.3e} | {:.0} MiB |",
+            r.scene,
+            r.median_s,
+            theirs.map_or("–".into(), |t| format!("{:.3} s", t.median_s)),
+            theirs.map_or("–".into(), |_| format!(
+                "{:.1}×",
+                r.speedup_vs_mandelbulber2
+            )),
+            r.mpixels_per_s,
+            r.de_evaluations_per_s,
+            r.de_iterations_per_s,
+            r.peak_rss_mib,
+        );
+    }
+    md.push_str(
+        "\n| threads | median | speed-up over 1 thread | DE iterations/s | share of FMA peak |\n",
+    );
+    md.push_str("| ---: | ---: | ---: | ---: | ---: |\n");
+    for r in rows.iter().filter(|r| r.scene.ends_with("(scaling)")) {
+        let _ = writeln!(
+            md,
+            "| {} | {:.3} s | {:.2}× | {:.3e} | {:.1}% |",
+            r.threads,
+            r.median_s,
+            r.scaling_vs_one_thread,
+            r.de_iterations_per_s,
+            100.0 * r.fraction_of_peak
+        );
+    }
+    for r in rows.iter().filter(|r| r.scene == "kernel") {
+        let _ = writeln!(
+            md,
+            "\nKernel alone ({} threads, analytic estimate at points around the bulb): \
+{:.3e} DE iterations/s × {} flops = {:.1} GFLOP/s, {:.1}% of the nominal peak.",
+            r.threads,
+            r.de_iterations_per_s,
+            FLOPS_PER_POWER8_ITERATION,
+            r.gflops,
+            100.0 * r.fraction_of_peak
+        );
+    }
+    for r in rows.iter().filter(|r| r.scene.contains('@')) {
+        let _ = writeln!(
+            md,
+            "\nPeak memory, {}: {:.0} MiB against {:.0} MiB of output buffers \
+(RGB, alpha, depth as f32): {:.2}×, in {:.1} s.",
+            r.scene,
+            r.peak_rss_mib,
+            r.output_buffers_mib,
+            r.peak_rss_mib / r.output_buffers_mib.max(1e-9),
+            r.median_s
+        );
+    }
+    md
+}
+
+/// Runs the benchmark and writes `<results>/<machine>.csv` and `.md`;
+/// returns the Markdown.
+pub fn run_and_write(options: &Options) -> Result<String> {
+    let rows = run(options)?;
+    let peak = Peak::detect();
+    std::fs::create_dir_all(&options.results).map_err(|e| Error::io(&options.results, e))?;
+    let csv = options.results.join(format!("{}.csv", options.machine));
+    std::fs::write(&csv, to_csv(&rows)).map_err(|e| Error::io(&csv, e))?;
+    let md_text = to_markdown(&rows, &peak);
+    let md = options.results.join(format!("{}.md", options.machine));
+    std::fs::write(&md, &md_text).map_err(|e| Error::io(&md, e))?;
+    Ok(md_text)
+}
+
+/// A file-name-safe default machine name: cores and CPU model.
+pub fn default_machine_name(peak: &Peak) -> String {
+    let model: String = peak
+        .cpu
+        .to_lowercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '-' })
+        .collect();
+    let model = model
+        .split('-')
+        .filter(|s| !s.is_empty() && *s != "r" && *s != "tm")
+        .collect::<Vec<_>>()
+        .join("-");
+    format!("{}core-{model}", peak.cores)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
+        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
+        assert_eq!(median(vec![]), 0.0);
+    }
+
+    #[test]
+    fn peak_is_the_product_of_its_factors() {
+        let p = Peak {
+            cpu: "test".into(),
+            cores: 2,
+            clock_ghz: 2.5,
+            lanes: 4,
+            fma_units: 2,
+        };
+        assert_eq!(p.gflops(), 2.0 * 2.0 * 4.0 * 2.0 * 2.5);
+        assert_eq!(default_machine_name(&p), "2core-test");
+    }
+
+    #[test]
+    fn the_power8_iteration_count_matches_the_kernel() {
+        // The flop count assumes the whole-power path; check a power-8 orbit
+        // counts one iteration per power step through the thread counter.
+        let f = crate::fractal::Fractal {
+            iterations: 5,
+            ..crate::fractal::Fractal::default()
+        };
+        let before = crate::fractal::iterations_on_this_thread();
+        let orbit = f.orbit([0.1, 0.2, 0.3], 5, true);
+        assert_eq!(
+            crate::fractal::iterations_on_this_thread() - before,
+            orbit.iterations as u64
+        );
+        assert_eq!(
+            orbit.iterations, 5,
+            "the point is inside, so every iteration runs"
+        );
+    }
+}
