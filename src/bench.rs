@@ -406,6 +406,9 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
                 a.push(timed(&exe, &ours)?);
             }
             if let Some((program, args)) = &theirs {
+                // Mandelbulber2 skips animation frames that already exist: start empty.
+                let _ = std::fs::remove_dir_all(&out_b);
+                std::fs::create_dir_all(&out_b).map_err(|e| Error::io(&out_b, e))?;
                 b.push(timed(program, args)?);
             }
             if !first_ours {

@@ -3,6 +3,7 @@
 mod util;
 
 mod accuracy;
+mod bench;
 mod cli;
 mod farm;
 mod formats;

@@ -1,0 +1,112 @@
+//! `mandelreel bench` on a tiny scene with a stand-in for Mandelbulber2: the
+//! CSV and Markdown it writes, with counts checked against `render --stats`.
+
+use crate::util::{stdout, tiny_timeline, Dir};
+
+#[test]
+fn bench_writes_results_with_counts_that_match_a_render() {
+    let d = Dir::new();
+    std::fs::create_dir_all(d.path().join("scenes")).unwrap();
+    std::fs::create_dir_all(d.path().join("fract")).unwrap();
+    d.write("scenes/tiny.ron", &tiny_timeline(2, 7.0));
+    d.write("fract/tiny.fract", "[main_parameters]\n");
+    // Stands in for mandelbulber2: takes its arguments, writes nothing, succeeds.
+    let fake = d.write("fake-mandelbulber", "#!/bin/sh\nsleep 0.05\nexit 0\n");
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::set_permissions(&fake, std::fs::Permissions::from_mode(0o755)).unwrap();
+    }
+    let out = d.ok(&[
+        "bench",
+        "--scenes",
+        "scenes",
+        "--fract-dir",
+        "fract",
+        "--mandelbulber",
+        fake.to_str().unwrap(),
+        "--runs",
+        "2",
+        "--threads",
+        "1,2",
+        "--memory-size",
+        "64x36",
+        "--results",
+        "results",
+        "--machine",
+        "testbox",
+        "--quiet",
+    ]);
+    let md = std::fs::read_to_string(d.path().join("results/testbox.md")).unwrap();
+    assert!(stdout(&out).contains(md.trim()), "the table is printed too");
+    let csv = std::fs::read_to_string(d.path().join("results/testbox.csv")).unwrap();
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    let row = |scene: &str, renderer: &str, threads: &str| {
+        rows.iter()
+            .find(|r| {
+                r[col("scene")] == scene
+                    && r[col("renderer")] == renderer
+                    && r[col("threads")] == threads
+            })
+            .unwrap_or_else(|| panic!("no row {scene}/{renderer}/{threads} in\n{csv}"))
+    };
+    let num = |r: &Vec<&str>, name: &str| -> f64 { r[col(name)].parse::<f64>().unwrap() };
+    let cores = std::thread::available_parallelism()
+        .map_or(1, |n| n.get())
+        .to_string();
+    let ours = row("tiny", "mandelreel", &cores);
+    let theirs = row("tiny", "mandelbulber2", &cores);
+    assert_eq!(num(ours, "runs"), 2.0);
+    assert_eq!(num(theirs, "runs"), 2.0);
+    // The speed-up is the ratio of the two medians.
+    let ratio = num(theirs, "median_s") / num(ours, "median_s");
+    assert!(
+        (num(ours, "speedup_vs_mandelbulber2") / ratio - 1.0).abs() < 0.05,
+        "{csv}"
+    );
+    // The stand-in sleeps 50 ms, so its median cannot be below that.
+    assert!(num(theirs, "median_s") >= 0.05);
+    // Counts agree with what `render --stats` reports for the same frames.
+    let stats = d.ok(&["render", "scenes/tiny.ron", "--out", "check", "--stats"]);
+    let text = String::from_utf8_lossy(&stats.stderr).to_string() + &stdout(&stats);
+    let total: u64 = text
+        .lines()
+        .find_map(|l| l.strip_prefix("total DE evaluations: "))
+        .and_then(|l| l.split(',').next())
+        .expect("render --stats prints the total")
+        .parse()
+        .unwrap();
+    assert_eq!(num(ours, "de_evaluations") as u64, total);
+    assert_eq!(num(ours, "pixels"), (48 * 27 * 2) as f64);
+    assert!(num(ours, "de_iterations") > num(ours, "de_evaluations"));
+    // Scaling rows for each thread count asked for, one thread as the unit.
+    let one = row("tiny (scaling)", "mandelreel", "1");
+    let two = row("tiny (scaling)", "mandelreel", "2");
+    assert_eq!(num(one, "scaling_vs_one_thread"), 1.0);
+    assert!(num(two, "scaling_vs_one_thread") > 0.0);
+    // The kernel row measures a share of the nominal peak, and the memory row
+    // a peak RSS against the output buffers (64×36 pixels × 20 bytes).
+    let kernel = rows.iter().find(|r| r[col("scene")] == "kernel").unwrap();
+    let fraction = num(kernel, "fraction_of_peak");
+    assert!(fraction > 0.0 && fraction < 1.0, "{fraction}");
+    let memory = rows
+        .iter()
+        .find(|r| r[col("scene")].contains("@64x36"))
+        .unwrap();
+    assert!((num(memory, "output_buffers_mib") - 64.0 * 36.0 * 20.0 / 1048576.0).abs() < 0.05);
+    #[cfg(target_os = "linux")]
+    assert!(num(memory, "peak_rss_mib") > 1.0, "{csv}");
+}
+
+#[test]
+fn bench_rejects_a_folder_without_timelines() {
+    let d = Dir::new();
+    std::fs::create_dir_all(d.path().join("empty")).unwrap();
+    let out = d.run(&["bench", "--scenes", "empty", "--no-mandelbulber", "--quiet"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no .ron timelines in empty"));
+    assert!(!d.path().join("bench").exists(), "nothing written");
+}
