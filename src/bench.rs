@@ -537,15 +537,7 @@ pub const OUTPUT_BYTES_PER_PIXEL: u64 = 20;
 /// frame (where the marcher spends most of its estimates).
 pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
     let fractal = timeline.scene_at(0).fractal;
-    let points: Vec<crate::math::DVec3> = (0..1u64 << 16)
-        .map(|i| {
-            let u = |d: u32| crate::math::sample_1d(7, 0, i, 0, d);
-            let z = 2.0 * u(0) - 1.0;
-            let phi = std::f64::consts::TAU * u(1);
-            let s = (1.0 - z * z).sqrt();
-            crate::math::DVec3::new(s * phi.cos(), s * phi.sin(), z) * (0.9 + 0.4 * u(2))
-        })
-        .collect();
+    let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
     let threads = rayon::current_num_threads();
     let mut walls = Vec::new();
     let mut iterations = 0;

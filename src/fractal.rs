@@ -1,5 +1,5 @@
-//! The Mandelbulb itself: the triplex power for each angle convention (with
-//! Quilez's trig-free power-8 polynomial as a fast path), one iteration driver
+//! The Mandelbulb itself: the triplex power for each angle convention (whole
+//! powers by complex squaring, without trigonometry), one iteration driver
 //! (bailout, running derivative, orbit traps, Julia mode) generic over f64, f32
 //! and dual numbers, and five distance estimators built on it.
 //!
@@ -7,8 +7,8 @@
 //! `dr ← n·r^(n−1)·dr (+1 in Mandelbrot mode)` with `DE = ½·ln(r)·r/dr`: seeds
 //! 002 (course notes) and 001 (Christensen, "distance estimated 3D fractals",
 //! parts V–VI, which also gives the potential-gradient, sinh and escape-length
-//! estimators and their costs); the y-up convention, the power-8 polynomial and
-//! the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
+//! estimators and their costs); the y-up convention, the power-8 polynomial
+//! (now only a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
 //! "Coloring").
 
 use crate::math::{DVec3, Dual, Number, Real};
@@ -155,12 +155,23 @@ fn length<T: Number>(z: Triplex<T>) -> T {
 /// convention with trigonometric functions. The origin maps to itself.
 #[inline]
 pub fn triplex_power_trig<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: Real) -> Triplex<T> {
+    triplex_power_trig_scaled(formula, z, r, n, r.powf(n))
+}
+
+/// `triplex_power_trig` with rⁿ = `rn` already known.
+#[inline]
+fn triplex_power_trig_scaled<T: Number>(
+    formula: Formula,
+    z: Triplex<T>,
+    r: T,
+    n: Real,
+    rn: T,
+) -> Triplex<T> {
     let rv = r.value();
     if rv <= 0.0 || !rv.is_finite() {
         return [T::from_real(0.0); 3];
     }
     let nn = T::from_real(n);
-    let rn = r.powf(n);
     let [x, y, zz] = z;
     match formula {
         Formula::Quilez => {
@@ -289,18 +300,6 @@ pub fn power8_polynomial<T: Number>(w: Triplex<T>) -> Option<Triplex<T>> {
     out.iter().all(|v| v.value().is_finite()).then_some(out)
 }
 
-/// The triplex power: the trigonometry-free path for whole exponents where it
-/// applies, the trigonometric form otherwise.
-#[inline]
-pub fn triplex_power<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: Real) -> Triplex<T> {
-    if let Some(k) = whole_power(n) {
-        if let Some(w) = triplex_power_int(formula, z, k) {
-            return w;
-        }
-    }
-    triplex_power_trig(formula, z, r, n)
-}
-
 /// `n` as a whole number in 2..=64, if it is one.
 #[inline]
 pub fn whole_power(n: Real) -> Option<u32> {
@@ -313,12 +312,8 @@ pub fn whole_power(n: Real) -> Option<u32> {
 fn whole_power_step<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: u32) -> (Triplex<T>, T) {
     let w = triplex_power_int(formula, z, n)
         .unwrap_or_else(|| triplex_power_trig(formula, z, r, n as Real));
-    let r_n_minus_1 = if n > 1 {
-        powi(r, n - 1, |a, b| a * b)
-    } else {
-        T::from_real(1.0)
-    };
-    (w, r_n_minus_1)
+    // `whole_power` guarantees n ≥ 2.
+    (w, powi(r, n - 1, |a, b| a * b))
 }
 
 thread_local! {
@@ -448,7 +443,10 @@ impl Fractal {
                 whole_power_step(formula, z, r, k)
             }),
             None => self.orbit_with(p, limit, stop_at_bailout, |z, r| {
-                (triplex_power_trig(formula, z, r, n), r.powf(n - 1.0))
+                // One powf serves both: rⁿ = rⁿ⁻¹·r.
+                let r_n_minus_1 = r.powf(n - 1.0);
+                let w = triplex_power_trig_scaled(formula, z, r, n, r_n_minus_1 * r);
+                (w, r_n_minus_1)
             }),
         }
     }
@@ -539,8 +537,16 @@ impl Fractal {
 
     /// Whether `p` belongs to the set at this iteration count: its orbit never
     /// passes the bailout. Trusts no distance estimate.
+    /// Iterates in the estimator's precision, so a march that finds a point
+    /// inside by its estimate bisects the same set.
     pub fn contains(&self, p: DVec3) -> bool {
-        !self.orbit([p.x, p.y, p.z], self.iterations, true).escaped
+        match self.precision {
+            Precision::F64 => !self.orbit([p.x, p.y, p.z], self.iterations, true).escaped,
+            Precision::F32 => {
+                let q = [p.x as f32, p.y as f32, p.z as f32];
+                !self.orbit(q, self.iterations, true).escaped
+            }
+        }
     }
 
     /// Estimates the distance from `p` to the surface. `scale` is the size of
@@ -608,7 +614,7 @@ impl Fractal {
         } else {
             let r = centre.r.value();
             let d = match self.de {
-                DeMethod::Analytic => 0.5 * r.ln() * r / centre.dr.value(),
+                DeMethod::Analytic => half_r_ln_r_over(r, centre.dr.value()),
                 DeMethod::Jacobian => {
                     let jacobian = jacobian.expect("computed above for this method");
                     let mut norm = spectral_norm(jacobian);
@@ -618,7 +624,7 @@ impl Fractal {
                         // n·r^(n−1), so bound the norm by n·dr: conservative.
                         norm = self.power * centre.dr.value();
                     }
-                    0.5 * r.ln() * r / norm
+                    half_r_ln_r_over(r, norm)
                 }
                 DeMethod::Potential | DeMethod::SinhPotential | DeMethod::EscapeLength => {
                     // Tetrahedral finite differences; the step is a fraction of the
@@ -641,7 +647,7 @@ impl Fractal {
                     orbits += 4;
                     let slope = gradient.length() / (4.0 * h);
                     match self.de {
-                        DeMethod::EscapeLength => 0.5 * r * r.ln() / slope,
+                        DeMethod::EscapeLength => half_r_ln_r_over(r, slope),
                         DeMethod::Potential => {
                             0.5 * potential(r, centre.iterations, self.power) / slope
                         }
@@ -703,13 +709,19 @@ pub fn spectral_norm(m: glam::DMat3) -> Real {
 /// orbit if that is finite, else 0, which the marcher treats as a hit: it may
 /// stop early but never skips surface.
 fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
-    let r = centre.r.value();
-    let analytic = 0.5 * r.ln() * r / centre.dr.value();
+    let analytic = half_r_ln_r_over(centre.r.value(), centre.dr.value());
     if analytic.is_finite() && analytic >= 0.0 {
         analytic
     } else {
         0.0
     }
+}
+
+/// ½·r·ln r / `slope`: the distance bound of an orbit that escaped to radius
+/// r, given how fast |z| grows with the starting point (seed 001, part V).
+#[inline]
+fn half_r_ln_r_over(r: Real, slope: Real) -> Real {
+    0.5 * r.ln() * r / slope
 }
 
 /// Tetrahedral stencil for gradients: four corners of a cube, summing to zero.
@@ -733,6 +745,15 @@ fn potential(r: Real, k: u32, n: Real) -> Real {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The triplex power as the orbit takes it: complex squaring for whole
+    /// exponents off the pole axis, the trigonometric form otherwise.
+    fn triplex_power<T: Number>(formula: Formula, z: Triplex<T>, r: T, n: Real) -> Triplex<T> {
+        match whole_power(n) {
+            Some(k) => whole_power_step(formula, z, r, k).0,
+            None => triplex_power_trig(formula, z, r, n),
+        }
+    }
 
     /// The triplex power on glam vectors.
     fn power(f: Formula, z: DVec3, n: Real) -> DVec3 {
@@ -883,19 +904,7 @@ mod tests {
         );
     }
 
-    /// Random points on a sphere shell, from a fixed seed.
-    fn points(count: usize, radius: std::ops::Range<Real>, seed: u64) -> Vec<DVec3> {
-        (0..count as u64)
-            .map(|i| {
-                let u = |d: u32| crate::render::sample_1d(seed, 0, i, 0, d);
-                let z = 2.0 * u(0) - 1.0;
-                let phi = std::f64::consts::TAU * u(1);
-                let s = (1.0 - z * z).sqrt();
-                let r = radius.start + (radius.end - radius.start) * u(2);
-                DVec3::new(s * phi.cos(), z, s * phi.sin()) * r
-            })
-            .collect()
-    }
+    use crate::math::shell_points as points;
 
     #[test]
     fn lanes_are_bit_identical_to_one_estimate_at_a_time() {
@@ -1192,13 +1201,15 @@ mod tests {
 
     #[test]
     fn dual_number_jacobian_matches_finite_differences() {
-        // Power 8 in Quilez's form runs the polynomial; power 7 and the other
-        // conventions run the trigonometric form through the dual numbers.
+        // Whole powers run complex squaring through the dual numbers;
+        // fractional ones (7.5, 5.5) the trigonometric form.
         let cases = [
             (Formula::Quilez, 8.0),
             (Formula::Quilez, 7.0),
             (Formula::WhiteNylander, 3.0),
             (Formula::Asin, 8.0),
+            (Formula::Quilez, 7.5),
+            (Formula::Asin, 5.5),
         ];
         for (formula, power) in cases {
             let f = Fractal {
@@ -1335,6 +1346,29 @@ mod tests {
                     assert!(
                         (w - DVec3::from_array(exact)).length() <= 1e-12 * scale,
                         "{formula:?} at {p}"
+                    );
+                }
+            }
+        }
+        // Beside each convention's pole axis, inside the hand-over band
+        // (1e-7) and just outside it where complex squaring runs (1e-5), the
+        // result still agrees with the trigonometric form.
+        for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+            let (pole, across) = match formula {
+                Formula::Quilez => (DVec3::Y, DVec3::new(0.6, 0.0, 0.8)),
+                _ => (DVec3::Z, DVec3::new(0.6, 0.8, 0.0)),
+            };
+            for offset in [1e-7, 1e-5] {
+                for radius in [0.3, 1.0, 1.9] {
+                    let p = (pole + across * offset) * radius;
+                    let q = [p.x, p.y, p.z];
+                    assert_eq!(triplex_power_int(formula, q, 8).is_some(), offset > 1e-6);
+                    let w = power(formula, p, 8.0);
+                    let exact = triplex_power_trig(formula, q, p.length(), 8.0);
+                    let scale = p.length().powi(8);
+                    assert!(
+                        (w - DVec3::from_array(exact)).length() <= 1e-9 * scale,
+                        "{formula:?} at {p}: {w} vs {exact:?}"
                     );
                 }
             }

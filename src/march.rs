@@ -73,7 +73,7 @@ pub struct Hit {
     pub estimate: Estimate,
 }
 
-/// Outcome of marching one ray, with the number of distance evaluations spent.
+/// Outcome of marching one ray, with the orbits it computed.
 #[derive(Clone, Copy, Debug)]
 pub struct MarchResult {
     pub hit: Option<Hit>,
@@ -104,44 +104,41 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
     };
     let at = |t: Real| ray.origin + ray.dir * t;
     let mut t = t_enter;
-    let mut t_outside: Option<Real> = None;
+    // The last point found outside the set, with its estimate.
+    let mut outside: Option<(Real, Estimate)> = None;
     let mut omega = settings.over_relaxation;
     let (mut previous_distance, mut previous_step) = (0.0, 0.0);
     for _ in 0..settings.max_steps {
         let point = at(t);
-        let estimate = fractal.estimate(point, ray.footprint(t));
+        let footprint = ray.footprint(t);
+        let estimate = fractal.estimate(point, footprint);
         evaluations += estimate.orbits;
-        closest = closest.min(estimate.distance / ray.footprint(t));
+        closest = closest.min(estimate.distance / footprint);
         if omega > 1.0
             && estimate.escaped
             && previous_distance + settings.fudge * estimate.distance < previous_step
         {
             // The spheres of free space around this point and the last one do
-            // not overlap: the long step may have jumped over surface. Take it
-            // back and continue with plain steps.
-            t -= previous_step;
-            previous_step = 0.0;
+            // not overlap: the long step may have jumped over surface. Go from
+            // the last point by the plain step instead, without relaxation.
+            t += previous_distance - previous_step;
             omega = 1.0;
             continue;
         }
         if !estimate.escaped {
-            if let Some(mut lo) = t_outside {
-                // Overshot: bisect [lo (outside), t (inside)] down to the threshold.
-                let mut hi = t;
-                while hi - lo > settings.hit_threshold * ray.footprint(lo) {
-                    let mid = 0.5 * (lo + hi);
-                    if !(lo < mid && mid < hi) {
-                        break; // the interval cannot be split any further
-                    }
-                    evaluations += 1;
-                    if fractal.contains(at(mid)) {
-                        hi = mid;
-                    } else {
-                        lo = mid;
-                    }
-                }
-                let estimate = fractal.estimate(at(lo), ray.footprint(lo));
-                evaluations += estimate.orbits;
+            if let Some((t_out, estimate_out)) = outside {
+                // Overshot: bisect [outside, t (inside)] down to the threshold.
+                let (lo, tests) = bisect_membership(fractal, &at, t_out, t, |lo| {
+                    settings.hit_threshold * ray.footprint(lo)
+                });
+                evaluations += tests;
+                let estimate = if lo == t_out {
+                    estimate_out
+                } else {
+                    let e = fractal.estimate(at(lo), ray.footprint(lo));
+                    evaluations += e.orbits;
+                    e
+                };
                 return MarchResult {
                     hit: Some(Hit {
                         t: lo,
@@ -153,20 +150,24 @@ pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchRes
                 };
             }
         }
-        if estimate.distance < settings.hit_threshold * ray.footprint(t) {
+        if estimate.distance < settings.hit_threshold * footprint {
             return MarchResult {
                 hit: Some(Hit { t, point, estimate }),
                 evaluations,
                 closest,
             };
         }
-        t_outside = Some(t);
+        outside = Some((t, estimate));
         let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;
-        // The over-relaxed step is checked at the next point; an unchecked
-        // plain step is safe by itself.
+        // The over-relaxed step is checked at the next point (or, leaving the
+        // bounding sphere, by retrying the plain step); a plain step is safe.
         previous_distance = step;
         previous_step = step * omega;
         t += previous_step;
+        if t > t_exit && previous_step > previous_distance {
+            t += previous_distance - previous_step;
+            omega = 1.0;
+        }
         if t > t_exit {
             return MarchResult {
                 hit: None,
@@ -219,20 +220,9 @@ pub fn march_by_membership(
         let next = t + (step_fraction * ray.footprint(t)).max(min_step);
         tests += 1;
         if fractal.contains(at(next)) {
-            let (mut lo, mut hi) = (t, next);
-            while hi - lo > 1e-3 * ray.footprint(lo) {
-                let mid = 0.5 * (lo + hi);
-                if !(lo < mid && mid < hi) {
-                    break;
-                }
-                tests += 1;
-                if fractal.contains(at(mid)) {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
-            return (Some(lo), tests);
+            let (lo, bisections) =
+                bisect_membership(fractal, &at, t, next, |lo| 1e-3 * ray.footprint(lo));
+            return (Some(lo), tests + bisections);
         }
         if next > t_exit {
             return (None, tests);
@@ -240,6 +230,32 @@ pub fn march_by_membership(
         t = next;
     }
     (None, tests)
+}
+
+/// Bisects [`lo` (outside the set), `hi` (inside)] by membership until the
+/// interval is narrower than `width(lo)` or cannot be split; returns the
+/// last point outside and the membership tests spent.
+fn bisect_membership(
+    fractal: &Fractal,
+    at: &impl Fn(Real) -> DVec3,
+    mut lo: Real,
+    mut hi: Real,
+    width: impl Fn(Real) -> Real,
+) -> (Real, u32) {
+    let mut tests = 0;
+    while hi - lo > width(lo) {
+        let mid = 0.5 * (lo + hi);
+        if !(lo < mid && mid < hi) {
+            break; // the interval cannot be split any further
+        }
+        tests += 1;
+        if fractal.contains(at(mid)) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    (lo, tests)
 }
 
 /// Surface normal at `hit` from a tetrahedral central difference of the
@@ -458,7 +474,7 @@ mod tests {
             };
             let mut checked = 0;
             for i in 0..60u64 {
-                let u = |d: u32| crate::render::sample_1d(99, 0, i, 0, d);
+                let u = |d: u32| crate::math::sample_1d(99, 0, i, 0, d);
                 let origin = DVec3::new(u(0) - 0.5, u(1) - 0.5, u(2) - 0.5).normalize() * 2.5;
                 let aim = DVec3::new(u(3) - 0.5, u(4) - 0.5, u(5) - 0.5) * 0.8;
                 let r = Ray {

@@ -248,6 +248,21 @@ pub fn finite_or_zero(c: Vec3) -> Vec3 {
     )
 }
 
+/// `count` points spread over the shell of radii `radius` around the origin,
+/// from the sampler with `seed`: the same points every run.
+pub fn shell_points(count: usize, radius: std::ops::Range<Real>, seed: u64) -> Vec<DVec3> {
+    (0..count as u64)
+        .map(|i| {
+            let u = |d: u32| sample_1d(seed, 0, i, 0, d);
+            let z = 2.0 * u(0) - 1.0;
+            let phi = std::f64::consts::TAU * u(1);
+            let s = (1.0 - z * z).sqrt();
+            let r = radius.start + (radius.end - radius.start) * u(2);
+            DVec3::new(s * phi.cos(), z, s * phi.sin()) * r
+        })
+        .collect()
+}
+
 /// Ray–sphere intersection (sphere centred on the origin). Returns the entry and
 /// exit distances along the ray, entry clamped to 0 when the origin is inside.
 pub fn sphere_interval(origin: DVec3, dir: DVec3, radius: Real) -> Option<(Real, Real)> {
@@ -296,6 +311,19 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn sampler_is_uniform_and_deterministic() {
+        let mut sum = 0.0;
+        for i in 0..10_000u64 {
+            let u = sample_1d(7, 3, i, 0, 0);
+            assert!((0.0..1.0).contains(&u));
+            sum += u;
+        }
+        assert!((sum / 10_000.0 - 0.5).abs() < 0.01);
+        assert_eq!(sample_1d(1, 2, 3, 4, 5), sample_1d(1, 2, 3, 4, 5));
+        assert_ne!(sample_1d(1, 2, 3, 4, 5), sample_1d(1, 2, 3, 4, 6));
+    }
 
     #[test]
     fn dual_numbers_match_finite_differences() {
