@@ -509,11 +509,12 @@ impl Plan {
             .all(|&f| output::is_current(&self.path(frame, f), f, hash))
     }
 
-    /// Renders one frame and writes every format.
-    /// Renders one frame in waves of samples and writes every format. A frame
-    /// of several waves saves its accumulation every `checkpoint_every`, and
-    /// continues from a saved one for the same inputs; the result is
-    /// bit-identical either way. Returns the stats and the samples resumed from.
+    /// Renders one frame and writes every format. A frame of one sample per
+    /// pixel is rendered band by band (`render_frame_in_time`), without the
+    /// whole frame's running sums. Others run in waves of samples, saving
+    /// their accumulation every `checkpoint_every` and continuing from a
+    /// saved one for the same inputs; the result is bit-identical either way.
+    /// Returns the stats and the samples resumed from.
     fn render_frame(
         &self,
         frame: u32,
@@ -524,13 +525,8 @@ impl Plan {
     ) -> anyhow::Result<(FrameStats, u32)> {
         let n = scenes[0].samples_per_pixel.max(1);
         let layers = self.layers();
-        let checkpoint = output::checkpoint_path(&self.out_dir, frame);
-        let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
-            .filter(|a| a.samples_done < n);
-        let wave = wave_size(n);
-        if saved_acc.is_none() && wave >= n {
-            // One wave: nothing to checkpoint, so render band by band without
-            // the whole frame's running sums (the same pixels in less memory).
+        if n == 1 {
+            // One sample is one wave: there is never a checkpoint to resume.
             let film = crate::render::render_frame_in_time(
                 scenes,
                 frame,
@@ -541,6 +537,10 @@ impl Plan {
             );
             return self.write_film(frame, &film, hash).map(|stats| (stats, 0));
         }
+        let checkpoint = output::checkpoint_path(&self.out_dir, frame);
+        let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
+            .filter(|a| a.samples_done < n);
+        let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
         let resumed = acc.samples_done;

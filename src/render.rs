@@ -34,6 +34,26 @@ pub struct Film {
     pub stats: FrameStats,
 }
 
+impl Film {
+    /// Adds the rows of `band` below this film's (layers present in both).
+    fn append(&mut self, band: Film) {
+        fn extend<T>(all: &mut Option<Vec<T>>, part: Option<Vec<T>>) {
+            if let (Some(all), Some(part)) = (all.as_mut(), part) {
+                all.extend(part);
+            }
+        }
+        self.colour.extend(band.colour);
+        self.alpha.extend(band.alpha);
+        self.depth.extend(band.depth);
+        self.evaluations.extend(band.evaluations);
+        extend(&mut self.normal, band.normal);
+        extend(&mut self.albedo, band.albedo);
+        extend(&mut self.traps, band.traps);
+        // `+` keeps the larger per-pixel maximum.
+        self.stats = self.stats + band.stats;
+    }
+}
+
 /// Which extra per-pixel layers to collect. Each is averaged over the
 /// pixel's samples that hit; a layer not asked for costs no memory.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -53,7 +73,8 @@ struct SampleResult {
 /// Work counted while rendering one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FrameStats {
-    /// Distance-estimator evaluations, every stage together.
+    /// Orbits computed for distance estimates and membership tests, every
+    /// stage together (1 per analytic estimate, 5 per gradient estimate).
     pub de_evaluations: u64,
     /// The same by stage: primary marching, normals, shadow marches, occlusion.
     pub primary_evaluations: u64,
@@ -176,25 +197,7 @@ pub fn render_frame_in_time(
         let rows = BAND_ROWS.min(height - first_row);
         let mut acc = Accumulation::new(width, rows, layers);
         render_rows(scenes, frame_index, &mut acc, n, first_row, height, on_row);
-        let band = acc.finish(n);
-        film.colour.extend(band.colour);
-        film.alpha.extend(band.alpha);
-        film.depth.extend(band.depth);
-        film.evaluations.extend(band.evaluations);
-        for (all, part) in [
-            (&mut film.normal, band.normal),
-            (&mut film.albedo, band.albedo),
-        ] {
-            if let (Some(all), Some(part)) = (all.as_mut(), part) {
-                all.extend(part);
-            }
-        }
-        if let (Some(all), Some(part)) = (film.traps.as_mut(), band.traps) {
-            all.extend(part);
-        }
-        let max_pixel = film.stats.max_pixel_evaluations;
-        film.stats = film.stats + band.stats;
-        film.stats.max_pixel_evaluations = max_pixel.max(band.stats.max_pixel_evaluations);
+        film.append(acc.finish(n));
         first_row += rows;
     }
     film
@@ -257,6 +260,7 @@ impl Accumulation {
             })
             .collect();
         let alpha = self.hits.iter().map(|&h| h as f32 / n as f32).collect();
+        // A pixel no sample hit has zero layer sums, which stay zero.
         let per_hit = |i: usize| 1.0 / self.hits[i].max(1) as f32;
         let normal = (!self.normal.is_empty())
             .then(|| self.normal.iter().map(|v| v.normalize_or_zero()).collect());
@@ -264,20 +268,14 @@ impl Accumulation {
             self.albedo
                 .iter()
                 .enumerate()
-                .map(|(i, &v)| if self.hits[i] > 0 { v * per_hit(i) } else { v })
+                .map(|(i, &v)| v * per_hit(i))
                 .collect()
         });
         let traps = (!self.traps.is_empty()).then(|| {
             self.traps
                 .iter()
                 .enumerate()
-                .map(|(i, v)| {
-                    if self.hits[i] > 0 {
-                        v.map(|x| x * per_hit(i))
-                    } else {
-                        *v
-                    }
-                })
+                .map(|(i, v)| v.map(|x| x * per_hit(i)))
                 .collect()
         });
         let max_pixel = self.spent.iter().copied().max().unwrap_or(0);
@@ -339,18 +337,12 @@ fn render_rows(
         .map(|s| (s.camera.position - s.camera.target).length())
         .collect();
     let w = width as usize;
-    let chunk = |on: bool| if on { w } else { usize::MAX };
     // An environment map is looked up once per frame, not per ray.
     let environment = scenes[0]
         .effects
         .path_tracing
         .as_ref()
         .and_then(|pt| pt.sky.environment());
-    let (normal_on, albedo_on, traps_on) = (
-        !acc.normal.is_empty(),
-        !acc.albedo.is_empty(),
-        !acc.traps.is_empty(),
-    );
     // One row per task; rayon spreads rows over threads and each pixel depends
     // only on its own samples, so the result is independent of the split.
     let stats = acc
@@ -359,17 +351,9 @@ fn render_rows(
         .zip(acc.hits.par_chunks_mut(w))
         .zip(acc.depth.par_chunks_mut(w))
         .zip(acc.spent.par_chunks_mut(w))
-        .zip(optional_rows(
-            &mut acc.normal,
-            chunk(normal_on),
-            band_height,
-        ))
-        .zip(optional_rows(
-            &mut acc.albedo,
-            chunk(albedo_on),
-            band_height,
-        ))
-        .zip(optional_rows(&mut acc.traps, chunk(traps_on), band_height))
+        .zip(optional_rows(&mut acc.normal, w, band_height))
+        .zip(optional_rows(&mut acc.albedo, w, band_height))
+        .zip(optional_rows(&mut acc.traps, w, band_height))
         .enumerate()
         .map(
             |(
@@ -719,8 +703,10 @@ mod tests {
             traps: true,
         };
         let scenes = std::slice::from_ref(&scene);
-        let at_once = render_frame_in_time(scenes, 3, 24, 16, layers, &|| {});
-        let mut acc = Accumulation::new(24, 16, layers);
+        // 130 rows: two whole bands of `BAND_ROWS` and a part one.
+        let (w, h) = (12, 2 * BAND_ROWS + 2);
+        let at_once = render_frame_in_time(scenes, 3, w, h, layers, &|| {});
+        let mut acc = Accumulation::new(w, h, layers);
         for until in [1, 2, 5, 6] {
             render_samples(scenes, 3, &mut acc, until, &|| {});
         }
@@ -728,5 +714,8 @@ mod tests {
         assert!(waves.colour == at_once.colour && waves.depth == at_once.depth);
         assert!(waves.normal == at_once.normal && waves.traps == at_once.traps);
         assert_eq!(waves.stats, at_once.stats);
+        assert!(waves.albedo == at_once.albedo && waves.alpha == at_once.alpha);
+        assert_eq!(waves.evaluations, at_once.evaluations);
+        assert_eq!(at_once.colour.len(), (w * h) as usize);
     }
 }

@@ -1,6 +1,8 @@
-//! What a hit looks like: orbit-trap colour, one directional light with Lambert
-//! diffuse plus ambient, the background gradient for misses, and the optional
-//! effects a scene declares (shadows, ambient occlusion, specular, fog, glow).
+//! What a hit looks like: orbit-trap colour, Lambert diffuse from the main
+//! light and up to `MAX_LIGHTS` − 1 extra ones plus ambient, the background
+//! gradient for misses, and the optional effects a scene declares (shadows,
+//! ambient occlusion, specular, fog, glow, motion blur, and the path tracer
+//! with its skies).
 //! An effect that is off (`None`) runs no code and spends no estimate.
 //!
 //! Colouring idea from ../shared/seeds/000 (Quilez, "Coloring"): the three plane
@@ -38,8 +40,9 @@ pub struct Effects {
 pub struct PathTracing {
     /// Most bounces of a path (Russian roulette usually ends it sooner).
     pub max_bounces: u32,
-    /// Apparent diameter of the sun (`look.light_direction`, irradiance
-    /// `look.light_colour`); 0.53° is the real sun's.
+    /// Apparent diameter of every light (the main one, `look.light_direction`
+    /// with irradiance `look.light_colour`, and the extra ones); 0.53° is the
+    /// real sun's.
     pub sun_angle_degrees: Real,
     pub sky: Sky,
     /// Scales the sky's radiance.
@@ -568,12 +571,7 @@ pub fn preetham(dir: DVec3, to_sun: DVec3, turbidity: Real) -> Vec3 {
         + (0.15346 * s3 - 0.26756 * s2 + 0.06670 * s1 + 0.26688);
     // Below the horizon: the horizon's colour at half brightness.
     let (d, dim) = if dir.y < 0.0 {
-        (
-            DVec3::new(dir.x, 0.0, dir.z)
-                .try_normalize()
-                .unwrap_or(DVec3::X),
-            0.5,
-        )
+        (normalize_or(DVec3::new(dir.x, 0.0, dir.z), DVec3::X), 0.5)
     } else {
         (dir, 1.0)
     };
@@ -617,7 +615,8 @@ pub fn trace_path(
     let mut radiance = Vec3::ZERO;
     let mut throughput = Vec3::ONE;
     let mut here = *at;
-    for bounce in 0..pt.max_bounces.max(1) {
+    let bounces = pt.max_bounces.max(1);
+    for bounce in 0..bounces {
         // Dimensions 0–3 belong to the pixel and lens; 32 per bounce after that:
         // 0–2 the bounce and roulette, then two per light.
         let dim = |k: u32| random(4 + 32 * bounce + k);
@@ -680,6 +679,9 @@ pub fn trace_path(
             radiance += throughput * sky * sky_scale;
             break;
         };
+        if bounce + 1 == bounces {
+            break; // the path ends here: its hit needs no normal
+        }
         // Russian roulette from the third bounce: unbiased, and paths that
         // carry little light end early.
         if bounce >= 2 {
