@@ -11,7 +11,7 @@
 //! machine's speed falls on both alike; medians are reported.
 
 use crate::error::{Error, Result};
-use crate::render::{render_frame_in_time, FrameStats, Layers};
+use crate::render::{render_frame_in_time, Film, FrameStats, Layers};
 use crate::timeline::Timeline;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -27,9 +27,6 @@ use std::time::Instant;
 /// azimuth vector 3, two complex eighth powers by three squarings of 6 each
 /// 36, the output 2); r⁷ 4; running derivative 3; adding c 3; |z| 6.
 pub const FLOPS_PER_POWER8_ITERATION: u64 = 69;
-
-/// Pixels of the frame the memory measurement renders (4K UHD).
-pub const MEMORY_SIZE: (u32, u32) = (3840, 2160);
 
 /// What the bench is asked to do.
 #[derive(Clone, Debug)]
@@ -49,25 +46,35 @@ pub struct Options {
     /// Where `<machine>.csv` and `<machine>.md` go.
     pub results: PathBuf,
     pub machine: String,
+    /// The machine's peak, detected once for every row.
+    pub peak: Peak,
     pub quiet: bool,
 }
 
+/// FMA units per core: 2 on current x86 server cores (an assumption; the
+/// CPU does not report it).
+pub const FMA_UNITS: u32 = 2;
+
 /// The machine's floating-point peak, from what the CPU reports.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug)]
 pub struct Peak {
     pub cpu: String,
+    /// Physical cores: hyper-threads share their core's FMA units.
     pub cores: usize,
     pub clock_ghz: f64,
     /// f64 lanes of the widest vector unit (8 with AVX-512, 4 with AVX2, 2 with SSE2).
     pub lanes: u32,
-    /// FMA units per core (2 on current x86 server cores; an assumption).
-    pub fma_units: u32,
 }
 
 impl Peak {
     /// cores × FMA units × lanes × 2 flops × clock, in GFLOP/s.
     pub fn gflops(&self) -> f64 {
-        self.cores as f64 * self.fma_units as f64 * self.lanes as f64 * 2.0 * self.clock_ghz
+        self.cores as f64 * FMA_UNITS as f64 * self.lanes as f64 * 2.0 * self.clock_ghz
+    }
+
+    /// The peak of `threads` threads: one core each, at most every core.
+    pub fn gflops_for(&self, threads: usize) -> f64 {
+        self.gflops() * threads.min(self.cores) as f64 / self.cores as f64
     }
 
     /// Reads the CPU model, clock and vector width of this machine.
@@ -83,12 +90,31 @@ impl Peak {
         let clock_ghz = field("cpu MHz")
             .and_then(|v| v.parse::<f64>().ok())
             .map_or(0.0, |mhz| mhz / 1000.0);
+        // Distinct (physical id, core id) pairs; logical CPUs where absent.
+        let mut core_ids = std::collections::BTreeSet::new();
+        let mut physical = "";
+        for line in cpuinfo.lines() {
+            if let Some((key, value)) = line.split_once(':') {
+                match key.trim() {
+                    "physical id" => physical = value.trim(),
+                    "core id" => {
+                        core_ids.insert((physical, value.trim()));
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let logical = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let cores = if core_ids.is_empty() {
+            logical
+        } else {
+            core_ids.len().min(logical)
+        };
         Peak {
             cpu: field("model name").unwrap_or_else(|| std::env::consts::ARCH.to_string()),
-            cores: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            cores,
             clock_ghz,
             lanes: vector_lanes(),
-            fma_units: 2,
         }
     }
 }
@@ -261,7 +287,7 @@ pub struct Row {
     pub peak_gflops: f64,
     pub fraction_of_peak: f64,
     pub peak_rss_mib: f64,
-    /// Size of the frame's output buffers (RGB, alpha and depth as f32), MiB.
+    /// Size of the frame's output buffers (`Film::BYTES_PER_PIXEL` per pixel), MiB.
     pub output_buffers_mib: f64,
     /// Mandelbulber2's median over mandelreel's, on the mandelreel row.
     pub speedup_vs_mandelbulber2: f64,
@@ -295,16 +321,20 @@ fn timing_row(mut row: Row, runs: &[Measurement], work: Option<&Work>, peak: &Pe
         let t = row.median_s.max(1e-9);
         row.frames = w.frames;
         row.pixels = w.pixels;
-        row.mpixels_per_s = w.pixels as f64 / t / 1e6;
+        row.mpixels_per_s = mpixels_per_s(w.pixels, t);
         row.de_evaluations = w.stats.de_evaluations;
         row.de_evaluations_per_s = w.stats.de_evaluations as f64 / t;
         row.de_iterations = w.stats.de_iterations;
         row.de_iterations_per_s = w.stats.de_iterations as f64 / t;
         row.gflops = row.de_iterations_per_s * FLOPS_PER_POWER8_ITERATION as f64 / 1e9;
-        row.peak_gflops = peak.gflops() * row.threads as f64 / peak.cores as f64;
+        row.peak_gflops = peak.gflops_for(row.threads);
         row.fraction_of_peak = row.gflops / row.peak_gflops.max(1e-9);
     }
     row
+}
+
+fn mpixels_per_s(pixels: u64, seconds: f64) -> f64 {
+    pixels as f64 / seconds.max(1e-9) / 1e6
 }
 
 fn log(quiet: bool, message: &str) {
@@ -355,8 +385,8 @@ fn mandelbulber_args(fract: &Path, out: &Path, keyframed: bool) -> Vec<String> {
 /// Runs the whole benchmark and returns its rows.
 pub fn run(options: &Options) -> Result<Vec<Row>> {
     let exe = std::env::current_exe().map_err(|e| Error::io(Path::new("mandelreel"), e))?;
-    let peak = Peak::detect();
-    let all_threads = peak.cores;
+    let peak = &options.peak;
+    let all_threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let scenes = scenes(&options.scenes, &options.fract_dir)?;
     let scratch = tempfile::tempdir().map_err(|e| Error::io(Path::new("temp"), e))?;
     let base = || Row {
@@ -424,7 +454,7 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
             },
             &a,
             Some(&work),
-            &peak,
+            peak,
         );
         if !b.is_empty() {
             let mut theirs_row = timing_row(
@@ -438,10 +468,10 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
                 },
                 &b,
                 None,
-                &peak,
+                peak,
             );
             ours_row.speedup_vs_mandelbulber2 = theirs_row.median_s / ours_row.median_s.max(1e-9);
-            theirs_row.mpixels_per_s = work.pixels as f64 / theirs_row.median_s.max(1e-9) / 1e6;
+            theirs_row.mpixels_per_s = mpixels_per_s(work.pixels, theirs_row.median_s);
             rows.push(ours_row);
             rows.push(theirs_row);
         } else {
@@ -486,7 +516,7 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
             },
             &runs,
             Some(&work),
-            &peak,
+            peak,
         );
         if let Some(one) = one {
             row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
@@ -495,7 +525,7 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     }
 
     // The kernel alone: analytic estimates at points where marching spends its time.
-    rows.push(kernel_row(&timeline, &peak, base()));
+    rows.push(kernel_row(&timeline, peak, base()));
 
     // Peak memory of a big EXR frame against its output buffers.
     if let Some((w, h)) = options.memory_size {
@@ -518,19 +548,16 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
             },
             &[m],
             None,
-            &peak,
+            peak,
         );
         row.frames = 1;
         row.pixels = w as u64 * h as u64;
-        row.mpixels_per_s = row.pixels as f64 / row.median_s.max(1e-9) / 1e6;
-        row.output_buffers_mib = row.pixels as f64 * OUTPUT_BYTES_PER_PIXEL as f64 / MIB;
+        row.mpixels_per_s = mpixels_per_s(row.pixels, row.median_s);
+        row.output_buffers_mib = row.pixels as f64 * Film::BYTES_PER_PIXEL as f64 / MIB;
         rows.push(row);
     }
     Ok(rows)
 }
-
-/// Bytes per pixel of a frame's output buffers: linear RGB, alpha and depth, f32 each.
-pub const OUTPUT_BYTES_PER_PIXEL: u64 = 20;
 
 /// Measures DE iterations per second of the analytic estimator on every
 /// thread, at points on a shell just outside the bulb of `timeline`'s first
@@ -539,11 +566,9 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
     let fractal = timeline.scene_at(0).fractal;
     let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
     let threads = rayon::current_num_threads();
-    let mut walls = Vec::new();
-    let mut iterations = 0;
-    for _ in 0..5 {
-        let start = Instant::now();
-        iterations = points
+    // One pass over the points: its orbit iterations.
+    let pass = || {
+        points
             .par_chunks(1024)
             .map(|chunk| {
                 let before = crate::fractal::iterations_on_this_thread();
@@ -554,23 +579,38 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
                 std::hint::black_box(sum);
                 crate::fractal::iterations_on_this_thread() - before
             })
-            .sum::<u64>();
-        walls.push(Measurement {
-            wall_s: start.elapsed().as_secs_f64(),
-            peak_rss_kib: 0,
-            exit_code: 0,
-        });
-    }
+            .sum::<u64>()
+    };
+    // A warm-up pass, then samples of enough passes to last 0.2 s each, so
+    // thread start-up and fork/join are a small part of what is timed.
+    let start = Instant::now();
+    let iterations_per_pass = pass();
+    let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
+        .ceil()
+        .max(1.0) as u64;
+    let walls: Vec<Measurement> = (0..5)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..passes {
+                pass();
+            }
+            Measurement {
+                wall_s: start.elapsed().as_secs_f64(),
+                peak_rss_kib: 0,
+                exit_code: 0,
+            }
+        })
+        .collect();
     let work = Work {
         frames: 0,
         pixels: 0,
         stats: FrameStats {
-            de_evaluations: points.len() as u64,
-            de_iterations: iterations,
+            de_evaluations: points.len() as u64 * passes,
+            de_iterations: iterations_per_pass * passes,
             ..FrameStats::default()
         },
     };
-    let mut row = timing_row(
+    timing_row(
         Row {
             scene: "kernel".into(),
             renderer: "mandelreel".into(),
@@ -580,9 +620,7 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
         &walls,
         Some(&work),
         peak,
-    );
-    row.peak_rss_mib = 0.0;
-    row
+    )
 }
 
 /// The rows as CSV, one header line first.
@@ -595,7 +633,7 @@ scaling_vs_one_thread";
     for r in rows {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{:.4},{:.4},{:.4},{},{},{:.3},{},{:.4e},{},{:.4e},{:.3},{:.1},{:.4},{:.1},{:.1},{:.2},{:.2}",
+            "{},{},{},{},{},{:.4},{:.4},{:.4},{},{},{:.3},{},{:.4e},{},{:.4e},{:.3},{:.1},{:.4},{:.1},{:.3},{:.2},{:.2}",
             r.machine.replace(',', " "),
             r.scene.replace(',', " "),
             r.renderer,
@@ -696,10 +734,11 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         let _ = writeln!(
             md,
             "\nPeak memory, {}: {:.0} MiB against {:.0} MiB of output buffers \
-(RGB, alpha, depth as f32): {:.2}×, in {:.1} s.",
+(the film: colour, alpha, depth, estimates per pixel; {} B/px): {:.2}×, in {:.1} s.",
             r.scene,
             r.peak_rss_mib,
             r.output_buffers_mib,
+            Film::BYTES_PER_PIXEL,
             r.peak_rss_mib / r.output_buffers_mib.max(1e-9),
             r.median_s
         );
@@ -711,11 +750,11 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
 /// returns the Markdown.
 pub fn run_and_write(options: &Options) -> Result<String> {
     let rows = run(options)?;
-    let peak = Peak::detect();
+    let peak = &options.peak;
     std::fs::create_dir_all(&options.results).map_err(|e| Error::io(&options.results, e))?;
     let csv = options.results.join(format!("{}.csv", options.machine));
     std::fs::write(&csv, to_csv(&rows)).map_err(|e| Error::io(&csv, e))?;
-    let md_text = to_markdown(&rows, &peak);
+    let md_text = to_markdown(&rows, peak);
     let md = options.results.join(format!("{}.md", options.machine));
     std::fs::write(&md, &md_text).map_err(|e| Error::io(&md, e))?;
     Ok(md_text)
@@ -755,16 +794,18 @@ mod tests {
             cores: 2,
             clock_ghz: 2.5,
             lanes: 4,
-            fma_units: 2,
         };
         assert_eq!(p.gflops(), 2.0 * 2.0 * 4.0 * 2.0 * 2.5);
+        // More threads than cores get no more peak.
+        assert_eq!(p.gflops_for(1), p.gflops() / 2.0);
+        assert_eq!(p.gflops_for(8), p.gflops());
         assert_eq!(default_machine_name(&p), "2core-test");
     }
 
     #[test]
-    fn the_power8_iteration_count_matches_the_kernel() {
-        // The flop count assumes the whole-power path; check a power-8 orbit
-        // counts one iteration per power step through the thread counter.
+    fn the_iteration_counter_counts_each_power_step() {
+        // The flop rate is iterations × flops per iteration: check a power-8
+        // orbit counts one iteration per power step through the thread counter.
         let f = crate::fractal::Fractal {
             iterations: 5,
             ..crate::fractal::Fractal::default()

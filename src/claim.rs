@@ -228,7 +228,11 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             .open(&marker)
         {
             Ok(_) => {
-                write_record(&path, &record)?;
+                if let Err(e) = write_record(&path, &record) {
+                    // A marker left behind would block this frame for good.
+                    let _ = std::fs::remove_file(&marker);
+                    return Err(e);
+                }
                 return Ok(Attempt::Claimed(Claim::start(
                     dir,
                     frame_index,
@@ -238,7 +242,18 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                // Someone else is taking it over; their claim will show up live.
+                // Someone else is taking it over; their claim will show up
+                // live. Unless the marker is older than the timeout: its maker
+                // died before writing its claim, so clear it and try again.
+                let stale = std::fs::metadata(&marker)
+                    .and_then(|m| m.modified())
+                    .ok()
+                    .and_then(|t| t.elapsed().ok())
+                    .is_some_and(|age| age > timeout);
+                if stale {
+                    let _ = std::fs::remove_file(&marker);
+                    continue;
+                }
                 return Ok(Attempt::Held(held));
             }
             Err(e) => return Err(Error::io(&marker, e)),
@@ -272,16 +287,51 @@ mod tests {
         ));
     }
 
-    #[test]
-    fn a_dead_claim_is_taken_over_exactly_once() {
-        let dir = tempfile::tempdir().unwrap();
+    /// The claim of a worker that stopped beating two minutes ago, under the
+    /// token "dead-token".
+    fn write_dead_claim(dir: &Path, frame_index: u32) -> ClaimRecord {
         let dead = ClaimRecord {
             host: "gone".into(),
             pid: 1,
             token: "dead-token".into(),
             heartbeat_ms: now_ms() - 120_000,
         };
-        write_record(&claim_path(dir.path(), 7), &dead).unwrap();
+        write_record(&claim_path(dir, frame_index), &dead).unwrap();
+        dead
+    }
+
+    #[test]
+    fn a_takeover_marker_blocks_until_it_is_older_than_the_timeout() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = write_dead_claim(dir.path(), 5);
+        let timeout = Duration::from_secs(60);
+        // Another worker has just begun taking the dead claim over.
+        let marker = takeover_path(dir.path(), 5, "dead-token");
+        let file = std::fs::File::create(&marker).unwrap();
+        assert!(matches!(
+            try_claim(dir.path(), 5, timeout).unwrap(),
+            Attempt::Held(_)
+        ));
+        assert_eq!(read_claim(&claim_path(dir.path(), 5)).unwrap(), dead);
+        // That worker died before writing its claim: once its marker is older
+        // than the timeout, the frame is taken over instead of blocked forever.
+        file.set_modified(std::time::SystemTime::now() - Duration::from_secs(120))
+            .unwrap();
+        drop(file);
+        let Attempt::Claimed(ours) = try_claim(dir.path(), 5, timeout).unwrap() else {
+            panic!("a stale marker does not block the frame");
+        };
+        assert_eq!(
+            read_claim(&claim_path(dir.path(), 5)).unwrap().pid,
+            std::process::id()
+        );
+        drop(ours);
+    }
+
+    #[test]
+    fn a_dead_claim_is_taken_over_exactly_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let dead = write_dead_claim(dir.path(), 7);
         let timeout = Duration::from_secs(60);
         let first = try_claim(dir.path(), 7, timeout).unwrap();
         let Attempt::Claimed(ours) = first else {

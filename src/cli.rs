@@ -1401,6 +1401,7 @@ fn sheet(args: SheetArgs) -> anyhow::Result<()> {
 /// `bench`: checks the options, runs the benchmark, prints the tables.
 fn bench(args: BenchArgs) -> anyhow::Result<()> {
     let peak = crate::bench::Peak::detect();
+    let logical_cpus = std::thread::available_parallelism().map_or(1, |n| n.get());
     let memory_size = match args.memory_size.as_str() {
         "none" => None,
         text => Some(parse_size("--memory-size", text)?),
@@ -1410,9 +1411,9 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
     }
     let threads = if args.threads.is_empty() {
         let mut t: Vec<usize> = std::iter::successors(Some(1), |n| Some(n * 2))
-            .take_while(|&n| n < peak.cores)
+            .take_while(|&n| n < logical_cpus)
             .collect();
-        t.push(peak.cores);
+        t.push(logical_cpus);
         t
     } else {
         args.threads.clone()
@@ -1448,6 +1449,7 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         machine: args
             .machine
             .unwrap_or_else(|| crate::bench::default_machine_name(&peak)),
+        peak,
         quiet: args.quiet,
     };
     let md = crate::bench::run_and_write(&options)?;

@@ -35,6 +35,11 @@ pub struct Film {
 }
 
 impl Film {
+    /// Bytes per pixel of the buffers every film holds (colour, alpha,
+    /// depth, evaluations); the optional layers add to it.
+    pub const BYTES_PER_PIXEL: usize =
+        std::mem::size_of::<Vec3>() + std::mem::size_of::<f32>() * 2 + std::mem::size_of::<u32>();
+
     /// Adds the rows of `band` below this film's (layers present in both).
     fn append(&mut self, band: Film) {
         fn extend<T>(all: &mut Option<Vec<T>>, part: Option<Vec<T>>) {

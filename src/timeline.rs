@@ -520,9 +520,15 @@ impl Timeline {
             base: file.scene,
             tracks,
         };
-        // Splines can overshoot their keys: check every frame the tracks produce.
+        // Splines can overshoot their keys: check every scene the frames
+        // render, motion blur's instants between frames included.
         for frame in 0..frame_count {
-            if let Err((field, message)) = validate_scene(&timeline.scene_at(frame)) {
+            let failure = timeline.sample_times(frame).into_iter().find_map(|time| {
+                validate_scene(&timeline.scene_at_time(time))
+                    .err()
+                    .map(|e| (time, e))
+            });
+            if let Some((time, (field, message))) = failure {
                 let animated = timeline
                     .tracks
                     .iter()
@@ -534,10 +540,7 @@ impl Timeline {
                     .collect::<Vec<_>>();
                 return Err(invalid(
                     animated.first().and_then(|n| line_of(text, n, 0)),
-                    format!(
-                        "frame {frame} (t = {:.4} s): scene.{field}",
-                        timeline.time_of(frame)
-                    ),
+                    format!("frame {frame} (t = {time:.4} s): scene.{field}"),
                     format!(
                         "{message}{}",
                         if animated.is_empty() {
@@ -576,31 +579,44 @@ impl Timeline {
         scene
     }
 
-    /// The scenes a frame's samples see: the frame's own, or with motion blur
-    /// one per sample spread evenly over the open shutter (sample s at
+    /// The instants a frame's samples see: the frame's own, or with motion
+    /// blur one per sample spread evenly over the open shutter (sample s at
     /// (s + ½)/n of it), so everything animated blurs as a camera would see it.
-    pub fn scenes_for_frame(&self, frame_index: u32) -> Vec<Scene> {
+    pub fn sample_times(&self, frame_index: u32) -> Vec<Real> {
+        let time = self.time_of(frame_index);
         let scene = self.scene_at(frame_index);
         let Some(blur) = &scene.effects.motion_blur else {
-            return vec![scene];
+            return vec![time];
         };
         let n = scene.samples_per_pixel.max(1);
         let open = blur.shutter / self.fps;
         (0..n)
-            .map(|s| {
-                self.scene_at_time(self.time_of(frame_index) + open * (s as Real + 0.5) / n as Real)
-            })
+            .map(|s| time + open * (s as Real + 0.5) / n as Real)
+            .collect()
+    }
+
+    /// The scenes a frame's samples see, one per `sample_times` instant.
+    pub fn scenes_for_frame(&self, frame_index: u32) -> Vec<Scene> {
+        self.sample_times(frame_index)
+            .into_iter()
+            .map(|t| self.scene_at_time(t))
             .collect()
     }
 }
 
 /// Checks one frame's scene; on failure returns the field path and the problem.
 pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
-    fn check(ok: bool, field: &str, message: String) -> Result<(), (String, String)> {
+    // The message is built only when the check fails: every rendered
+    // scene is checked, thousands per frame under motion blur.
+    fn check(
+        ok: bool,
+        field: &str,
+        message: impl FnOnce() -> String,
+    ) -> Result<(), (String, String)> {
         if ok {
             Ok(())
         } else {
-            Err((field.to_string(), message))
+            Err((field.to_string(), message()))
         }
     }
     let finite3 = |v: DVec3| v.is_finite();
@@ -610,32 +626,30 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         ("camera.target", c.target),
         ("camera.up", c.up),
     ] {
-        check(finite3(v), field, format!("must be finite, got {v}"))?;
+        check(finite3(v), field, || format!("must be finite, got {v}"))?;
     }
-    check(
-        c.roll_degrees.is_finite(),
-        "camera.roll_degrees",
-        format!("must be finite, got {}", c.roll_degrees),
-    )?;
+    check(c.roll_degrees.is_finite(), "camera.roll_degrees", || {
+        format!("must be finite, got {}", c.roll_degrees)
+    })?;
     check(
         c.fov_degrees.is_finite() && c.fov_degrees > 0.0 && c.fov_degrees < 179.0,
         "camera.fov_degrees",
-        format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
+        || format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
     )?;
     check(
         c.aperture_radius.is_finite() && c.aperture_radius >= 0.0,
         "camera.aperture_radius",
-        format!(
-            "must be 0 (a pinhole) or positive, got {}",
-            c.aperture_radius
-        ),
+        || {
+            format!(
+                "must be 0 (a pinhole) or positive, got {}",
+                c.aperture_radius
+            )
+        },
     )?;
     if let Some(f) = c.focus_distance {
-        check(
-            f.is_finite() && f > 0.0,
-            "camera.focus_distance",
-            format!("must be positive, got {f}"),
-        )?;
+        check(f.is_finite() && f > 0.0, "camera.focus_distance", || {
+            format!("must be positive, got {f}")
+        })?;
     }
     let view = c.target - c.position;
     // Below a few ulps of the coordinates the view direction is noise.
@@ -648,50 +662,50 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         view.length() > 8.0 * Real::EPSILON * scale,
         "camera.target",
-        format!(
+        || {
+            format!(
             "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale)",
             8.0 * Real::EPSILON * scale
-        ),
+        )
+        },
     )?;
     check(
         view.normalize().cross(c.up).length() > 1e-9,
         "camera.up",
-        format!(
-            "must not be zero or parallel to the view direction, got {}",
-            c.up
-        ),
+        || {
+            format!(
+                "must not be zero or parallel to the view direction, got {}",
+                c.up
+            )
+        },
     )?;
     let f = &s.fractal;
     check(
         f.power.is_finite() && f.power >= 1.0 && f.power <= 64.0,
         "fractal.power",
-        format!("must be between 1 and 64, got {}", f.power),
+        || format!("must be between 1 and 64, got {}", f.power),
     )?;
     check(
         (1..=10_000).contains(&f.iterations),
         "fractal.iterations",
-        format!("must be 1..=10000, got {}", f.iterations),
+        || format!("must be 1..=10000, got {}", f.iterations),
     )?;
     check(
         f.bailout.is_finite() && f.bailout > 1.0,
         "fractal.bailout",
-        format!("must be a finite number above 1, got {}", f.bailout),
+        || format!("must be a finite number above 1, got {}", f.bailout),
     )?;
     // An orbit at the bailout is raised to the power once more: keep that finite.
-    check(
-        f.power * f.bailout.ln() < 600.0,
-        "fractal.bailout",
+    check(f.power * f.bailout.ln() < 600.0, "fractal.bailout", || {
         format!(
             "bailout^power must stay below e^600 (f64 overflows near e^709), got {}^{}",
             f.bailout, f.power
-        ),
-    )?;
+        )
+    })?;
     if let Some(k) = f.julia {
-        check(
-            finite3(k),
-            "fractal.julia",
-            format!("must be finite, got {k}"),
-        )?;
+        check(finite3(k), "fractal.julia", || {
+            format!("must be finite, got {k}")
+        })?;
     }
     let q = &s.quality;
     for (field, v) in [
@@ -699,40 +713,40 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         ("quality.normal_step", q.normal_step),
         ("quality.bounding_radius", q.bounding_radius),
     ] {
-        check(
-            v.is_finite() && v > 0.0,
-            field,
-            format!("must be a positive number, got {v}"),
-        )?;
+        check(v.is_finite() && v > 0.0, field, || {
+            format!("must be a positive number, got {v}")
+        })?;
     }
     check(
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
         "quality.fudge",
-        format!("must be in (0, 1], got {}", q.fudge),
+        || format!("must be in (0, 1], got {}", q.fudge),
     )?;
     check(
         q.over_relaxation.is_finite() && (1.0..2.0).contains(&q.over_relaxation),
         "quality.over_relaxation",
-        format!("must be in [1, 2), got {}", q.over_relaxation),
+        || format!("must be in [1, 2), got {}", q.over_relaxation),
     )?;
     check(
         (1..=1_000_000).contains(&q.max_steps),
         "quality.max_steps",
-        format!("must be 1..=1000000, got {}", q.max_steps),
+        || format!("must be 1..=1000000, got {}", q.max_steps),
     )?;
     check(
         (1..=4096).contains(&s.samples_per_pixel),
         "samples_per_pixel",
-        format!("must be 1..=4096, got {}", s.samples_per_pixel),
+        || format!("must be 1..=4096, got {}", s.samples_per_pixel),
     )?;
     let l = &s.look;
     check(
         finite3(l.light_direction) && l.light_direction.length() > 0.0,
         "look.light_direction",
-        format!(
-            "must be a finite non-zero vector, got {}",
-            l.light_direction
-        ),
+        || {
+            format!(
+                "must be a finite non-zero vector, got {}",
+                l.light_direction
+            )
+        },
     )?;
     for (field, v) in [
         ("look.light_colour", l.light_colour),
@@ -744,31 +758,31 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         ("look.background_top", l.background_top),
         ("look.background_bottom", l.background_bottom),
     ] {
-        check(
-            v.is_finite() && v.min_element() >= 0.0,
-            field,
-            format!("colours must be finite and non-negative, got {v}"),
-        )?;
+        check(v.is_finite() && v.min_element() >= 0.0, field, || {
+            format!("colours must be finite and non-negative, got {v}")
+        })?;
     }
     check(
         l.trap_occlusion.is_finite() && (0.0..=1.0).contains(&l.trap_occlusion),
         "look.trap_occlusion",
-        format!("must be in [0, 1], got {}", l.trap_occlusion),
+        || format!("must be in [0, 1], got {}", l.trap_occlusion),
     )?;
     check(
         l.extra_lights.len() < crate::shade::MAX_LIGHTS,
         "look.extra_lights",
-        format!(
-            "at most {} extra lights, got {}",
-            crate::shade::MAX_LIGHTS - 1,
-            l.extra_lights.len()
-        ),
+        || {
+            format!(
+                "at most {} extra lights, got {}",
+                crate::shade::MAX_LIGHTS - 1,
+                l.extra_lights.len()
+            )
+        },
     )?;
     for (i, light) in l.extra_lights.iter().enumerate() {
         check(
             light.direction.is_finite() && light.direction.length() > 0.0,
             &format!("look.extra_lights[{i}].direction"),
-            format!("must be a finite non-zero vector, got {}", light.direction),
+            || format!("must be a finite non-zero vector, got {}", light.direction),
         )?;
         check(
             light.colour.is_finite()
@@ -776,10 +790,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                 && light.intensity.is_finite()
                 && light.intensity >= 0.0,
             &format!("look.extra_lights[{i}]"),
-            format!(
-                "colour and intensity must be finite and non-negative, got {} × {}",
-                light.colour, light.intensity
-            ),
+            || {
+                format!(
+                    "colour and intensity must be finite and non-negative, got {} × {}",
+                    light.colour, light.intensity
+                )
+            },
         )?;
     }
     let e = &s.effects;
@@ -787,89 +803,93 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             sh.softness.is_finite() && sh.softness >= 0.0,
             "effects.shadows.softness",
-            format!("must be 0 (hard) or positive, got {}", sh.softness),
+            || format!("must be 0 (hard) or positive, got {}", sh.softness),
         )?;
         check(
             (1..=100_000).contains(&sh.max_steps),
             "effects.shadows.max_steps",
-            format!("must be 1..=100000, got {}", sh.max_steps),
+            || format!("must be 1..=100000, got {}", sh.max_steps),
         )?;
     }
     if let Some(ao) = &e.ambient_occlusion {
         check(
             (1..=64).contains(&ao.samples),
             "effects.ambient_occlusion.samples",
-            format!("must be 1..=64, got {}", ao.samples),
+            || format!("must be 1..=64, got {}", ao.samples),
         )?;
         check(
             ao.radius.is_finite() && ao.radius > 0.0,
             "effects.ambient_occlusion.radius",
-            format!("must be positive, got {}", ao.radius),
+            || format!("must be positive, got {}", ao.radius),
         )?;
         check(
             ao.strength.is_finite() && (0.0..=1.0).contains(&ao.strength),
             "effects.ambient_occlusion.strength",
-            format!("must be in [0, 1], got {}", ao.strength),
+            || format!("must be in [0, 1], got {}", ao.strength),
         )?;
     }
     if let Some(sp) = &e.specular {
         check(
             sp.strength.is_finite() && sp.strength >= 0.0,
             "effects.specular.strength",
-            format!("must be non-negative, got {}", sp.strength),
+            || format!("must be non-negative, got {}", sp.strength),
         )?;
         check(
             sp.shininess.is_finite() && sp.shininess > 0.0,
             "effects.specular.shininess",
-            format!("must be positive, got {}", sp.shininess),
+            || format!("must be positive, got {}", sp.shininess),
         )?;
     }
     if let Some(fog) = &e.fog {
         check(
             fog.density.is_finite() && fog.density >= 0.0,
             "effects.fog.density",
-            format!("must be non-negative, got {}", fog.density),
+            || format!("must be non-negative, got {}", fog.density),
         )?;
         check(
             fog.colour.is_finite() && fog.colour.min_element() >= 0.0,
             "effects.fog.colour",
-            format!(
-                "colours must be finite and non-negative, got {}",
-                fog.colour
-            ),
+            || {
+                format!(
+                    "colours must be finite and non-negative, got {}",
+                    fog.colour
+                )
+            },
         )?;
     }
     if let Some(pt) = &e.path_tracing {
         check(
             e.shadows.is_none() && e.ambient_occlusion.is_none() && e.specular.is_none(),
             "effects.path_tracing",
-            "path tracing computes shadows and occlusion itself: remove shadows, ambient_occlusion and specular".into(),
+            || {
+                "path tracing computes shadows and occlusion itself: remove shadows, ambient_occlusion and specular".into()
+            },
         )?;
         check(
             (1..=1024).contains(&pt.max_bounces),
             "effects.path_tracing.max_bounces",
-            format!("must be 1..=1024, got {}", pt.max_bounces),
+            || format!("must be 1..=1024, got {}", pt.max_bounces),
         )?;
         check(
             pt.sun_angle_degrees.is_finite() && (0.0..=30.0).contains(&pt.sun_angle_degrees),
             "effects.path_tracing.sun_angle_degrees",
-            format!("must be 0..=30, got {}", pt.sun_angle_degrees),
+            || format!("must be 0..=30, got {}", pt.sun_angle_degrees),
         )?;
         check(
             pt.sky_intensity.is_finite() && pt.sky_intensity >= 0.0,
             "effects.path_tracing.sky_intensity",
-            format!("must be non-negative, got {}", pt.sky_intensity),
+            || format!("must be non-negative, got {}", pt.sky_intensity),
         )?;
         match pt.sky {
             crate::shade::Sky::Constant(c) => check(
                 c.is_finite() && c.min_element() >= 0.0,
                 "effects.path_tracing.sky",
-                format!("a constant sky must be finite and non-negative, got {c}"),
+                || format!("a constant sky must be finite and non-negative, got {c}"),
             )?,
             crate::shade::Sky::Preetham { turbidity } => check(
                 turbidity.is_finite() && (1.7..=12.0).contains(&turbidity),
                 "effects.path_tracing.sky",
-                format!("Preetham turbidity must be 1.7..=12, got {turbidity}"),
+                || format!("Preetham turbidity must be 1.7..=12, got {turbidity}"),
             )?,
             crate::shade::Sky::Gradient | crate::shade::Sky::Environment { .. } => {}
         }
@@ -878,24 +898,24 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             m.shutter.is_finite() && m.shutter > 0.0 && m.shutter <= 1.0,
             "effects.motion_blur.shutter",
-            format!("must be in (0, 1] of the frame interval, got {}", m.shutter),
+            || format!("must be in (0, 1] of the frame interval, got {}", m.shutter),
         )?;
     }
     if let Some(g) = &e.glow {
         check(
             g.strength.is_finite() && g.strength >= 0.0,
             "effects.glow.strength",
-            format!("must be non-negative, got {}", g.strength),
+            || format!("must be non-negative, got {}", g.strength),
         )?;
         check(
             g.width.is_finite() && g.width > 0.0,
             "effects.glow.width",
-            format!("must be positive, got {}", g.width),
+            || format!("must be positive, got {}", g.width),
         )?;
         check(
             g.colour.is_finite() && g.colour.min_element() >= 0.0,
             "effects.glow.colour",
-            format!("colours must be finite and non-negative, got {}", g.colour),
+            || format!("colours must be finite and non-negative, got {}", g.colour),
         )?;
     }
     Ok(())

@@ -87,8 +87,15 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     let two = row("tiny (scaling)", "mandelreel", "2");
     assert_eq!(num(one, "scaling_vs_one_thread"), 1.0);
     assert!(num(two, "scaling_vs_one_thread") > 0.0);
+    // … and each is the one-thread median over its own.
+    let expected = num(one, "median_s") / num(two, "median_s");
+    assert!(
+        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
+        "{csv}"
+    );
     // The kernel row measures a share of the nominal peak, and the memory row
-    // a peak RSS against the output buffers (64×36 pixels × 20 bytes).
+    // a peak RSS against the output buffers (64×36 pixels × 24 bytes: RGB,
+    // alpha, depth and the estimate count, 4 bytes each).
     let kernel = rows.iter().find(|r| r[col("scene")] == "kernel").unwrap();
     let fraction = num(kernel, "fraction_of_peak");
     assert!(fraction > 0.0 && fraction < 1.0, "{fraction}");
@@ -96,7 +103,7 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         .iter()
         .find(|r| r[col("scene")].contains("@64x36"))
         .unwrap();
-    assert!((num(memory, "output_buffers_mib") - 64.0 * 36.0 * 20.0 / 1048576.0).abs() < 0.05);
+    assert!((num(memory, "output_buffers_mib") - 64.0 * 36.0 * 24.0 / 1048576.0).abs() < 0.001);
     #[cfg(target_os = "linux")]
     assert!(num(memory, "peak_rss_mib") > 1.0, "{csv}");
 }

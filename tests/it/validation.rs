@@ -134,3 +134,36 @@ fn missing_timeline_is_an_io_failure() {
     assert!(stderr(&out).contains("nope.ron"));
     assert!(!d.path().join("out").exists());
 }
+
+#[test]
+fn motion_blur_instants_between_frames_are_checked_too() {
+    // Every frame sits on a key, so each frame's own scene is valid, but the
+    // Catmull-Rom curve dips below bailout 1 between the keys at 0 s and
+    // 1 s, where frame 0's open shutter sends its samples.
+    let timeline = "(
+    fps: 1,
+    frames: 3,
+    size: (8, 6),
+    scene: (samples_per_pixel: 4, effects: (motion_blur: (shutter: 1))),
+    tracks: {
+        \"fractal.bailout\": (interpolation: CatmullRom, keys: [(time: 0, value: 4), (time: 1, value: 1.01), (time: 2, value: 50)]),
+    },
+)";
+    rejected(
+        timeline,
+        &[],
+        3,
+        &[
+            "frame 0 (t = 0.",
+            "fractal.bailout",
+            "set by track \"fractal.bailout\"",
+        ],
+    );
+    // Without the blur the same tracks render.
+    let d = Dir::new();
+    d.write(
+        "ok.ron",
+        &timeline.replace(", effects: (motion_blur: (shutter: 1))", ""),
+    );
+    d.ok(&["render", "ok.ron", "--quiet"]);
+}
