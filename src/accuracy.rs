@@ -146,7 +146,7 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     for v in [0.5, 0.7, 1.0] {
         add("fudge", format!("{v}"), &|s| s.quality.fudge = v);
     }
-    for v in [1.2, 1.5, 1.8] {
+    for v in [1.0, 1.2, 1.5, 1.8] {
         add("over_relaxation", format!("{v}"), &|s| {
             s.quality.over_relaxation = v
         });
@@ -615,11 +615,11 @@ pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()>
         root.present().map_err(|e| chart_error(e.to_string()))?;
     }
     let image = image::RgbImage::from_raw(w, h, pixels).expect("buffer matches the chart size");
-    let temp = crate::output::temporary_path(path);
-    image
-        .save_with_format(&temp, image::ImageFormat::Png)
-        .map_err(|e| chart_error(e.to_string()))?;
-    std::fs::rename(&temp, path).map_err(|e| Error::io(path, e))
+    crate::output::write_atomic(path, |w, _| {
+        image
+            .write_to(w, image::ImageFormat::Png)
+            .map_err(|e| chart_error(e.to_string()))
+    })
 }
 
 #[cfg(test)]

@@ -66,17 +66,10 @@ pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
 
 /// Replaces `path` with `record`, atomically (temporary file, then rename).
 fn write_record(path: &Path, record: &ClaimRecord) -> Result<()> {
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut temp = tempfile::Builder::new()
-        .prefix(&format!(".claim.{}", crate::output::writer_tag()))
-        .suffix(".partial")
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(dir, e))?;
     let json = serde_json::to_string(record).expect("a claim record always serialises");
-    temp.write_all(json.as_bytes())
-        .map_err(|e| Error::io(temp.path(), e))?;
-    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    crate::output::write_atomic(path, |w, temp| {
+        w.write_all(json.as_bytes()).map_err(|e| Error::io(temp, e))
+    })
 }
 
 /// Outcome of trying to claim a frame.
@@ -331,7 +324,7 @@ mod tests {
     #[test]
     fn a_dead_claim_is_taken_over_exactly_once() {
         let dir = tempfile::tempdir().unwrap();
-        let dead = write_dead_claim(dir.path(), 7);
+        write_dead_claim(dir.path(), 7);
         let timeout = Duration::from_secs(60);
         let first = try_claim(dir.path(), 7, timeout).unwrap();
         let Attempt::Claimed(ours) = first else {

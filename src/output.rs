@@ -88,17 +88,6 @@ pub fn frame_pattern(format: Format) -> String {
     format!("frame_%0{FRAME_DIGITS}d.{}", format.extension())
 }
 
-/// The hidden name pattern a frame is written under until it is complete
-/// (`.frame_00042.png.<host>.<pid>.<random>.partial` in practice, unique per writer). It
-/// never matches a final frame name, so a leftover one is never taken for a frame.
-pub fn temporary_path(final_path: &Path) -> PathBuf {
-    let name = final_path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    final_path.with_file_name(format!(".{name}.partial"))
-}
-
 /// Hash of everything that decides a frame's pixels: the effective scenes
 /// (one, or one per sample under motion blur), the frame index (it seeds the
 /// sampler), the size and the renderer's revision.
@@ -196,42 +185,52 @@ pub fn write_frame(
     hash: &str,
     aovs: &[Aov],
 ) -> Result<()> {
+    let image_error = |temp: &Path, message: String| Error::Image {
+        path: temp.to_path_buf(),
+        message,
+    };
+    write_atomic(path, |writer, temp| match format {
+        Format::Png => encode_png(writer, film, hash).map_err(|m| image_error(temp, m)),
+        Format::Exr => encode_exr(writer, film, hash, aovs).map_err(|m| image_error(temp, m)),
+    })
+}
+
+/// Replaces `path` whole or not at all: `write` fills a hidden temporary file
+/// beside it (`.<name>.<host>.<pid>.<random>.partial`, unique per writer, so a
+/// leftover one is never taken for a final file and `remove_stale_partials`
+/// knows whose it is), which is flushed, synced and renamed over `path`. On
+/// any error the temporary file is deleted. Files are readable by all.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<tempfile::NamedTempFile>, &Path) -> Result<()>,
+) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let hidden = temporary_path(path);
-    let prefix = hidden
+    let name = path
         .file_name()
-        .map(|n| n.to_string_lossy().trim_end_matches(".partial").to_string() + ".")
-        .unwrap_or_default()
-        + &writer_tag();
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
     let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{}.{}", name.trim_start_matches('.'), writer_tag());
     builder.prefix(&prefix).suffix(".partial");
     #[cfg(unix)]
     {
-        // Frames are ordinary files, readable by all (tempfile's default is 0600).
+        // Ordinary files, readable by all (tempfile's default is 0600).
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
     let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
     let temp_path = temp.path().to_path_buf();
-    let image_error = |message: String| Error::Image {
-        path: temp_path.clone(),
-        message,
-    };
     let mut writer = BufWriter::new(temp);
-    match format {
-        Format::Png => encode_png(&mut writer, film, hash).map_err(image_error)?,
-        Format::Exr => encode_exr(&mut writer, film, hash, aovs).map_err(image_error)?,
-    }
+    write(&mut writer, &temp_path)?;
     let temp = writer
         .into_inner()
         .map_err(|e| Error::io(&temp_path, e.into_error()))?;
     temp.as_file()
         .sync_all()
         .map_err(|e| Error::io(&temp_path, e))?;
-    // On any error above the temporary file is deleted when `temp` drops.
     temp.persist(path).map_err(|e| Error::io(path, e.error))?;
     Ok(())
 }
@@ -391,17 +390,10 @@ impl JobRecord {
     /// Writes the record into `dir` atomically (concurrent workers of one job
     /// write the same record; the last rename wins whole).
     pub fn write(&self, dir: &Path) -> Result<()> {
-        let path = dir.join(JOB_FILE);
-        let mut temp = tempfile::Builder::new()
-            .prefix(&format!(".job.{}", writer_tag()))
-            .suffix(".partial")
-            .tempfile_in(dir)
-            .map_err(|e| Error::io(dir, e))?;
         let json = serde_json::to_string_pretty(self).expect("a job record serialises");
-        temp.write_all(json.as_bytes())
-            .map_err(|e| Error::io(temp.path(), e))?;
-        temp.persist(&path).map_err(|e| Error::io(&path, e.error))?;
-        Ok(())
+        write_atomic(&dir.join(JOB_FILE), |w, temp| {
+            w.write_all(json.as_bytes()).map_err(|e| Error::io(temp, e))
+        })
     }
 
     pub fn read(dir: &Path) -> Result<JobRecord> {
@@ -466,19 +458,9 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
     for v in &acc.traps {
         v.iter().for_each(|x| bytes.extend(x.to_le_bytes()));
     }
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut temp = tempfile::Builder::new()
-        .prefix(&format!(".ckpt.{}", writer_tag()))
-        .suffix(".partial")
-        .tempfile_in(dir)
-        .map_err(|e| Error::io(dir, e))?;
-    temp.write_all(&bytes)
-        .map_err(|e| Error::io(temp.path(), e))?;
-    temp.as_file()
-        .sync_all()
-        .map_err(|e| Error::io(temp.path(), e))?;
-    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
-    Ok(())
+    write_atomic(path, |w, temp| {
+        w.write_all(&bytes).map_err(|e| Error::io(temp, e))
+    })
 }
 
 /// The saved accumulation at `path`, if it is whole and belongs to a frame
@@ -597,9 +579,10 @@ pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
     for entry in entries.filter_map(|e| e.ok()) {
         let name = entry.file_name().to_string_lossy().into_owned();
         let temporary = name.ends_with(".partial")
-            && [".frame_", ".claim.", ".job.", ".ckpt."]
-                .iter()
-                .any(|p| name.starts_with(p));
+            && (name.starts_with(".frame_")
+                || name.starts_with(&format!(".{JOB_FILE}."))
+                // Names of earlier versions' temporary files.
+                || [".claim.", ".job.", ".ckpt."].iter().any(|p| name.starts_with(p)));
         if !temporary {
             continue;
         }
@@ -690,14 +673,14 @@ pub fn write_contact_sheet(
             (cy * (thumb_height + gap)) as i64,
         );
     }
-    let temp = temporary_path(out);
-    sheet
-        .save_with_format(&temp, image::ImageFormat::Png)
-        .map_err(|e| Error::Image {
-            path: out.to_path_buf(),
-            message: e.to_string(),
-        })?;
-    std::fs::rename(&temp, out).map_err(|e| Error::io(out, e))
+    write_atomic(out, |w, temp| {
+        sheet
+            .write_to(w, image::ImageFormat::Png)
+            .map_err(|e| Error::Image {
+                path: temp.to_path_buf(),
+                message: e.to_string(),
+            })
+    })
 }
 
 #[cfg(test)]
@@ -725,8 +708,18 @@ mod tests {
     fn names_are_zero_padded_and_temporaries_hidden() {
         assert_eq!(frame_file_name(42, Format::Png), "frame_00042.png");
         assert_eq!(frame_file_name(7, Format::Exr), "frame_00007.exr");
-        let t = temporary_path(Path::new("out/x/frame_00042.png"));
-        assert_eq!(t, Path::new("out/x/.frame_00042.png.partial"));
+        // While it is written, a file is a hidden temporary beside the final one.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frame_00042.png");
+        write_atomic(&path, |_, t| {
+            let name = t.file_name().unwrap().to_string_lossy().into_owned();
+            assert_eq!(t.parent(), Some(dir.path()));
+            assert!(name.starts_with(&format!(".frame_00042.png.{}", writer_tag())));
+            assert!(name.ends_with(".partial"));
+            Ok(())
+        })
+        .unwrap();
+        assert!(path.exists());
     }
 
     #[test]
