@@ -897,29 +897,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     }
     let timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
     // Fresh temporary files, by frame: a writer is finishing that frame.
-    let mut writing = std::collections::HashSet::new();
-    if let Ok(entries) = std::fs::read_dir(&plan.out_dir) {
-        for e in entries.filter_map(|e| e.ok()) {
-            let name = e.file_name().to_string_lossy().into_owned();
-            let fresh = e
-                .metadata()
-                .and_then(|m| m.modified())
-                .ok()
-                .and_then(|t| t.elapsed().ok())
-                .is_some_and(|age| age < output::STALE_PARTIAL_AGE);
-            if let (true, Some(rest)) = (
-                fresh && name.ends_with(".partial"),
-                name.strip_prefix(".frame_"),
-            ) {
-                if let Some(n) = rest
-                    .get(..output::FRAME_DIGITS)
-                    .and_then(|d| d.parse::<u32>().ok())
-                {
-                    writing.insert(n);
-                }
-            }
-        }
-    }
+    let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<&str, Vec<u32>> = Default::default();
     let mut workers = std::collections::BTreeSet::new();
     for frame in plan.range.clone() {

@@ -569,34 +569,58 @@ fn writer_is_dead_here(name: &str) -> bool {
     }
 }
 
-/// Deletes temporary files in `dir` left by writers that are gone: those of
-/// dead processes on this machine at once, any other older than
-/// `STALE_PARTIAL_AGE`. Returns how many went. Fresh ones of live writers may
-/// belong to a render running beside this one and are left alone.
-pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
+/// The temporary files in `dir` (any writer's, any version's), each with
+/// whether its writer is gone: a dead process on this machine, or older than
+/// `STALE_PARTIAL_AGE`.
+fn partials(dir: &Path) -> Result<Vec<(PathBuf, String, bool)>> {
     let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
-    let mut removed = 0;
-    for entry in entries.filter_map(|e| e.ok()) {
-        let name = entry.file_name().to_string_lossy().into_owned();
-        let temporary = name.ends_with(".partial")
-            && (name.starts_with(".frame_")
-                || name.starts_with(&format!(".{JOB_FILE}."))
-                // Names of earlier versions' temporary files.
-                || [".claim.", ".job.", ".ckpt."].iter().any(|p| name.starts_with(p)));
-        if !temporary {
-            continue;
-        }
-        let age = entry
-            .metadata()
-            .and_then(|m| m.modified())
-            .ok()
-            .and_then(|t| t.elapsed().ok());
-        let stale = writer_is_dead_here(&name) || age.is_some_and(|a| a >= STALE_PARTIAL_AGE);
-        if stale && std::fs::remove_file(entry.path()).is_ok() {
-            removed += 1;
-        }
-    }
-    Ok(removed)
+    Ok(entries
+        .filter_map(|e| e.ok())
+        .filter_map(|entry| {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            let temporary = name.ends_with(".partial")
+                && (name.starts_with(".frame_")
+                    || name.starts_with(&format!(".{JOB_FILE}."))
+                    // Names of earlier versions' temporary files.
+                    || [".claim.", ".job.", ".ckpt."].iter().any(|p| name.starts_with(p)));
+            if !temporary {
+                return None;
+            }
+            let age = entry
+                .metadata()
+                .and_then(|m| m.modified())
+                .ok()
+                .and_then(|t| t.elapsed().ok());
+            let stale = writer_is_dead_here(&name) || age.is_some_and(|a| a >= STALE_PARTIAL_AGE);
+            Some((entry.path(), name, stale))
+        })
+        .collect())
+}
+
+/// Deletes temporary files in `dir` left by writers that are gone. Returns
+/// how many went. Fresh ones of live writers may belong to a render running
+/// beside this one and are left alone.
+pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
+    Ok(partials(dir)?
+        .into_iter()
+        .filter(|(path, _, stale)| *stale && std::fs::remove_file(path).is_ok())
+        .count())
+}
+
+/// Frames a live writer is working on: those with a temporary file (frame,
+/// claim or checkpoint) that is not stale.
+pub fn frames_being_written(dir: &Path) -> std::collections::HashSet<u32> {
+    partials(dir)
+        .unwrap_or_default()
+        .into_iter()
+        .filter(|(_, _, stale)| !stale)
+        .filter_map(|(_, name, _)| {
+            name.strip_prefix(".frame_")?
+                .get(..FRAME_DIGITS)?
+                .parse::<u32>()
+                .ok()
+        })
+        .collect()
 }
 
 /// The final frame files of `format` in `dir`, in frame order.
