@@ -1,6 +1,6 @@
 //! The command line: clap arguments checked into a job before any pixel is
-//! rendered, the `render`, `info` and `pick` subcommands, progress bars, and
-//! exit codes.
+//! rendered, the subcommands (`render`, `info`, `pick`, `sheet`, `status`,
+//! `accuracy`, `bench`), progress bars, and exit codes.
 
 use crate::error::{Error, Result};
 use crate::march::{march, normal};
@@ -483,7 +483,6 @@ impl Plan {
         })
     }
 
-    /// The scene and content hash of one frame.
     /// The scenes of one frame (one per sample under motion blur) and its content hash.
     fn frame(&self, frame: u32) -> (Vec<crate::scene::Scene>, String) {
         let scenes = if self.preview {
