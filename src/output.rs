@@ -287,53 +287,76 @@ fn encode_exr(
     hash: &str,
     aovs: &[Aov],
 ) -> std::result::Result<(), String> {
+    use exr::image::recursive::{NoneMore, Recursive};
     use exr::prelude::*;
-    let half = |f: &dyn Fn(usize) -> f32| -> Vec<f16> {
-        (0..film.colour.len())
-            .map(|i| f16::from_f32(f(i)))
-            .collect()
+    // The file's channels are described here and each pixel's values read
+    // from the film while exr encodes its blocks: no per-channel copy of the
+    // frame, so a 4K frame costs little beyond the film itself. Layers not
+    // asked for are `None` and not written; their tuple slots are ignored.
+    let channel = |name: &str, sample: SampleType| ChannelDescription::named(name, sample);
+    let optional =
+        |present: bool, name: &str, sample: SampleType| present.then(|| channel(name, sample));
+    let (normal, albedo, traps) = (
+        film.normal.is_some(),
+        film.albedo.is_some(),
+        film.traps.is_some(),
+    );
+    let channels = Recursive::new(NoneMore, channel("R", SampleType::F16));
+    let channels = Recursive::new(channels, channel("G", SampleType::F16));
+    let channels = Recursive::new(channels, channel("B", SampleType::F16));
+    let channels = Recursive::new(channels, channel("A", SampleType::F16));
+    let channels = Recursive::new(channels, channel("Z", SampleType::F32));
+    let channels = Recursive::new(channels, optional(normal, "N.X", SampleType::F32));
+    let channels = Recursive::new(channels, optional(normal, "N.Y", SampleType::F32));
+    let channels = Recursive::new(channels, optional(normal, "N.Z", SampleType::F32));
+    let channels = Recursive::new(channels, optional(albedo, "albedo.R", SampleType::F16));
+    let channels = Recursive::new(channels, optional(albedo, "albedo.G", SampleType::F16));
+    let channels = Recursive::new(channels, optional(albedo, "albedo.B", SampleType::F16));
+    let channels = Recursive::new(channels, optional(traps, "trap.origin", SampleType::F32));
+    let channels = Recursive::new(channels, optional(traps, "trap.x", SampleType::F32));
+    let channels = Recursive::new(channels, optional(traps, "trap.y", SampleType::F32));
+    let channels = Recursive::new(channels, optional(traps, "trap.z", SampleType::F32));
+    // Cost heat map: distance estimates spent per pixel.
+    let channels = Recursive::new(
+        channels,
+        optional(aovs.contains(&Aov::Steps), "DE", SampleType::U32),
+    );
+    let width = film.width as usize;
+    let pixel = |at: Vec2<usize>| {
+        let i = at.y() * width + at.x();
+        let c = film.colour[i];
+        let n = film
+            .normal
+            .as_ref()
+            .map_or(crate::math::Vec3::ZERO, |n| n[i]);
+        let a = film
+            .albedo
+            .as_ref()
+            .map_or(crate::math::Vec3::ZERO, |a| a[i]);
+        let t = film.traps.as_ref().map_or([0.0; 4], |t| t[i]);
+        (
+            f16::from_f32(c.x),
+            f16::from_f32(c.y),
+            f16::from_f32(c.z),
+            f16::from_f32(film.alpha[i]),
+            film.depth[i],
+            n.x,
+            n.y,
+            n.z,
+            f16::from_f32(a.x),
+            f16::from_f32(a.y),
+            f16::from_f32(a.z),
+            t[0],
+            t[1],
+            t[2],
+            t[3],
+            film.evaluations[i],
+        )
     };
-    let mut list = vec![
-        AnyChannel::new("R", FlatSamples::F16(half(&|i| film.colour[i].x))),
-        AnyChannel::new("G", FlatSamples::F16(half(&|i| film.colour[i].y))),
-        AnyChannel::new("B", FlatSamples::F16(half(&|i| film.colour[i].z))),
-        AnyChannel::new("A", FlatSamples::F16(half(&|i| film.alpha[i]))),
-        AnyChannel::new("Z", FlatSamples::F32(film.depth.clone())),
-    ];
-    if let Some(n) = &film.normal {
-        for (name, k) in [("N.X", 0), ("N.Y", 1), ("N.Z", 2)] {
-            list.push(AnyChannel::new(
-                name,
-                FlatSamples::F32(n.iter().map(|v| v[k]).collect()),
-            ));
-        }
-    }
-    if let Some(a) = &film.albedo {
-        for (name, k) in [("albedo.R", 0), ("albedo.G", 1), ("albedo.B", 2)] {
-            list.push(AnyChannel::new(name, FlatSamples::F16(half(&|i| a[i][k]))));
-        }
-    }
-    if let Some(t) = &film.traps {
-        for (name, k) in [
-            ("trap.origin", 0),
-            ("trap.x", 1),
-            ("trap.y", 2),
-            ("trap.z", 3),
-        ] {
-            list.push(AnyChannel::new(
-                name,
-                FlatSamples::F32(t.iter().map(|v| v[k]).collect()),
-            ));
-        }
-    }
-    if aovs.contains(&Aov::Steps) {
-        // Cost heat map: distance estimates spent per pixel.
-        list.push(AnyChannel::new(
-            "DE",
-            FlatSamples::U32(film.evaluations.clone()),
-        ));
-    }
-    let channels = AnyChannels::sort(SmallVec::from_vec(list));
+    let channels = SpecificChannels {
+        channels,
+        pixels: pixel,
+    };
     let mut attributes = LayerAttributes::named("");
     attributes.software_name = Some(Text::from(
         format!("mandelreel {}", env!("CARGO_PKG_VERSION")).as_str(),
@@ -744,6 +767,81 @@ mod tests {
         })
         .unwrap();
         assert!(path.exists());
+    }
+
+    #[test]
+    fn exr_channels_hold_each_pixels_film_values() {
+        // Distinct values per pixel and channel, so a pixel or channel read
+        // from the wrong place shows.
+        let mut f = film();
+        let v = |i: usize, k: usize| (i * 4 + k) as f32 * 0.25 + 0.125;
+        f.colour = (0..6)
+            .map(|i| Vec3::new(v(i, 0), v(i, 1), v(i, 2)))
+            .collect();
+        f.alpha = (0..6).map(|i| v(i, 3) / 8.0).collect();
+        f.depth = (0..6).map(|i| 1.0 + i as f32 / 3.0).collect();
+        f.evaluations = (0..6).map(|i| 10 + i as u32).collect();
+        f.normal = Some((0..6).map(|i| Vec3::new(-v(i, 0), v(i, 1), 0.1)).collect());
+        f.albedo = Some((0..6).map(|i| Vec3::new(v(i, 2), 0.5, v(i, 0))).collect());
+        f.traps = Some(
+            (0..6)
+                .map(|i| [v(i, 0), v(i, 1), v(i, 2), v(i, 3)])
+                .collect(),
+        );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("all.exr");
+        write_frame(&path, Format::Exr, &f, "h", &[Aov::Steps]).unwrap();
+        let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+        let layer = &image.layer_data[0];
+        assert_eq!(layer.channel_data.list.len(), 16);
+        let get = |name: &str, i: usize| -> f32 {
+            let c = layer
+                .channel_data
+                .list
+                .iter()
+                .find(|c| c.name.to_string() == name)
+                .unwrap_or_else(|| panic!("channel {name} missing"));
+            c.sample_data.value_by_flat_index(i).to_f32()
+        };
+        let half = |x: f32| exr::prelude::f16::from_f32(x).to_f32();
+        let (normal, albedo, traps) = (
+            f.normal.as_ref().unwrap(),
+            f.albedo.as_ref().unwrap(),
+            f.traps.as_ref().unwrap(),
+        );
+        for i in 0..6 {
+            let expected = [
+                ("R", half(f.colour[i].x)),
+                ("G", half(f.colour[i].y)),
+                ("B", half(f.colour[i].z)),
+                ("A", half(f.alpha[i])),
+                ("Z", f.depth[i]),
+                ("N.X", normal[i].x),
+                ("N.Y", normal[i].y),
+                ("N.Z", normal[i].z),
+                ("albedo.R", half(albedo[i].x)),
+                ("albedo.G", half(albedo[i].y)),
+                ("albedo.B", half(albedo[i].z)),
+                ("trap.origin", traps[i][0]),
+                ("trap.x", traps[i][1]),
+                ("trap.y", traps[i][2]),
+                ("trap.z", traps[i][3]),
+                ("DE", f.evaluations[i] as f32),
+            ];
+            for (name, value) in expected {
+                assert_eq!(get(name, i), value, "{name} at pixel {i}");
+            }
+        }
+        // Without layers only the five standard channels are written.
+        write_frame(&path, Format::Exr, &film(), "h", &[]).unwrap();
+        let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+        let names: Vec<String> = image.layer_data[0]
+            .channel_data
+            .list
+            .iter()
+            .map(|c| c.name.to_string())
+            .collect();
+        assert_eq!(names, ["A", "B", "G", "R", "Z"]);
     }
 
     #[test]
