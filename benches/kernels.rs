@@ -122,7 +122,7 @@ fn estimate_lanes<const N: usize>(bencher: divan::Bencher) {
 
 /// Orbits that never escape (points deep inside): the cost of 12 iterations,
 /// counted per iteration.
-#[divan::bench(consts = [1, 4])]
+#[divan::bench(consts = [1, 4, 8, 16])]
 fn inside_lanes<const N: usize>(bencher: divan::Bencher) {
     bench_lanes::<N>(bencher, points().iter().map(|p| *p * 0.4).collect(), 12);
 }

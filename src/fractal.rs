@@ -11,7 +11,7 @@
 //! (now only a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
 //! "Coloring").
 
-use crate::math::{DVec3, Dual, Number, Real};
+use crate::math::{Arith, DVec3, Dual, Lanes, Number, Real};
 use serde::{Deserialize, Serialize};
 
 /// Which spherical-coordinate convention defines the triplex power.
@@ -146,9 +146,14 @@ pub struct Estimate {
 /// A point of the kernel's number type.
 pub type Triplex<T> = [T; 3];
 
-#[inline]
-fn length<T: Number>(z: Triplex<T>) -> T {
-    (z[0] * z[0] + z[1] * z[1] + z[2] * z[2]).sqrt()
+#[inline(always)]
+fn length<T: Arith>(z: Triplex<T>) -> T {
+    length_squared(z).sqrt()
+}
+
+#[inline(always)]
+fn length_squared<T: Arith>(z: Triplex<T>) -> T {
+    z[0] * z[0] + z[1] * z[1] + z[2] * z[2]
 }
 
 /// Raises `z` (with length `r`, already computed) to the power `n` in the given
@@ -217,7 +222,7 @@ pub fn powi<T: Copy>(x: T, n: u32, mul: impl Fn(T, T) -> T) -> T {
 
 /// The complex number (re, im) to the integer power `n` ≥ 1.
 #[inline(always)]
-fn complex_powi<T: Number>(re: T, im: T, n: u32) -> (T, T) {
+fn complex_powi<T: Arith>(re: T, im: T, n: u32) -> (T, T) {
     powi((re, im), n, |(a, b), (c, d)| (a * c - b * d, a * d + b * c))
 }
 
@@ -234,6 +239,22 @@ fn complex_powi<T: Number>(re: T, im: T, n: u32) -> (T, T) {
 /// uses the trigonometric form, which is exact there.
 #[inline(always)]
 pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> Option<Triplex<T>> {
+    let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n);
+    let usable = rho2.value() > 1e-12 * r2.value()
+        && r2.value().is_finite()
+        && out.iter().all(|v| v.value().is_finite());
+    usable.then_some(out)
+}
+
+/// `triplex_power_int` without its checks, for any `Arith` (one point or
+/// `Lanes` of them): the power, ρ² and r², whose test `usable_power` makes.
+/// Branch-free, so lanes near the axis compute garbage the caller replaces.
+#[inline(always)]
+fn triplex_power_int_unchecked<T: Arith>(
+    formula: Formula,
+    z: Triplex<T>,
+    n: u32,
+) -> (Triplex<T>, T, T) {
     let [x, y, zz] = z;
     // The pole coordinate and the equatorial pair whose angle is the azimuth.
     let (pole, (e1, e2)) = match formula {
@@ -242,14 +263,19 @@ pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> 
     };
     let rho2 = e1 * e1 + e2 * e2;
     let r2 = rho2 + pole * pole;
-    let off_axis = rho2.value() > 1e-12 * r2.value();
-    if !off_axis || !r2.value().is_finite() {
-        return None;
-    }
     let rho = rho2.sqrt();
-    let inv_rho = T::from_real(1.0) / rho;
-    // cos nφ + i sin nφ.
-    let (cp, sp) = complex_powi(e1 * inv_rho, e2 * inv_rho, n);
+    // cos nφ + i sin nφ: (e1 + i·e2)ⁿ = ρⁿ(cos nφ + i sin nφ), divided by ρⁿ.
+    // For even n, ρⁿ comes from ρ² directly, so the division runs beside
+    // the square root instead of after it.
+    let mul = |a: T, b: T| a * b;
+    let rho_n = if n.is_multiple_of(2) {
+        powi(rho2, n / 2, mul)
+    } else {
+        powi(rho, n, mul)
+    };
+    let inv_rho_n = T::from_real(1.0) / rho_n;
+    let (a, b) = complex_powi(e1, e2, n);
+    let (cp, sp) = (a * inv_rho_n, b * inv_rho_n);
     let out = match formula {
         Formula::Quilez | Formula::WhiteNylander => {
             // θ from the pole: rⁿ(cos nθ + i sin nθ) = (pole + iρ)ⁿ.
@@ -265,7 +291,7 @@ pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> 
             [rc * cp, rc * sp, rs]
         }
     };
-    out.iter().all(|v| v.value().is_finite()).then_some(out)
+    (out, rho2, r2)
 }
 
 /// Quilez's expanded power-8 polynomial (seed 000, "Optimizing"), kept only
@@ -341,6 +367,21 @@ pub struct Orbit<T> {
     pub escaped: bool,
 }
 
+impl Orbit<f64> {
+    /// A placeholder, overwritten before use.
+    const IDLE: Orbit<f64> = Orbit {
+        z: [0.0; 3],
+        r: 0.0,
+        dr: 0.0,
+        traps: OrbitTraps {
+            origin: 0.0,
+            planes: DVec3::ZERO,
+        },
+        iterations: 0,
+        escaped: false,
+    };
+}
+
 /// An orbit being iterated: the loop body shared by `orbit` and `orbit_lanes`.
 #[derive(Clone, Copy)]
 struct OrbitState<T> {
@@ -349,6 +390,9 @@ struct OrbitState<T> {
     /// 1 in Mandelbrot mode (dc/dc), 0 in Julia mode.
     plus_one: T,
     n: T,
+    /// |z|² and |z|: the bailout test needs only the first, so the square
+    /// root is off the loop's critical path.
+    r2: T,
     r: T,
     dr: T,
     traps: OrbitTraps,
@@ -370,6 +414,7 @@ impl<T: Number> OrbitState<T> {
             c,
             plus_one: T::from_real(plus_one),
             n: T::from_real(fractal.power),
+            r2: length_squared(p),
             r: length(p),
             dr: T::from_real(1.0),
             traps: OrbitTraps {
@@ -391,8 +436,16 @@ impl<T: Number> OrbitState<T> {
         self.dr = self.n * r_n_minus_1 * self.dr + self.plus_one;
         let c = self.c;
         self.z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
-        self.r = length(self.z);
+        self.r2 = length_squared(self.z);
+        self.r = self.r2.sqrt();
         self.i += 1;
+    }
+
+    /// Whether |z| has passed the bailout, tested on squares. A NaN radius
+    /// has not, and keeps iterating to the limit.
+    #[inline(always)]
+    fn outside(&self, bailout: Real) -> bool {
+        self.r2.value() > bailout * bailout
     }
 
     #[inline(always)]
@@ -410,7 +463,7 @@ impl<T: Number> OrbitState<T> {
             dr: self.dr,
             traps,
             iterations: self.i,
-            escaped: self.r.value() > bailout,
+            escaped: self.outside(bailout),
         }
     }
 }
@@ -462,7 +515,7 @@ impl Fractal {
     ) -> Orbit<T> {
         let mut state = OrbitState::start(self, p);
         while state.i < limit {
-            if stop_at_bailout && state.r.value() > self.bailout {
+            if stop_at_bailout && state.outside(self.bailout) {
                 break;
             }
             state.step(&power);
@@ -472,49 +525,30 @@ impl Fractal {
     }
 
     /// `N` orbits (Mandelbrot or Julia, stopping at the bailout) iterated
-    /// side by side in f64. Each lane does exactly the operations of
-    /// `orbit`, so its result is bit-identical; what changes is that the N
-    /// independent dependency chains interleave, and the processor overlaps
-    /// their latencies (the square roots and the division) instead of
-    /// waiting on one chain. For whole powers; `None` otherwise.
+    /// side by side in f64, each lane of a vector register holding one
+    /// orbit. Each lane does exactly the operations of `orbit`, so its
+    /// result is bit-identical. For whole powers; `None` otherwise.
     #[inline]
     pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
-        let formula = self.formula;
-        match whole_power(self.power)? {
-            8 => Some(self.orbit_lanes_with(points, |z, r| whole_power_step(formula, z, r, 8))),
-            k => Some(self.orbit_lanes_with(points, |z, r| whole_power_step(formula, z, r, k))),
+        let n = whole_power(self.power)?;
+        // Always a full vector of `VECTOR` orbits: lanes past the points
+        // start outside the bailout ball and cost no iterations.
+        let mut orbits = [Orbit::IDLE; N];
+        for (chunk, out) in points.chunks(VECTOR).zip(orbits.chunks_mut(VECTOR)) {
+            let lanes: [DVec3; VECTOR] = match <[DVec3; VECTOR]>::try_from(chunk) {
+                Ok(full) => full,
+                Err(_) => std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT)),
+            };
+            let done = if n == 8 {
+                orbit_lanes_8(self, lanes)
+            } else {
+                orbit_lanes_n(self, lanes, n)
+            };
+            out.copy_from_slice(&done[..out.len()]);
         }
-    }
-
-    #[inline(always)]
-    fn orbit_lanes_with<const N: usize>(
-        &self,
-        points: [DVec3; N],
-        power: impl Fn(Triplex<f64>, f64) -> (Triplex<f64>, f64),
-    ) -> [Orbit<f64>; N] {
-        let mut states = points.map(|p| OrbitState::start(self, [p.x, p.y, p.z]));
-        let mut running = [true; N];
-        let mut iterations = 0u64;
-        for _ in 0..self.iterations {
-            let mut any = false;
-            for (state, running) in states.iter_mut().zip(running.iter_mut()) {
-                // As `orbit`'s test, so a NaN radius keeps iterating alike.
-                let escaped = state.r > self.bailout;
-                *running = *running && !escaped;
-                if *running {
-                    state.step(&power);
-                    any = true;
-                }
-            }
-            if !any {
-                break;
-            }
-        }
-        for state in &states {
-            iterations += state.i as u64;
-        }
+        let iterations: u64 = orbits.iter().map(|o| o.iterations as u64).sum();
         ITERATIONS.with(|count| count.set(count.get() + iterations));
-        states.map(|s| s.finish(self.bailout))
+        Some(orbits)
     }
 
     /// Analytic estimates at `N` points at once through `orbit_lanes`:
@@ -672,6 +706,161 @@ impl Fractal {
             orbits,
         }
     }
+}
+
+/// A point for a lane with nothing to do: outside the bailout ball, so its
+/// orbit ends before the first iteration.
+pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
+
+/// Orbits one vector of the lane kernel holds: eight f64, one AVX-512
+/// register (two AVX2 registers).
+pub const VECTOR: usize = 8;
+
+/// `Fractal::orbit_lanes` for power 8, compiled once per instruction set
+/// and picked at run time by the processor's features (AVX-512, AVX2, or
+/// the baseline SSE2), so one binary runs everywhere and uses the widest
+/// vectors it finds. Rust never fuses a multiply and an add unasked, so
+/// every version rounds exactly as the scalar `orbit` does.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
+fn orbit_lanes_8(fractal: &Fractal, points: [DVec3; VECTOR]) -> [Orbit<f64>; VECTOR] {
+    // One copy of the loop per convention, with no branch on it inside.
+    match fractal.formula {
+        Formula::Quilez => orbit_lanes_kernel(fractal, points, 8, Formula::Quilez),
+        Formula::WhiteNylander => orbit_lanes_kernel(fractal, points, 8, Formula::WhiteNylander),
+        Formula::Asin => orbit_lanes_kernel(fractal, points, 8, Formula::Asin),
+    }
+}
+
+/// `orbit_lanes_8` for any other whole power.
+#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
+fn orbit_lanes_n(fractal: &Fractal, points: [DVec3; VECTOR], n: u32) -> [Orbit<f64>; VECTOR] {
+    orbit_lanes_kernel(fractal, points, n, fractal.formula)
+}
+
+/// The lane-wise orbit loop: `OrbitState::step` on `Lanes`, with each
+/// lane's state frozen (by selection, not branching) once it has escaped.
+/// Lanes near the pole axis take the trigonometric form one at a time, as
+/// `whole_power_step` does.
+#[inline(always)]
+fn orbit_lanes_kernel<const N: usize>(
+    fractal: &Fractal,
+    points: [DVec3; N],
+    n: u32,
+    formula: Formula,
+) -> [Orbit<f64>; N] {
+    let bailout = fractal.bailout;
+    let mut z = [
+        Lanes(points.map(|p| p.x)),
+        Lanes(points.map(|p| p.y)),
+        Lanes(points.map(|p| p.z)),
+    ];
+    let (c, plus_one) = match fractal.julia {
+        Some(k) => ([k.x, k.y, k.z].map(Lanes::from_real), 0.0),
+        None => (z, 1.0),
+    };
+    let (power, plus_one) = (Lanes::from_real(fractal.power), Lanes::from_real(plus_one));
+    let mut r2 = length_squared(z);
+    let mut r = r2.sqrt();
+    let mut dr = Lanes::from_real(1.0);
+    let mut origin = [Real::INFINITY; N];
+    let mut planes = [[Real::INFINITY; N]; 3];
+    let mut i = [0u32; N];
+    let mut running = [true; N];
+    let bailout2 = bailout * bailout;
+    // Branch-free per lane (`&` not `&&`, selections not `if`), so each
+    // step stays one block of vector instructions.
+    let select = |mask: &[bool; N], new: Lanes<N>, old: Lanes<N>| {
+        Lanes(std::array::from_fn(|k| {
+            if mask[k] {
+                new.0[k]
+            } else {
+                old.0[k]
+            }
+        }))
+    };
+    for _ in 0..fractal.iterations {
+        // `OrbitState::outside`, so a NaN radius keeps iterating alike.
+        for (run, &r2) in running.iter_mut().zip(&r2.0) {
+            *run &= r2 <= bailout2 || r2.is_nan();
+        }
+        if !running.contains(&true) {
+            break;
+        }
+        let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n);
+        let mut near_axis = [false; N];
+        for (k, near) in near_axis.iter_mut().enumerate() {
+            let finite = w[0].0[k].is_finite() & w[1].0[k].is_finite() & w[2].0[k].is_finite();
+            let usable = (rho2.0[k] > 1e-12 * power_r2.0[k]) & power_r2.0[k].is_finite() & finite;
+            *near = running[k] & !usable;
+        }
+        if near_axis.contains(&true) {
+            let exact = near_axis_powers(formula, z, r, n, &near_axis);
+            for axis in 0..3 {
+                w[axis] = select(&near_axis, exact[axis], w[axis]);
+            }
+        }
+        // `OrbitState::step`'s trap updates (|z|² is the r2 of this z).
+        origin = select(&running, Lanes(origin).zip(r2, f64::min), Lanes(origin)).0;
+        for axis in 0..3 {
+            let next = Lanes(planes[axis]).zip(z[axis], |m, v| m.min(v.abs()));
+            planes[axis] = select(&running, next, Lanes(planes[axis])).0;
+        }
+        dr = select(
+            &running,
+            power * powi(r, n - 1, |a, b| a * b) * dr + plus_one,
+            dr,
+        );
+        let next_z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
+        let next_r2 = length_squared(next_z);
+        r2 = select(&running, next_r2, r2);
+        r = select(&running, next_r2.sqrt(), r);
+        for axis in 0..3 {
+            z[axis] = select(&running, next_z[axis], z[axis]);
+        }
+        for (i, &run) in i.iter_mut().zip(&running) {
+            *i += run as u32;
+        }
+    }
+    std::array::from_fn(|k| {
+        OrbitState {
+            z: [z[0].0[k], z[1].0[k], z[2].0[k]],
+            c: [c[0].0[k], c[1].0[k], c[2].0[k]],
+            plus_one: plus_one.0[k],
+            n: power.0[k],
+            r2: r2.0[k],
+            r: r.0[k],
+            dr: dr.0[k],
+            traps: OrbitTraps {
+                origin: origin[k],
+                planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+            },
+            i: i[k],
+        }
+        .finish(bailout)
+    })
+}
+
+/// The trigonometric power of the lanes in `which`, as `whole_power_step`
+/// takes it near the pole axis; other lanes are left 0. Rare, and out of
+/// line so the vector loop keeps its registers.
+#[cold]
+#[inline(never)]
+fn near_axis_powers<const N: usize>(
+    formula: Formula,
+    z: Triplex<Lanes<N>>,
+    r: Lanes<N>,
+    n: u32,
+    which: &[bool; N],
+) -> Triplex<Lanes<N>> {
+    let mut out = [Lanes([0.0; N]); 3];
+    for k in (0..N).filter(|&k| which[k]) {
+        let at = [z[0].0[k], z[1].0[k], z[2].0[k]];
+        let exact = triplex_power_trig(formula, at, r.0[k], n as Real);
+        for axis in 0..3 {
+            out[axis].0[k] = exact[axis];
+        }
+    }
+    out
 }
 
 /// The spectral norm (largest singular value) of `m`: the most it stretches
@@ -925,22 +1114,45 @@ mod tests {
             de: DeMethod::Potential,
             ..Fractal::default()
         });
-        let pts = points(400, 0.0..2.5, 5);
-        for f in &fractals {
-            for chunk in pts.chunks_exact(4) {
-                let p: [DVec3; 4] = chunk.try_into().expect("chunks of 4");
-                let scales = [1e-3, 1e-4, 2e-3, 1e-5];
+        let mut pts = points(400, 0.0..2.5, 5);
+        // Lanes that take the trigonometric form (on and beside every
+        // convention's pole axis, the origin) or never iterate (far out,
+        // the idle point) mixed in among ordinary ones.
+        for (k, p) in [
+            DVec3::new(0.0, 0.0, 0.7),
+            DVec3::new(0.0, -0.6, 0.0),
+            DVec3::new(1e-9, 0.0, 0.5),
+            DVec3::new(0.0, 1e-9, -0.4),
+            DVec3::ZERO,
+            DVec3::new(40.0, -3.0, 2.0),
+            IDLE_POINT,
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            pts.insert(k * 13 + 3, p);
+        }
+        fn check<const N: usize>(f: &Fractal, pts: &[DVec3]) {
+            for chunk in pts.chunks_exact(N) {
+                let p: [DVec3; N] = chunk.try_into().expect("chunks of N");
+                let scales: [Real; N] = std::array::from_fn(|k| [1e-3, 1e-4, 2e-3, 1e-5][k % 4]);
                 let before = iterations_on_this_thread();
                 let lanes = f.estimate_lanes(p, scales);
                 let lane_iterations = iterations_on_this_thread() - before;
                 let before = iterations_on_this_thread();
-                let one: Vec<Estimate> = (0..4).map(|k| f.estimate(p[k], scales[k])).collect();
+                let one: Vec<Estimate> = (0..N).map(|k| f.estimate(p[k], scales[k])).collect();
                 assert_eq!(iterations_on_this_thread() - before, lane_iterations);
-                for k in 0..4 {
+                for k in 0..N {
                     assert_eq!(lanes[k].distance.to_bits(), one[k].distance.to_bits());
                     assert_eq!(lanes[k], one[k], "{f:?} at {}", p[k]);
                 }
             }
+        }
+        for f in &fractals {
+            // Fewer points than a vector, exactly one, and more than one.
+            check::<4>(f, &pts);
+            check::<8>(f, &pts);
+            check::<12>(f, &pts);
         }
     }
 

@@ -83,6 +83,17 @@ pub struct MarchResult {
     pub closest: Real,
 }
 
+impl Default for MarchResult {
+    /// A miss that estimated nothing.
+    fn default() -> Self {
+        MarchResult {
+            hit: None,
+            evaluations: 0,
+            closest: Real::INFINITY,
+        }
+    }
+}
+
 /// Sphere-traces `ray` against `fractal` inside the bounding sphere.
 ///
 /// Every estimate also tells whether its point is inside the set (its orbit
@@ -92,103 +103,196 @@ pub struct MarchResult {
 /// outside and that one, so the hit never lies past the surface by more than
 /// the hit threshold.
 pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchResult {
-    let mut evaluations = 0;
-    let mut closest = Real::INFINITY;
-    let Some((t_enter, t_exit)) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-    else {
-        return MarchResult {
-            hit: None,
-            evaluations,
-            closest,
-        };
+    let mut marcher = match Marcher::start(ray, settings) {
+        Ok(marcher) => marcher,
+        Err(miss) => return miss,
     };
-    let at = |t: Real| ray.origin + ray.dir * t;
-    let mut t = t_enter;
-    // The last point found outside the set, with its estimate.
-    let mut outside: Option<(Real, Estimate)> = None;
-    let mut omega = settings.over_relaxation;
-    let (mut previous_distance, mut previous_step) = (0.0, 0.0);
-    for _ in 0..settings.max_steps {
-        let point = at(t);
-        let footprint = ray.footprint(t);
+    loop {
+        let (point, footprint) = marcher.next_point();
         let estimate = fractal.estimate(point, footprint);
-        evaluations += estimate.orbits;
-        closest = closest.min(estimate.distance / footprint);
-        if omega > 1.0
+        if let Some(result) = marcher.advance(estimate, fractal, settings) {
+            return result;
+        }
+    }
+}
+
+/// Marches many rays, `LANES` at a time: each ray's estimates are taken
+/// side by side with other rays' through `Fractal::estimate_lanes`, and a
+/// lane whose ray ends takes the next ray at once, so the lanes stay full.
+/// Each ray goes through exactly the steps `march` takes, so `results[i]`
+/// is bit-identical to `march(&rays[i], ..)`.
+pub fn march_many(
+    rays: &[Ray],
+    fractal: &Fractal,
+    settings: &MarchSettings,
+    results: &mut [MarchResult],
+) {
+    debug_assert_eq!(rays.len(), results.len());
+    let mut lanes: [Option<(usize, Marcher)>; LANES] = [None; LANES];
+    let mut next_ray = 0;
+    loop {
+        for lane in lanes.iter_mut().filter(|lane| lane.is_none()) {
+            while next_ray < rays.len() && lane.is_none() {
+                match Marcher::start(&rays[next_ray], settings) {
+                    Ok(marcher) => *lane = Some((next_ray, marcher)),
+                    Err(miss) => results[next_ray] = miss,
+                }
+                next_ray += 1;
+            }
+        }
+        if lanes.iter().all(Option::is_none) {
+            return;
+        }
+        // Idle lanes estimate a point outside the bailout ball: no iterations.
+        let idle = (crate::fractal::IDLE_POINT, 1.0);
+        let asked = lanes.map(|lane| lane.map_or(idle, |(_, m)| m.next_point()));
+        let estimates = fractal.estimate_lanes(asked.map(|a| a.0), asked.map(|a| a.1));
+        for (lane, estimate) in lanes.iter_mut().zip(estimates) {
+            if let Some((i, marcher)) = lane {
+                if let Some(result) = marcher.advance(estimate, fractal, settings) {
+                    results[*i] = result;
+                    *lane = None;
+                }
+            }
+        }
+    }
+}
+
+/// Rays `march_many` marches side by side: one vector of the lane kernel.
+pub const LANES: usize = crate::fractal::VECTOR;
+
+/// One ray's march between estimates: where to estimate next, and what to
+/// do with the estimate. `march` and `march_many` both drive it, so the
+/// two cannot step differently.
+#[derive(Clone, Copy)]
+struct Marcher {
+    ray: Ray,
+    t: Real,
+    t_exit: Real,
+    /// The last point found outside the set, with its estimate.
+    outside: Option<(Real, Estimate)>,
+    omega: Real,
+    previous_distance: Real,
+    previous_step: Real,
+    steps: u32,
+    evaluations: u32,
+    closest: Real,
+}
+
+impl Marcher {
+    /// Starts at the bounding sphere, or the miss of a ray that passes it by.
+    fn start(ray: &Ray, settings: &MarchSettings) -> Result<Marcher, MarchResult> {
+        let Some((t_enter, t_exit)) =
+            sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
+        else {
+            return Err(MarchResult::default());
+        };
+        Ok(Marcher {
+            ray: *ray,
+            t: t_enter,
+            t_exit,
+            outside: None,
+            omega: settings.over_relaxation,
+            previous_distance: 0.0,
+            previous_step: 0.0,
+            steps: 0,
+            evaluations: 0,
+            closest: Real::INFINITY,
+        })
+    }
+
+    fn at(&self, t: Real) -> DVec3 {
+        self.ray.origin + self.ray.dir * t
+    }
+
+    /// The point to estimate next and its pixel footprint.
+    fn next_point(&self) -> (DVec3, Real) {
+        (self.at(self.t), self.ray.footprint(self.t))
+    }
+
+    /// Takes the estimate at `next_point`; the result once the ray ends.
+    fn advance(
+        &mut self,
+        estimate: Estimate,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<MarchResult> {
+        let (t, ray) = (self.t, self.ray);
+        let footprint = ray.footprint(t);
+        self.evaluations += estimate.orbits;
+        if self.steps == settings.max_steps {
+            // Out of steps inside the bounding sphere: the ray is creeping
+            // along a surface it keeps almost touching (a grazing ray).
+            // Calling that a miss punches background-coloured speckles into
+            // the surface; call it a hit.
+            return Some(self.hit(t, estimate));
+        }
+        self.steps += 1;
+        self.closest = self.closest.min(estimate.distance / footprint);
+        if self.omega > 1.0
             && estimate.escaped
-            && previous_distance + settings.fudge * estimate.distance < previous_step
+            && self.previous_distance + settings.fudge * estimate.distance < self.previous_step
         {
             // The spheres of free space around this point and the last one do
             // not overlap: the long step may have jumped over surface. Go from
             // the last point by the plain step instead, without relaxation.
-            t += previous_distance - previous_step;
-            omega = 1.0;
-            continue;
+            self.t += self.previous_distance - self.previous_step;
+            self.omega = 1.0;
+            return None;
         }
         if !estimate.escaped {
-            if let Some((t_out, estimate_out)) = outside {
+            if let Some((t_out, estimate_out)) = self.outside {
                 // Overshot: bisect [outside, t (inside)] down to the threshold.
+                let at = |t: Real| ray.origin + ray.dir * t;
                 let (lo, tests) = bisect_membership(fractal, &at, t_out, t, |lo| {
                     settings.hit_threshold * ray.footprint(lo)
                 });
-                evaluations += tests;
+                self.evaluations += tests;
                 let estimate = if lo == t_out {
                     estimate_out
                 } else {
                     let e = fractal.estimate(at(lo), ray.footprint(lo));
-                    evaluations += e.orbits;
+                    self.evaluations += e.orbits;
                     e
                 };
-                return MarchResult {
-                    hit: Some(Hit {
-                        t: lo,
-                        point: at(lo),
-                        estimate,
-                    }),
-                    evaluations,
-                    closest: 0.0,
-                };
+                self.closest = 0.0;
+                return Some(self.hit(lo, estimate));
             }
         }
         if estimate.distance < settings.hit_threshold * footprint {
-            return MarchResult {
-                hit: Some(Hit { t, point, estimate }),
-                evaluations,
-                closest,
-            };
+            return Some(self.hit(t, estimate));
         }
-        outside = Some((t, estimate));
+        self.outside = Some((t, estimate));
         let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;
         // The over-relaxed step is checked at the next point (or, leaving the
         // bounding sphere, by retrying the plain step); a plain step is safe.
-        previous_distance = step;
-        previous_step = step * omega;
-        t += previous_step;
-        if t > t_exit && previous_step > previous_distance {
-            t += previous_distance - previous_step;
-            omega = 1.0;
+        self.previous_distance = step;
+        self.previous_step = step * self.omega;
+        self.t += self.previous_step;
+        if self.t > self.t_exit && self.previous_step > self.previous_distance {
+            self.t += self.previous_distance - self.previous_step;
+            self.omega = 1.0;
         }
-        if t > t_exit {
-            return MarchResult {
+        if self.t > self.t_exit {
+            return Some(MarchResult {
                 hit: None,
-                evaluations,
-                closest,
-            };
+                evaluations: self.evaluations,
+                closest: self.closest,
+            });
         }
+        None
     }
-    // Out of steps inside the bounding sphere: the ray is creeping along a
-    // surface it keeps almost touching (a grazing ray). Calling that a miss
-    // punches background-coloured speckles into the surface; call it a hit.
-    let estimate = fractal.estimate(at(t), ray.footprint(t));
-    evaluations += estimate.orbits;
-    MarchResult {
-        hit: Some(Hit {
-            t,
-            point: at(t),
-            estimate,
-        }),
-        evaluations,
-        closest,
+
+    fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
+        MarchResult {
+            hit: Some(Hit {
+                t,
+                point: self.at(t),
+                estimate,
+            }),
+            evaluations: self.evaluations,
+            closest: self.closest,
+        }
     }
 }
 
@@ -292,6 +396,62 @@ mod tests {
             dir: dir.normalize(),
             pixel_angle: 1e-3,
             start_footprint: 0.0,
+        }
+    }
+
+    #[test]
+    fn marching_many_side_by_side_is_bit_identical_to_one_at_a_time() {
+        use crate::fractal::Formula;
+        // Rays fanned over the bulb from two sides: hits, misses, grazing
+        // rays, rays that never reach the bounding sphere; 61 of them, so
+        // the last batch leaves lanes idle.
+        let mut rays = vec![];
+        for (k, origin) in [DVec3::new(0.3, -2.6, 0.4), DVec3::new(2.0, 0.5, -1.7)]
+            .into_iter()
+            .enumerate()
+        {
+            for i in 0..30 + k {
+                let a = i as Real / 30.0;
+                let dir = -origin + DVec3::new(4.0 * a - 2.0, 0.9 * (7.0 * a).sin(), 4.4 * a - 2.2);
+                rays.push(ray(origin, dir));
+            }
+        }
+        let bulb = |formula, power, julia| Fractal {
+            formula,
+            power,
+            julia,
+            ..Fractal::default()
+        };
+        let fractals = [
+            bulb(Formula::Quilez, 8.0, None),
+            bulb(Formula::Asin, 8.0, None),
+            bulb(
+                Formula::WhiteNylander,
+                3.0,
+                Some(DVec3::new(0.3, -0.5, 0.2)),
+            ),
+            bulb(Formula::Quilez, 7.5, None),
+            Fractal::unit_ball(),
+        ];
+        for max_steps in [300, 7] {
+            let settings = MarchSettings {
+                max_steps,
+                ..MarchSettings::default()
+            };
+            for f in &fractals {
+                let mut many = vec![MarchResult::default(); rays.len()];
+                march_many(&rays, f, &settings, &mut many);
+                let mut hits = 0;
+                for (r, m) in rays.iter().zip(&many) {
+                    let one = march(r, f, &settings);
+                    assert_eq!(format!("{one:?}"), format!("{m:?}"), "{f:?} along {r:?}");
+                    hits += one.hit.is_some() as usize;
+                }
+                assert!(
+                    hits > 5 && hits < rays.len() - 5,
+                    "{hits} hits: too few misses or hits"
+                );
+            }
         }
     }
 

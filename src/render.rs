@@ -4,7 +4,7 @@
 //! Every pixel depends only on (scene, frame, pixel, sample), never on which
 //! thread ran it or in which order, so the image is identical for any thread count.
 
-use crate::march::{march, normal};
+use crate::march::{march_many, normal, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, trace_path, StageCounts, SurfacePoint};
@@ -376,24 +376,35 @@ fn render_rows(
                 // A row runs start to end on one thread, so this thread's
                 // count of orbit iterations measures exactly the row's.
                 let iterations_before = crate::fractal::iterations_on_this_thread();
-                for x in 0..w {
-                    let pixel = (y * w + x) as u64;
-                    let before = stats.stage_total();
-                    for s in first..until {
-                        let k = s as usize % scenes.len();
-                        let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
+                // Each sample index at a time over the whole row, so the
+                // row's camera rays march side by side (`march_many`); each
+                // pixel still takes its samples in order.
+                let mut rays = Vec::with_capacity(w);
+                let mut marched = vec![MarchResult::default(); w];
+                for s in first..until {
+                    let k = s as usize % scenes.len();
+                    let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
+                    rays.clear();
+                    rays.extend((0..w).map(|x| {
+                        let pixel = (y * w + x) as u64;
                         let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
-                        let ray = if camera.has_lens() {
+                        if camera.has_lens() {
                             let u = sample_1d(scene.seed, frame_index, pixel, s, 2);
                             let v = sample_1d(scene.seed, frame_index, pixel, s, 3);
                             camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
                         } else {
                             camera.ray(x as Real + ox, y as Real + oy, width, height)
-                        };
+                        }
+                    }));
+                    march_many(&rays, &scene.fractal, &scene.quality, &mut marched);
+                    for (x, (ray, result)) in rays.iter().zip(&marched).enumerate() {
+                        let pixel = (y * w + x) as u64;
+                        let before = stats.stage_total();
                         let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
                         let sample = trace(
                             scene,
-                            &ray,
+                            ray,
+                            result,
                             camera.up,
                             scale,
                             environment.as_deref(),
@@ -433,8 +444,8 @@ fn render_rows(
                         colour_row[x][1] += c.y as f64;
                         colour_row[x][2] += c.z as f64;
                         stats.samples += 1;
+                        spent_row[x] += stats.stage_total() - before;
                     }
-                    spent_row[x] += stats.stage_total() - before;
                 }
                 stats.de_iterations +=
                     crate::fractal::iterations_on_this_thread() - iterations_before;
@@ -464,16 +475,17 @@ fn optional_rows<T: Send>(
 
 /// One camera sample: its radiance and, if it met the surface, the distance.
 /// Only the stages of the scene's enabled effects run; `stats` counts each.
+#[allow(clippy::too_many_arguments)]
 fn trace(
     scene: &Scene,
     ray: &crate::march::Ray,
+    result: &MarchResult,
     up: crate::math::DVec3,
     scale: Real,
     environment: Option<&crate::environment::EnvironmentMap>,
     random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
 ) -> SampleResult {
-    let result = march(ray, &scene.fractal, &scene.quality);
     stats.primary_evaluations += result.evaluations as u64;
     let Some(hit) = result.hit else {
         let sky = match &scene.effects.path_tracing {

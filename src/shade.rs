@@ -11,7 +11,7 @@
 //! estimate (the smallest k·h/t along the shadow march); distance-field
 //! occlusion compares the estimate with the distance stepped along the normal.
 
-use crate::fractal::{Fractal, OrbitTraps};
+use crate::fractal::{Fractal, OrbitTraps, VECTOR};
 use crate::march::MarchSettings;
 use crate::math::{mix, normalize_or, sphere_interval, DVec3, Real, Vec3};
 use serde::{Deserialize, Serialize};
@@ -317,16 +317,28 @@ pub fn occlusion(
     let mut weight = 1.0;
     let mut spent = 0;
     let n = ao.samples.max(1);
-    for i in 1..=n {
-        let d = ao.radius * t * i as Real / n as Real;
-        let e = fractal.estimate(point + normal * d, footprint);
-        spent += e.orbits as u64;
-        // Where the field is nearer than the distance stepped, geometry crowds
-        // in. The estimate is about half the true distance near the surface
-        // (the ½ in ½·ln r·r/dr, kept for safe marching), so double it here.
-        blocked += weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
-        weights += weight;
-        weight *= 0.6;
+    let step = |i: u32| ao.radius * t * i as Real / n as Real;
+    // The samples are independent: estimated a vector at a time, summed in order.
+    let mut first = 1;
+    while first <= n {
+        let count = (n + 1 - first).min(VECTOR as u32) as usize;
+        let ds: [Real; VECTOR] = std::array::from_fn(|k| step(first + k as u32));
+        // Lanes past the last sample idle outside the bailout ball.
+        let points = std::array::from_fn(|k| match k < count {
+            true => point + normal * ds[k],
+            false => crate::fractal::IDLE_POINT,
+        });
+        let estimates = fractal.estimate_lanes(points, [footprint; VECTOR]);
+        for (&d, e) in ds.iter().zip(&estimates).take(count) {
+            spent += e.orbits as u64;
+            // Where the field is nearer than the distance stepped, geometry crowds
+            // in. The estimate is about half the true distance near the surface
+            // (the ½ in ½·ln r·r/dr, kept for safe marching), so double it here.
+            blocked += weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
+            weights += weight;
+            weight *= 0.6;
+        }
+        first += VECTOR as u32;
     }
     let ambient = 1.0 - ao.strength as Real * blocked / weights;
     (ambient.clamp(0.0, 1.0) as f32, spent)
