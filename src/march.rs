@@ -145,7 +145,8 @@ pub fn march_many(
         }
         // Idle lanes estimate a point outside the bailout ball: no iterations.
         let idle = (crate::fractal::IDLE_POINT, 1.0);
-        let asked = lanes.map(|lane| lane.map_or(idle, |(_, m)| m.next_point()));
+        let asked: [(DVec3, Real); LANES] =
+            std::array::from_fn(|k| lanes[k].as_ref().map_or(idle, |(_, m)| m.next_point()));
         let estimates = fractal.estimate_lanes(asked.map(|a| a.0), asked.map(|a| a.1));
         for (lane, estimate) in lanes.iter_mut().zip(estimates) {
             if let Some((i, marcher)) = lane {

@@ -270,11 +270,16 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
             .add_text_chunk(key.to_string(), value)
             .map_err(|e| e.to_string())?;
     }
+    // fdeflate: several times faster than the default level for a few
+    // per cent more bytes; encoding is the one serial stage of a frame.
+    encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
+    // The sRGB curve (a powf per channel) runs on every thread.
+    use rayon::prelude::*;
     let bytes: Vec<u8> = film
         .colour
-        .iter()
-        .flat_map(|c| [c.x, c.y, c.z])
+        .par_iter()
+        .flat_map_iter(|c| [c.x, c.y, c.z])
         .map(|v| (linear_to_srgb(v) * 255.0 + 0.5) as u8)
         .collect();
     writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
