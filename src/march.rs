@@ -103,24 +103,11 @@ impl Default for MarchResult {
 /// outside and that one, so the hit never lies past the surface by more than
 /// the hit threshold.
 pub fn march(ray: &Ray, fractal: &Fractal, settings: &MarchSettings) -> MarchResult {
-    let mut marcher = match Marcher::start(ray, settings) {
-        Ok(marcher) => marcher,
-        Err(miss) => return miss,
-    };
-    loop {
-        let (point, footprint) = marcher.next_point();
-        let estimate = fractal.estimate(point, footprint);
-        if let Some(result) = marcher.advance(estimate, fractal, settings) {
-            return result;
-        }
-    }
+    walk_one(Marcher::start(ray, settings), fractal, settings)
 }
 
-/// Marches many rays, `LANES` at a time: each ray's estimates are taken
-/// side by side with other rays' through `Fractal::estimate_lanes`, and a
-/// lane whose ray ends takes the next ray at once, so the lanes stay full.
-/// Each ray goes through exactly the steps `march` takes, so `results[i]`
-/// is bit-identical to `march(&rays[i], ..)`.
+/// Marches many rays side by side (`walk_many`): `results[i]` is
+/// bit-identical to `march(&rays[i], ..)`.
 pub fn march_many(
     rays: &[Ray],
     fractal: &Fractal,
@@ -128,16 +115,67 @@ pub fn march_many(
     results: &mut [MarchResult],
 ) {
     debug_assert_eq!(rays.len(), results.len());
-    let mut lanes: [Option<(usize, Marcher)>; LANES] = [None; LANES];
-    let mut next_ray = 0;
+    let walks = rays.iter().map(|ray| Marcher::start(ray, settings));
+    walk_many(walks, fractal, settings, |i, result| results[i] = result);
+}
+
+/// A walk along a ray driven by distance estimates, one at a time: sphere
+/// tracing, a shadow ray. `walk_one` and `walk_many` both drive it, so a walk
+/// takes the same steps whichever does.
+pub trait Walk: Copy {
+    type Output;
+    /// The point to estimate next and its pixel footprint.
+    fn next_point(&self) -> (DVec3, Real);
+    /// Takes the estimate at `next_point`; the output once the walk ends.
+    fn advance(
+        &mut self,
+        estimate: Estimate,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<Self::Output>;
+}
+
+/// Drives one walk (or returns the output it started with) to its end.
+pub fn walk_one<W: Walk>(
+    walk: Result<W, W::Output>,
+    fractal: &Fractal,
+    settings: &MarchSettings,
+) -> W::Output {
+    let mut walk = match walk {
+        Ok(walk) => walk,
+        Err(done) => return done,
+    };
+    loop {
+        let (point, footprint) = walk.next_point();
+        if let Some(done) = walk.advance(fractal.estimate(point, footprint), fractal, settings) {
+            return done;
+        }
+    }
+}
+
+/// Drives many walks, `LANES` at a time: each step's estimates are taken
+/// side by side through `Fractal::estimate_lanes`, and a lane whose walk
+/// ends takes the next walk at once, so the lanes stay full. Each walk's
+/// output, bit-identical to `walk_one`'s, goes to `done` with its index
+/// (walks that end at the start included), in the order walks end.
+pub fn walk_many<W: Walk>(
+    walks: impl IntoIterator<Item = Result<W, W::Output>>,
+    fractal: &Fractal,
+    settings: &MarchSettings,
+    mut done: impl FnMut(usize, W::Output),
+) {
+    let mut walks = walks.into_iter().enumerate();
+    let mut lanes: [Option<(usize, W)>; LANES] = [None; LANES];
     loop {
         for lane in lanes.iter_mut().filter(|lane| lane.is_none()) {
-            while next_ray < rays.len() && lane.is_none() {
-                match Marcher::start(&rays[next_ray], settings) {
-                    Ok(marcher) => *lane = Some((next_ray, marcher)),
-                    Err(miss) => results[next_ray] = miss,
+            for (i, walk) in walks.by_ref() {
+                match walk {
+                    Ok(walk) => {
+                        *lane = Some((i, walk));
+                        break;
+                    }
+                    Err(output) => done(i, output),
                 }
-                next_ray += 1;
             }
         }
         if lanes.iter().all(Option::is_none) {
@@ -146,12 +184,12 @@ pub fn march_many(
         // Idle lanes estimate a point outside the bailout ball: no iterations.
         let idle = (crate::fractal::IDLE_POINT, 1.0);
         let asked: [(DVec3, Real); LANES] =
-            std::array::from_fn(|k| lanes[k].as_ref().map_or(idle, |(_, m)| m.next_point()));
+            std::array::from_fn(|k| lanes[k].as_ref().map_or(idle, |(_, w)| w.next_point()));
         let estimates = fractal.estimate_lanes(asked.map(|a| a.0), asked.map(|a| a.1));
         for (lane, estimate) in lanes.iter_mut().zip(estimates) {
-            if let Some((i, marcher)) = lane {
-                if let Some(result) = marcher.advance(estimate, fractal, settings) {
-                    results[*i] = result;
+            if let Some((i, walk)) = lane {
+                if let Some(output) = walk.advance(estimate, fractal, settings) {
+                    done(*i, output);
                     *lane = None;
                 }
             }
@@ -159,7 +197,7 @@ pub fn march_many(
     }
 }
 
-/// Rays `march_many` marches side by side: one vector of the lane kernel.
+/// Walks `walk_many` takes side by side: one vector of the lane kernel.
 pub const LANES: usize = crate::fractal::VECTOR;
 
 /// One ray's march between estimates: where to estimate next, and what to
@@ -206,12 +244,26 @@ impl Marcher {
         self.ray.origin + self.ray.dir * t
     }
 
-    /// The point to estimate next and its pixel footprint.
+    fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
+        MarchResult {
+            hit: Some(Hit {
+                t,
+                point: self.at(t),
+                estimate,
+            }),
+            evaluations: self.evaluations,
+            closest: self.closest,
+        }
+    }
+}
+
+impl Walk for Marcher {
+    type Output = MarchResult;
+
     fn next_point(&self) -> (DVec3, Real) {
         (self.at(self.t), self.ray.footprint(self.t))
     }
 
-    /// Takes the estimate at `next_point`; the result once the ray ends.
     fn advance(
         &mut self,
         estimate: Estimate,
@@ -282,18 +334,6 @@ impl Marcher {
             });
         }
         None
-    }
-
-    fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
-        MarchResult {
-            hit: Some(Hit {
-                t,
-                point: self.at(t),
-                estimate,
-            }),
-            evaluations: self.evaluations,
-            closest: self.closest,
-        }
     }
 }
 

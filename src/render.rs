@@ -4,7 +4,7 @@
 //! Every pixel depends only on (scene, frame, pixel, sample), never on which
 //! thread ran it or in which order, so the image is identical for any thread count.
 
-use crate::march::{march_many, normal, MarchResult};
+use crate::march::{march_many, normal, walk_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, trace_path, StageCounts, SurfacePoint};
@@ -402,6 +402,8 @@ fn render_rows(
                 // pixel still takes its samples in order.
                 let mut rays = Vec::with_capacity(w);
                 let mut marched = vec![MarchResult::default(); w];
+                let mut surfaces = Vec::with_capacity(w);
+                let (mut shadows, mut first_shadow) = (vec![], vec![]);
                 for s in first..until {
                     let k = s as usize % scenes.len();
                     let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
@@ -418,14 +420,48 @@ fn render_rows(
                         }
                     }));
                     march_many(&rays, &scene.fractal, &scene.quality, &mut marched);
-                    for (x, (ray, result)) in rays.iter().zip(&marched).enumerate() {
-                        let pixel = (y * w + x) as u64;
+                    // Where each ray met the surface, with what that cost.
+                    surfaces.clear();
+                    surfaces.extend(rays.iter().zip(&marched).map(|(ray, result)| {
                         let before = stats.stage_total();
+                        let at = surface(scene, ray, result, &mut stats);
+                        (at, stats.stage_total() - before)
+                    }));
+                    // The row's shadow rays, walked side by side.
+                    shadows.clear();
+                    first_shadow.clear();
+                    if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
+                        let mut walks = vec![];
+                        for (at, _) in &surfaces {
+                            first_shadow.push(walks.len());
+                            if let Some(at) = at {
+                                let look = &scene.look;
+                                walks.extend(look.shadow_walks(&scene.effects, &scene.quality, at));
+                            }
+                        }
+                        shadows.resize(walks.len(), (1.0, 0));
+                        walk_many(walks, &scene.fractal, &scene.quality, |i, out| {
+                            shadows[i] = out
+                        });
+                    }
+                    first_shadow.push(shadows.len());
+                    for (x, ((ray, result), (at, surface_cost))) in
+                        rays.iter().zip(&marched).zip(&surfaces).enumerate()
+                    {
+                        let pixel = (y * w + x) as u64;
+                        let before = stats.stage_total() - surface_cost;
                         let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
+                        let mut outcomes = first_shadow
+                            .get(x..x + 2)
+                            .map_or(&[][..], |range| &shadows[range[0]..range[1]])
+                            .iter()
+                            .copied();
                         let sample = trace(
                             scene,
                             ray,
                             result,
+                            at.as_ref(),
+                            &mut |_| outcomes.next().expect("one outcome per shadow ray"),
                             camera.up,
                             scale,
                             environment.as_deref(),
@@ -494,21 +530,47 @@ fn optional_rows<T: Send>(
     rows.into_par_iter()
 }
 
-/// One camera sample: its radiance and, if it met the surface, the distance.
-/// Only the stages of the scene's enabled effects run; `stats` counts each.
+/// Where a camera ray's march met the surface, with its normal: the
+/// surface point shading needs, or `None` for a miss. Counts the march's
+/// and the normal's estimates.
+fn surface(
+    scene: &Scene,
+    ray: &crate::march::Ray,
+    result: &MarchResult,
+    stats: &mut FrameStats,
+) -> Option<SurfacePoint> {
+    stats.primary_evaluations += result.evaluations as u64;
+    let hit = result.hit?;
+    let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
+    stats.normal_evaluations += evals as u64;
+    Some(SurfacePoint {
+        point: hit.point,
+        normal: nrm,
+        view_dir: ray.dir,
+        t: hit.t,
+        footprint: ray.footprint(hit.t),
+        traps: hit.estimate.traps,
+    })
+}
+
+/// One camera sample: its radiance and, if it met the surface (`at`), the
+/// distance. Shadow rays' outcomes come from `shadow_of` (see
+/// `Look::shade_with`). Only the stages of the scene's enabled effects run;
+/// `stats` counts each.
 #[allow(clippy::too_many_arguments)]
 fn trace(
     scene: &Scene,
     ray: &crate::march::Ray,
     result: &MarchResult,
+    at: Option<&SurfacePoint>,
+    shadow_of: &mut dyn FnMut(crate::math::DVec3) -> (f32, u64),
     up: crate::math::DVec3,
     scale: Real,
     environment: Option<&crate::environment::EnvironmentMap>,
     random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
 ) -> SampleResult {
-    stats.primary_evaluations += result.evaluations as u64;
-    let Some(hit) = result.hit else {
+    let Some(at) = at else {
         let sky = match &scene.effects.path_tracing {
             Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
             None => scene.look.background(ray.dir, up),
@@ -519,16 +581,6 @@ fn trace(
         };
         return SampleResult { colour, hit: None };
     };
-    let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
-    stats.normal_evaluations += evals as u64;
-    let at = SurfacePoint {
-        point: hit.point,
-        normal: nrm,
-        view_dir: ray.dir,
-        t: hit.t,
-        footprint: ray.footprint(hit.t),
-        traps: hit.estimate.traps,
-    };
     let mut stages = StageCounts::default();
     let lit = match &scene.effects.path_tracing {
         Some(pt) => trace_path(
@@ -536,31 +588,27 @@ fn trace(
             pt,
             &scene.fractal,
             &scene.quality,
-            &at,
+            at,
             up,
             environment,
             random,
             &mut stages,
         ),
-        None => scene.look.shade(
-            &scene.effects,
-            &scene.fractal,
-            &scene.quality,
-            &at,
-            &mut stages,
-        ),
+        None => scene
+            .look
+            .shade_with(&scene.effects, &scene.fractal, at, &mut stages, shadow_of),
     };
     stats.shadow_evaluations += stages.shadows;
     stats.occlusion_evaluations += stages.occlusion;
     stats.bounce_evaluations += stages.bounces;
     stats.sun_evaluations += stages.sun_rays;
     let colour = match &scene.effects.fog {
-        Some(fog) => fogged(lit, fog, hit.t, scale),
+        Some(fog) => fogged(lit, fog, at.t, scale),
         None => lit,
     };
     SampleResult {
         colour,
-        hit: Some((hit.t, nrm, at.traps)),
+        hit: Some((at.t, at.normal, at.traps)),
     }
 }
 

@@ -279,28 +279,99 @@ pub fn shadow(
     to_light: DVec3,
     footprint: Real,
 ) -> (f32, u64) {
-    let Some((_, t_exit)) = sphere_interval(from, to_light, settings.bounding_radius) else {
-        return (1.0, 0);
-    };
-    let eps = settings.hit_threshold * footprint;
-    let mut t = 2.0 * footprint;
-    let mut light: Real = 1.0;
-    let mut spent = 0;
-    for _ in 0..shadows.max_steps {
-        if t > t_exit {
-            break;
+    crate::march::walk_one(
+        ShadowWalk::start(settings, shadows, from, to_light, footprint),
+        fractal,
+        settings,
+    )
+}
+
+/// Where a surface point's shadow rays start: a couple of footprints off
+/// the surface, so it does not shadow itself.
+fn shadow_origin(at: &SurfacePoint) -> DVec3 {
+    at.point + at.normal * (2.0 * at.footprint)
+}
+
+/// A shadow ray between estimates (see `shadow`), so many can be walked
+/// side by side (`march::walk_many`).
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowWalk {
+    from: DVec3,
+    to_light: DVec3,
+    footprint: Real,
+    t: Real,
+    t_exit: Real,
+    eps: Real,
+    softness: Real,
+    light: Real,
+    steps_left: u32,
+    spent: u64,
+}
+
+impl ShadowWalk {
+    /// Starts a couple of footprints off the surface; the output at once
+    /// for a ray that misses the bounding sphere or may take no step.
+    pub fn start(
+        settings: &MarchSettings,
+        shadows: &Shadows,
+        from: DVec3,
+        to_light: DVec3,
+        footprint: Real,
+    ) -> Result<ShadowWalk, (f32, u64)> {
+        let Some((_, t_exit)) = sphere_interval(from, to_light, settings.bounding_radius) else {
+            return Err((1.0, 0));
+        };
+        let walk = ShadowWalk {
+            from,
+            to_light,
+            footprint,
+            t: 2.0 * footprint,
+            t_exit,
+            eps: settings.hit_threshold * footprint,
+            softness: shadows.softness,
+            light: 1.0,
+            steps_left: shadows.max_steps,
+            spent: 0,
+        };
+        match walk.finished() {
+            true => Err(walk.output()),
+            false => Ok(walk),
         }
-        let e = fractal.estimate(from + to_light * t, footprint);
-        spent += e.orbits as u64;
-        if !e.escaped || e.distance < eps {
-            return (0.0, spent);
-        }
-        if shadows.softness > 0.0 {
-            light = light.min(shadows.softness * e.distance / t);
-        }
-        t += e.distance * settings.fudge;
     }
-    (light.clamp(0.0, 1.0) as f32, spent)
+
+    fn finished(&self) -> bool {
+        self.steps_left == 0 || self.t > self.t_exit
+    }
+
+    fn output(&self) -> (f32, u64) {
+        (self.light.clamp(0.0, 1.0) as f32, self.spent)
+    }
+}
+
+impl crate::march::Walk for ShadowWalk {
+    type Output = (f32, u64);
+
+    fn next_point(&self) -> (DVec3, Real) {
+        (self.from + self.to_light * self.t, self.footprint)
+    }
+
+    fn advance(
+        &mut self,
+        e: crate::fractal::Estimate,
+        _: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<(f32, u64)> {
+        self.spent += e.orbits as u64;
+        if !e.escaped || e.distance < self.eps {
+            return Some((0.0, self.spent));
+        }
+        if self.softness > 0.0 {
+            self.light = self.light.min(self.softness * e.distance / self.t);
+        }
+        self.t += e.distance * settings.fudge;
+        self.steps_left -= 1;
+        self.finished().then(|| self.output())
+    }
 }
 
 /// Ambient light reaching a surface point: 1 in the open, less in crevices.
@@ -423,6 +494,60 @@ impl Look {
         at: &SurfacePoint,
         counts: &mut StageCounts,
     ) -> Vec3 {
+        self.shade_with(
+            effects,
+            fractal,
+            at,
+            counts,
+            &mut |to_light| match &effects.shadows {
+                Some(sh) => shadow(
+                    fractal,
+                    settings,
+                    sh,
+                    shadow_origin(at),
+                    to_light,
+                    at.footprint,
+                ),
+                None => (1.0, 0),
+            },
+        )
+    }
+
+    /// The lights that face the surface at `at`: (direction towards the
+    /// light, brightness, Lambert cosine), in the order of `lights`.
+    fn facing<'a>(&'a self, at: &'a SurfacePoint) -> impl Iterator<Item = (DVec3, Vec3, f32)> + 'a {
+        self.lights().filter_map(|(to_light, brightness)| {
+            let lambert = at.normal.dot(to_light).max(0.0) as f32;
+            (lambert > 0.0).then_some((to_light, brightness, lambert))
+        })
+    }
+
+    /// The shadow rays `shade` would walk at `at`, in the order it walks
+    /// them: to be walked side by side and handed to `shade_with`.
+    pub fn shadow_walks<'a>(
+        &'a self,
+        effects: &'a Effects,
+        settings: &'a MarchSettings,
+        at: &'a SurfacePoint,
+    ) -> impl Iterator<Item = Result<ShadowWalk, (f32, u64)>> + 'a {
+        effects.shadows.iter().flat_map(move |sh| {
+            self.facing(at).map(move |(to_light, _, _)| {
+                ShadowWalk::start(settings, sh, shadow_origin(at), to_light, at.footprint)
+            })
+        })
+    }
+
+    /// `shade` with the shadow rays' outcomes (factor, estimates spent)
+    /// given by `shadow_of(direction to the light)`, asked only with shadows
+    /// on, for the lights `shadow_walks` lists, in its order.
+    pub fn shade_with(
+        &self,
+        effects: &Effects,
+        fractal: &Fractal,
+        at: &SurfacePoint,
+        counts: &mut StageCounts,
+        shadow_of: &mut dyn FnMut(DVec3) -> (f32, u64),
+    ) -> Vec3 {
         let mut ambient = 1.0f32;
         if let Some(ao) = &effects.ambient_occlusion {
             let (a, spent) = occlusion(fractal, ao, at.point, at.normal, at.t, at.footprint);
@@ -431,16 +556,10 @@ impl Look {
         }
         let albedo = self.albedo(&at.traps);
         let mut c = albedo * self.ambient * ambient;
-        for (to_light, brightness) in self.lights() {
-            let lambert = at.normal.dot(to_light).max(0.0) as f32;
-            if lambert <= 0.0 {
-                continue;
-            }
+        for (to_light, brightness, lambert) in self.facing(at) {
             let mut light = 1.0f32;
-            if let Some(sh) = &effects.shadows {
-                // Start a couple of footprints off the surface so it does not shadow itself.
-                let from = at.point + at.normal * (2.0 * at.footprint);
-                let (f, spent) = shadow(fractal, settings, sh, from, to_light, at.footprint);
+            if effects.shadows.is_some() {
+                let (f, spent) = shadow_of(to_light);
                 light = f;
                 counts.shadows += spent;
             }
@@ -737,6 +856,80 @@ mod tests {
 
     fn unit_ball() -> Fractal {
         Fractal::unit_ball()
+    }
+
+    #[test]
+    fn shadow_rays_walked_side_by_side_match_one_at_a_time() {
+        // Surface points on the bulb lit by three lights, some facing away:
+        // `shade` with its own shadow rays against `shade_with` fed the
+        // outcomes `walk_many` found for `shadow_walks`, bit for bit.
+        let fractal = Fractal::default();
+        let settings = MarchSettings::default();
+        let mut look = Look::default();
+        for (direction, intensity) in [(DVec3::new(-1.0, 0.2, 0.3), 0.5), (DVec3::NEG_Y, 0.3)] {
+            look.extra_lights.push(Light {
+                direction,
+                intensity,
+                ..Light::default()
+            });
+        }
+        let effects = Effects {
+            shadows: Some(Shadows {
+                max_steps: 40,
+                ..Shadows::default()
+            }),
+            ..Effects::default()
+        };
+        // Real surface points: where rays from around the bulb meet it.
+        let points: Vec<SurfacePoint> = crate::math::shell_points(80, 2.5..2.6, 3)
+            .into_iter()
+            .filter_map(|origin| {
+                let ray = crate::march::Ray {
+                    origin,
+                    dir: (DVec3::new(0.1, -0.2, 0.15) - origin).normalize(),
+                    pixel_angle: 1e-3,
+                    start_footprint: 0.0,
+                };
+                let hit = crate::march::march(&ray, &fractal, &settings).hit?;
+                let (normal, _) = crate::march::normal(&ray, &hit, &fractal, &settings);
+                Some(SurfacePoint {
+                    point: hit.point,
+                    normal,
+                    view_dir: ray.dir,
+                    t: hit.t,
+                    footprint: ray.footprint(hit.t),
+                    traps: hit.estimate.traps,
+                })
+            })
+            .collect();
+        let walks: Vec<_> = points
+            .iter()
+            .flat_map(|at| look.shadow_walks(&effects, &settings, at))
+            .collect();
+        let mut outcomes = vec![(f32::NAN, 0); walks.len()];
+        crate::march::walk_many(walks, &fractal, &settings, |i, out| outcomes[i] = out);
+        let mut outcomes = outcomes.into_iter();
+        let (mut shaded, mut partly) = (0, 0);
+        for at in &points {
+            let (mut one, mut many) = (StageCounts::default(), StageCounts::default());
+            let alone = look.shade(&effects, &fractal, &settings, at, &mut one);
+            let batched = look.shade_with(&effects, &fractal, at, &mut many, &mut |_| {
+                let out = outcomes.next().expect("an outcome per walk");
+                shaded += (out.0 < 1.0) as u32;
+                partly += (out.0 > 0.0 && out.0 < 1.0) as u32;
+                out
+            });
+            assert_eq!(
+                alone.to_array().map(f32::to_bits),
+                batched.to_array().map(f32::to_bits)
+            );
+            assert_eq!(one, many);
+        }
+        assert!(outcomes.next().is_none(), "a walk no light asked for");
+        assert!(
+            shaded > 10 && partly > 3,
+            "{shaded} shaded, {partly} in penumbra"
+        );
     }
 
     #[test]
