@@ -231,15 +231,26 @@ fn srgb(film: &Film) -> Vec<f32> {
 
 /// Errors of one variant against the reference.
 struct Errors {
-    depth_mean: f64,
-    depth_p99: f64,
-    hit_mismatch: f64,
-    overshoot: f64,
+    depth: DepthErrors,
     rmse: f64,
 }
 
+/// How far hit distances lie from the reference's, per pixel, in pixel
+/// footprints at the reference depth.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DepthErrors {
+    /// Mean and 99th percentile of |depth − reference depth| over pixels
+    /// that both hit.
+    pub mean_px: f64,
+    pub p99_px: f64,
+    /// Share of pixels where one hits and the other misses.
+    pub hit_mismatch: f64,
+    /// Share of pixels whose hit lies more than a footprint past the reference.
+    pub overshoot: f64,
+}
+
 /// The hits of a rendered film: its nearest depth where any sample hit.
-fn film_hits(film: &Film) -> Vec<Option<Real>> {
+pub fn film_hits(film: &Film) -> Vec<Option<Real>> {
     film.alpha
         .iter()
         .zip(&film.depth)
@@ -247,24 +258,30 @@ fn film_hits(film: &Film) -> Vec<Option<Real>> {
         .collect()
 }
 
-/// Errors of `hits` and `image` against the reference.
-fn compare(
+/// Each pixel's footprint at its reference depth (at distance 1 where the
+/// reference misses), for `depth_errors`.
+pub fn footprints_at(scene: &Scene, width: u32, height: u32, depths: &[Option<Real>]) -> Vec<Real> {
+    let camera = scene.camera.frame();
+    (0..height)
+        .flat_map(|y| (0..width).map(move |x| (x, y)))
+        .map(|(x, y)| camera.ray(x as Real + 0.5, y as Real + 0.5, width, height))
+        .map(|ray| ray.footprint(1.0))
+        .zip(depths)
+        // Footprints scale with distance: footprint(t) = t × footprint(1).
+        .map(|(f, t)| t.map_or(f, |t| (t * f).max(1e-300)))
+        .collect()
+}
+
+/// Depth errors of `hits` against `reference` (see `DepthErrors`).
+pub fn depth_errors(
     hits: &[Option<Real>],
-    image: &[f32],
-    reference_image: &[f32],
-    reference_depth: &[Option<Real>],
+    reference: &[Option<Real>],
     footprints: &[Real],
-) -> Errors {
-    let mse = image
-        .iter()
-        .zip(reference_image)
-        .map(|(a, b)| ((a - b) as f64).powi(2))
-        .sum::<f64>()
-        / image.len().max(1) as f64;
+) -> DepthErrors {
     let mut errors = Vec::new();
     let mut mismatches = 0usize;
     let mut overshoots = 0usize;
-    for (i, (hit, reference)) in hits.iter().zip(reference_depth).enumerate() {
+    for (i, (hit, reference)) in hits.iter().zip(reference).enumerate() {
         match (hit, reference) {
             (Some(t), Some(r)) => {
                 let signed = (t - r) / footprints[i];
@@ -287,12 +304,31 @@ fn compare(
         .get(((errors.len() as f64 * 0.99).ceil() as usize).saturating_sub(1))
         .copied()
         .unwrap_or(0.0);
-    let pixels = reference_depth.len().max(1) as f64;
-    Errors {
-        depth_mean: mean,
-        depth_p99: p99,
+    let pixels = reference.len().max(1) as f64;
+    DepthErrors {
+        mean_px: mean,
+        p99_px: p99,
         hit_mismatch: mismatches as f64 / pixels,
         overshoot: overshoots as f64 / pixels,
+    }
+}
+
+/// Errors of `hits` and `image` against the reference.
+fn compare(
+    hits: &[Option<Real>],
+    image: &[f32],
+    reference_image: &[f32],
+    reference_depth: &[Option<Real>],
+    footprints: &[Real],
+) -> Errors {
+    let mse = image
+        .iter()
+        .zip(reference_image)
+        .map(|(a, b)| ((a - b) as f64).powi(2))
+        .sum::<f64>()
+        / image.len().max(1) as f64;
+    Errors {
+        depth: depth_errors(hits, reference_depth, footprints),
         rmse: mse.sqrt(),
     }
 }
@@ -335,28 +371,13 @@ pub fn measure(
 ) -> Report {
     let all = variants(scene);
     let reference = &all[0].scene;
-    let camera = scene.camera.frame();
-    let footprints: Vec<Real> = (0..height)
-        .flat_map(|y| (0..width).map(move |x| (x, y)))
-        .map(|(x, y)| camera.ray(x as Real + 0.5, y as Real + 0.5, width, height))
-        .map(|ray| ray.footprint(1.0))
-        .collect();
-    // Footprints scale with distance: per pixel, footprint(t) = t × footprint(1).
-    let footprints_at = |depths: &[Option<Real>]| -> Vec<Real> {
-        depths
-            .iter()
-            .zip(&footprints)
-            .map(|(t, f)| t.map_or(*f, |t| (t * f).max(1e-300)))
-            .collect()
-    };
-
     progress(0, all.len(), &all[0]);
     let started = Instant::now();
     let (reference_depth, tests) = reference_depths(reference, width, height, REFERENCE_STEP);
     let reference_film = render_frame(reference, frame_index, width, height, &|| {});
     let reference_seconds = started.elapsed().as_secs_f64();
     let reference_image = srgb(&reference_film);
-    let footprint_at_reference = footprints_at(&reference_depth);
+    let footprint_at_reference = footprints_at(scene, width, height, &reference_depth);
 
     // The same depths at twice the step: how far the reference itself has settled.
     let (coarse, _) = reference_depths(reference, width, height, 2.0 * REFERENCE_STEP);
@@ -368,8 +389,8 @@ pub fn measure(
         &footprint_at_reference,
     );
     let convergence = Convergence {
-        depth_change_mean_px: settled.depth_mean,
-        hit_change: settled.hit_mismatch,
+        depth_change_mean_px: settled.depth.mean_px,
+        hit_change: settled.depth.hit_mismatch,
     };
 
     let measurement = |variant: &Variant, seconds: f64, evaluations: u64, e: Errors| Measurement {
@@ -377,10 +398,10 @@ pub fn measure(
         setting: variant.setting.clone(),
         seconds,
         de_evaluations: evaluations,
-        depth_error_mean_px: e.depth_mean,
-        depth_error_p99_px: e.depth_p99,
-        hit_mismatch: e.hit_mismatch,
-        overshoot: e.overshoot,
+        depth_error_mean_px: e.depth.mean_px,
+        depth_error_p99_px: e.depth.p99_px,
+        hit_mismatch: e.depth.hit_mismatch,
+        overshoot: e.depth.overshoot,
         image_rmse: e.rmse,
         psnr_db: psnr(e.rmse),
         pareto: false,
@@ -438,28 +459,9 @@ pub fn mark_pareto(rows: &mut [Measurement]) {
     }
 }
 
-/// The table as CSV, one row per variant.
+/// The table as CSV, one row per variant, a column per field.
 pub fn to_csv(rows: &[Measurement]) -> String {
-    let mut out = String::from(
-        "knob,setting,seconds,de_evaluations,depth_error_mean_px,depth_error_p99_px,hit_mismatch,overshoot,image_rmse,psnr_db,pareto\n",
-    );
-    for r in rows {
-        out += &format!(
-            "{},\"{}\",{:.6},{},{:.6},{:.6},{:.6},{:.6},{:.6},{:.3},{}\n",
-            r.knob,
-            r.setting,
-            r.seconds,
-            r.de_evaluations,
-            r.depth_error_mean_px,
-            r.depth_error_p99_px,
-            r.hit_mismatch,
-            r.overshoot,
-            r.image_rmse,
-            r.psnr_db,
-            r.pareto
-        );
-    }
-    out
+    crate::output::csv_text(rows)
 }
 
 /// The table as Markdown, with times relative to the scene's own settings.

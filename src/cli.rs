@@ -94,6 +94,9 @@ pub struct BenchArgs {
     /// Size of the peak-memory EXR render, or `none` to skip it.
     #[arg(long, default_value = "3840x2160")]
     pub memory_size: String,
+    /// Size of the depth comparison against the accuracy reference (first scene), or `none`.
+    #[arg(long, default_value = "160x120")]
+    pub depth_size: String,
     /// Folder for <machine>.csv and <machine>.md.
     #[arg(long, default_value = "bench/results")]
     pub results: PathBuf,
@@ -1383,6 +1386,10 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         "none" => None,
         text => Some(parse_size("--memory-size", text)?),
     };
+    let depth_size = match args.depth_size.as_str() {
+        "none" => None,
+        text => Some(parse_size("--depth-size", text)?),
+    };
     if args.runs == 0 {
         return Err(Error::usage("--runs", "must be at least 1").into());
     }
@@ -1422,6 +1429,7 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         runs: args.runs,
         threads,
         memory_size,
+        depth_size,
         results: args.results.clone(),
         machine: args
             .machine

@@ -392,6 +392,18 @@ fn encode_exr(
         .map_err(|e| e.to_string())
 }
 
+/// `rows` as CSV: a header of the field names, then a line per row.
+pub fn csv_text<T: Serialize>(rows: &[T]) -> String {
+    let mut writer = csv::Writer::from_writer(vec![]);
+    for row in rows {
+        writer
+            .serialize(row)
+            .expect("plain records serialise to CSV in memory");
+    }
+    let bytes = writer.into_inner().expect("writing to memory cannot fail");
+    String::from_utf8(bytes).expect("CSV of UTF-8 fields is UTF-8")
+}
+
 /// The file in an output folder that records what it holds, so `status` can
 /// work from the folder alone.
 pub const JOB_FILE: &str = "mandelreel-job.json";

@@ -31,6 +31,8 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         "1,2",
         "--memory-size",
         "64x36",
+        "--depth-size",
+        "24x14",
         "--results",
         "results",
         "--machine",
@@ -106,6 +108,44 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     assert!((num(memory, "output_buffers_mib") - 64.0 * 36.0 * 24.0 / 1048576.0).abs() < 0.001);
     #[cfg(target_os = "linux")]
     assert!(num(memory, "peak_rss_mib") > 1.0, "{csv}");
+    // The depth row is mandelreel's error against the accuracy reference:
+    // the same figures as the accuracy sweep's own "scene" row at that size.
+    // The stand-in writes no z-buffer, so Mandelbulber2 has no depth row.
+    let depth = row("tiny depth@24x14", "mandelreel", "0");
+    d.ok(&[
+        "accuracy",
+        "scenes/tiny.ron",
+        "--size",
+        "24x14",
+        "--out",
+        "acc",
+        "--quiet",
+    ]);
+    let acc = std::fs::read_to_string(d.path().join("acc/accuracy.csv")).unwrap();
+    let scene_row = acc
+        .lines()
+        .find(|l| l.starts_with("scene,"))
+        .expect("the sweep has a scene row");
+    let acc_header: Vec<&str> = acc.lines().next().unwrap().split(',').collect();
+    let acc_num = |name: &str| -> f64 {
+        let at = acc_header.iter().position(|h| *h == name).unwrap();
+        scene_row.split(',').nth(at).unwrap().parse().unwrap()
+    };
+    for (ours, theirs) in [
+        ("depth_error_mean_px", "depth_error_mean_px"),
+        ("depth_error_p99_px", "depth_error_p99_px"),
+        ("hit_mismatch", "hit_mismatch"),
+    ] {
+        assert!(
+            (num(depth, ours) - acc_num(theirs)).abs() < 1e-9,
+            "{ours}: {csv}\n{acc}"
+        );
+    }
+    assert!(rows
+        .iter()
+        .all(|r| !r[col("scene")].contains("depth")
+            || !r[col("renderer")].starts_with("mandelbulber2")));
+    assert!(md.contains("| mandelreel (fitted) |"), "{md}");
 }
 
 #[test]
