@@ -11,7 +11,7 @@
 //! (now only a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
 //! "Coloring").
 
-use crate::math::{Arith, DVec3, Dual, Lanes, Number, Real};
+use crate::math::{Arith, DVec3, Dual, Number, Real, Vector};
 use serde::{Deserialize, Serialize};
 
 /// Which spherical-coordinate convention defines the triplex power.
@@ -239,21 +239,23 @@ fn complex_powi<T: Arith>(re: T, im: T, n: u32) -> (T, T) {
 /// uses the trigonometric form, which is exact there.
 #[inline(always)]
 pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> Option<Triplex<T>> {
-    let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n);
+    let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n, T::from_real(1.0));
     let usable = rho2.value() > 1e-12 * r2.value()
         && r2.value().is_finite()
         && out.iter().all(|v| v.value().is_finite());
     usable.then_some(out)
 }
 
-/// `triplex_power_int` without its checks, for any `Arith` (one point or
-/// `Lanes` of them): the power, ρ² and r², whose test `usable_power` makes.
-/// Branch-free, so lanes near the axis compute garbage the caller replaces.
+/// `triplex_power_int` without its checks, for any `Arith` (one point or a
+/// `Vector` of them; `one` is its 1): the power, ρ² and r², which the
+/// callers test. Branch-free, so lanes near the axis compute values the
+/// caller replaces.
 #[inline(always)]
 fn triplex_power_int_unchecked<T: Arith>(
     formula: Formula,
     z: Triplex<T>,
     n: u32,
+    one: T,
 ) -> (Triplex<T>, T, T) {
     let [x, y, zz] = z;
     // The pole coordinate and the equatorial pair whose angle is the azimuth.
@@ -273,7 +275,7 @@ fn triplex_power_int_unchecked<T: Arith>(
     } else {
         powi(rho, n, mul)
     };
-    let inv_rho_n = T::from_real(1.0) / rho_n;
+    let inv_rho_n = one / rho_n;
     let (a, b) = complex_powi(e1, e2, n);
     let (cp, sp) = (a * inv_rho_n, b * inv_rho_n);
     let out = match formula {
@@ -539,11 +541,7 @@ impl Fractal {
                 Ok(full) => full,
                 Err(_) => std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT)),
             };
-            let done = if n == 8 {
-                orbit_lanes_8(self, lanes)
-            } else {
-                orbit_lanes_n(self, lanes, n)
-            };
+            let done = orbit_vector(self, lanes, n);
             out.copy_from_slice(&done[..out.len()]);
         }
         let iterations: u64 = orbits.iter().map(|o| o.iterations as u64).sum();
@@ -716,148 +714,199 @@ pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
 /// register (two AVX2 registers).
 pub const VECTOR: usize = 8;
 
-/// `Fractal::orbit_lanes` for power 8, compiled once per instruction set
-/// and picked at run time by the processor's features (AVX-512, AVX2, or
-/// the baseline SSE2), so one binary runs everywhere and uses the widest
-/// vectors it finds. Rust never fuses a multiply and an add unasked, so
-/// every version rounds exactly as the scalar `orbit` does.
-#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
-fn orbit_lanes_8(fractal: &Fractal, points: [DVec3; VECTOR]) -> [Orbit<f64>; VECTOR] {
-    // One copy of the loop per convention, with no branch on it inside.
-    match fractal.formula {
-        Formula::Quilez => orbit_lanes_kernel(fractal, points, 8, Formula::Quilez),
-        Formula::WhiteNylander => orbit_lanes_kernel(fractal, points, 8, Formula::WhiteNylander),
-        Formula::Asin => orbit_lanes_kernel(fractal, points, 8, Formula::Asin),
+/// `Fractal::orbit_lanes` on one vector of points, compiled for each
+/// instruction set and picked at run time by the processor (pulp's `Arch`:
+/// AVX-512, AVX2 with FMA, or plain scalar code), so one binary runs
+/// everywhere and uses the widest registers it finds. Each operation is
+/// written out as the vector instruction it is, so the speed does not rest
+/// on the compiler vectorising; Rust never fuses a multiply and an add
+/// unasked, so every version rounds exactly as the scalar `orbit` does.
+fn orbit_vector(fractal: &Fractal, points: [DVec3; VECTOR], n: u32) -> [Orbit<f64>; VECTOR] {
+    pulp::Arch::new().dispatch(OrbitVector { fractal, points, n })
+}
+
+struct OrbitVector<'a> {
+    fractal: &'a Fractal,
+    points: [DVec3; VECTOR],
+    n: u32,
+}
+
+impl pulp::WithSimd for OrbitVector<'_> {
+    type Output = [Orbit<f64>; VECTOR];
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
+        let mut out = [Orbit::IDLE; VECTOR];
+        let lanes = S::F64_LANES.clamp(1, VECTOR);
+        for (points, out) in self.points.chunks(lanes).zip(out.chunks_mut(lanes)) {
+            // One copy of the loop per convention and for power 8, so the
+            // loop has no branch on either and power 8 unrolls.
+            let f = self.fractal;
+            let done = match (f.formula, self.n) {
+                (Formula::Quilez, 8) => orbit_register(simd, f, points, 8, Formula::Quilez),
+                (Formula::Asin, 8) => orbit_register(simd, f, points, 8, Formula::Asin),
+                (Formula::WhiteNylander, 8) => {
+                    orbit_register(simd, f, points, 8, Formula::WhiteNylander)
+                }
+                (formula, n) => orbit_register(simd, f, points, n, formula),
+            };
+            for (o, d) in out.iter_mut().zip(done) {
+                *o = d;
+            }
+        }
+        out
     }
 }
 
-/// `orbit_lanes_8` for any other whole power.
-#[multiversion::multiversion(targets("x86_64+avx512f+avx512vl+avx2+fma", "x86_64+avx2+fma"))]
-fn orbit_lanes_n(fractal: &Fractal, points: [DVec3; VECTOR], n: u32) -> [Orbit<f64>; VECTOR] {
-    orbit_lanes_kernel(fractal, points, n, fractal.formula)
-}
-
-/// The lane-wise orbit loop: `OrbitState::step` on `Lanes`, with each
-/// lane's state frozen (by selection, not branching) once it has escaped.
-/// Lanes near the pole axis take the trigonometric form one at a time, as
-/// `whole_power_step` does.
+/// The lane-wise orbit loop on one register of points (at most
+/// `VECTOR`): `OrbitState::step` on `Vector`s, each lane's state frozen by
+/// selection once it has escaped. Lanes near the pole axis take the
+/// trigonometric form one at a time, as `whole_power_step` does.
 #[inline(always)]
-fn orbit_lanes_kernel<const N: usize>(
+fn orbit_register<S: pulp::Simd>(
+    simd: S,
     fractal: &Fractal,
-    points: [DVec3; N],
+    points: &[DVec3],
     n: u32,
     formula: Formula,
-) -> [Orbit<f64>; N] {
-    let bailout = fractal.bailout;
-    let mut z = [
-        Lanes(points.map(|p| p.x)),
-        Lanes(points.map(|p| p.y)),
-        Lanes(points.map(|p| p.z)),
-    ];
-    let (c, plus_one) = match fractal.julia {
-        Some(k) => ([k.x, k.y, k.z].map(Lanes::from_real), 0.0),
+) -> [Orbit<f64>; VECTOR] {
+    let lanes = points.len();
+    debug_assert_eq!(lanes, S::F64_LANES.min(VECTOR));
+    let store = |v: Vector<S>| {
+        let mut a = [0.0; VECTOR];
+        S::as_mut_simd_f64s(&mut a[..lanes]).0[0] = v.1;
+        a
+    };
+    let splat = |v: f64| Vector::splat(simd, v);
+    let select = |mask: S::m64s, new: Vector<S>, old: Vector<S>| {
+        Vector(simd, simd.select_f64s(mask, new.1, old.1))
+    };
+    let any = |mask: S::m64s| simd.first_true_m64s(mask) < lanes;
+    let mut z = [0, 1, 2].map(|axis| {
+        let mut a = [0.0; VECTOR];
+        for (a, p) in a.iter_mut().zip(points) {
+            *a = p[axis];
+        }
+        Vector(simd, S::as_simd_f64s(&a[..lanes]).0[0])
+    });
+    let (c, plus_one_value) = match fractal.julia {
+        Some(k) => ([splat(k.x), splat(k.y), splat(k.z)], 0.0),
         None => (z, 1.0),
     };
-    let (power, plus_one) = (Lanes::from_real(fractal.power), Lanes::from_real(plus_one));
+    let (power, plus_one, one) = (splat(fractal.power), splat(plus_one_value), splat(1.0));
     let mut r2 = length_squared(z);
     let mut r = r2.sqrt();
-    let mut dr = Lanes::from_real(1.0);
-    let mut origin = [Real::INFINITY; N];
-    let mut planes = [[Real::INFINITY; N]; 3];
-    let mut i = [0u32; N];
-    let mut running = [true; N];
-    let bailout2 = bailout * bailout;
-    // Branch-free per lane (`&` not `&&`, selections not `if`), so each
-    // step stays one block of vector instructions.
-    let select = |mask: &[bool; N], new: Lanes<N>, old: Lanes<N>| {
-        Lanes(std::array::from_fn(|k| {
-            if mask[k] {
-                new.0[k]
-            } else {
-                old.0[k]
-            }
-        }))
-    };
+    let mut dr = one;
+    let infinity = splat(Real::INFINITY);
+    let mut origin = infinity;
+    let mut planes = [infinity; 3];
+    let mut i = splat(0.0);
+    let bailout2 = splat(fractal.bailout * fractal.bailout);
+    // Every lane holds a point (`VECTOR` is a multiple of the lane count).
+    let mut running = simd.equal_f64s(one.1, one.1);
     for _ in 0..fractal.iterations {
-        // `OrbitState::outside`, so a NaN radius keeps iterating alike.
-        for (run, &r2) in running.iter_mut().zip(&r2.0) {
-            *run &= r2 <= bailout2 || r2.is_nan();
-        }
-        if !running.contains(&true) {
+        // `OrbitState::outside`: a NaN radius keeps iterating alike.
+        running = simd.and_m64s(
+            running,
+            simd.not_m64s(simd.greater_than_f64s(r2.1, bailout2.1)),
+        );
+        if !any(running) {
             break;
         }
-        let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n);
-        let mut near_axis = [false; N];
-        for (k, near) in near_axis.iter_mut().enumerate() {
-            let finite = w[0].0[k].is_finite() & w[1].0[k].is_finite() & w[2].0[k].is_finite();
-            let usable = (rho2.0[k] > 1e-12 * power_r2.0[k]) & power_r2.0[k].is_finite() & finite;
-            *near = running[k] & !usable;
-        }
-        if near_axis.contains(&true) {
-            let exact = near_axis_powers(formula, z, r, n, &near_axis);
+        let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n, one);
+        // `triplex_power_int`'s test, lane by lane.
+        let finite = |v: Vector<S>| {
+            let a = simd.abs_f64s(v.1);
+            simd.less_than_f64s(a, infinity.1)
+        };
+        let usable = simd.and_m64s(
+            simd.and_m64s(
+                simd.greater_than_f64s(rho2.1, (splat(1e-12) * power_r2).1),
+                finite(power_r2),
+            ),
+            simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
+        );
+        let near_axis = simd.and_m64s(running, simd.not_m64s(usable));
+        if any(near_axis) {
+            let flags = store(select(near_axis, one, splat(0.0)));
+            let exact = near_axis_powers(
+                formula,
+                [store(z[0]), store(z[1]), store(z[2])],
+                store(r),
+                n,
+                &flags,
+            );
             for axis in 0..3 {
-                w[axis] = select(&near_axis, exact[axis], w[axis]);
+                let fixed = Vector(simd, S::as_simd_f64s(&exact[axis][..lanes]).0[0]);
+                w[axis] = select(near_axis, fixed, w[axis]);
             }
         }
-        // `OrbitState::step`'s trap updates (|z|² is the r2 of this z).
-        origin = select(&running, Lanes(origin).zip(r2, f64::min), Lanes(origin)).0;
+        // `OrbitState::step`'s traps (f64::min: the smaller, never a NaN
+        // over a number), its derivative and its new point.
+        let min = |a: Vector<S>, b: Vector<S>| select(simd.less_than_f64s(b.1, a.1), b, a);
+        origin = select(running, min(origin, r2), origin);
         for axis in 0..3 {
-            let next = Lanes(planes[axis]).zip(z[axis], |m, v| m.min(v.abs()));
-            planes[axis] = select(&running, next, Lanes(planes[axis])).0;
+            let next = min(planes[axis], Vector(simd, simd.abs_f64s(z[axis].1)));
+            planes[axis] = select(running, next, planes[axis]);
         }
         dr = select(
-            &running,
+            running,
             power * powi(r, n - 1, |a, b| a * b) * dr + plus_one,
             dr,
         );
         let next_z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
         let next_r2 = length_squared(next_z);
-        r2 = select(&running, next_r2, r2);
-        r = select(&running, next_r2.sqrt(), r);
+        r2 = select(running, next_r2, r2);
+        r = select(running, next_r2.sqrt(), r);
         for axis in 0..3 {
-            z[axis] = select(&running, next_z[axis], z[axis]);
+            z[axis] = select(running, next_z[axis], z[axis]);
         }
-        for (i, &run) in i.iter_mut().zip(&running) {
-            *i += run as u32;
-        }
+        i = select(running, i + one, i);
     }
-    std::array::from_fn(|k| {
-        OrbitState {
-            z: [z[0].0[k], z[1].0[k], z[2].0[k]],
-            c: [c[0].0[k], c[1].0[k], c[2].0[k]],
-            plus_one: plus_one.0[k],
-            n: power.0[k],
-            r2: r2.0[k],
-            r: r.0[k],
-            dr: dr.0[k],
+    let (z, c) = (
+        [store(z[0]), store(z[1]), store(z[2])],
+        [store(c[0]), store(c[1]), store(c[2])],
+    );
+    let planes = [store(planes[0]), store(planes[1]), store(planes[2])];
+    let (r2, r, dr, origin, i) = (store(r2), store(r), store(dr), store(origin), store(i));
+    let mut out = [Orbit::IDLE; VECTOR];
+    for (k, out) in out.iter_mut().enumerate().take(lanes) {
+        *out = OrbitState {
+            z: [z[0][k], z[1][k], z[2][k]],
+            c: [c[0][k], c[1][k], c[2][k]],
+            plus_one: plus_one_value,
+            n: fractal.power,
+            r2: r2[k],
+            r: r[k],
+            dr: dr[k],
             traps: OrbitTraps {
                 origin: origin[k],
                 planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
             },
-            i: i[k],
+            i: i[k] as u32,
         }
-        .finish(bailout)
-    })
+        .finish(fractal.bailout);
+    }
+    out
 }
 
-/// The trigonometric power of the lanes in `which`, as `whole_power_step`
-/// takes it near the pole axis; other lanes are left 0. Rare, and out of
-/// line so the vector loop keeps its registers.
+/// The trigonometric power of the lanes flagged (non-zero) in `which`, as
+/// `whole_power_step` takes it near the pole axis; other lanes are left 0.
+/// Rare, and out of line so the vector loop keeps its registers.
 #[cold]
 #[inline(never)]
-fn near_axis_powers<const N: usize>(
+fn near_axis_powers(
     formula: Formula,
-    z: Triplex<Lanes<N>>,
-    r: Lanes<N>,
+    z: [[f64; VECTOR]; 3],
+    r: [f64; VECTOR],
     n: u32,
-    which: &[bool; N],
-) -> Triplex<Lanes<N>> {
-    let mut out = [Lanes([0.0; N]); 3];
-    for k in (0..N).filter(|&k| which[k]) {
-        let at = [z[0].0[k], z[1].0[k], z[2].0[k]];
-        let exact = triplex_power_trig(formula, at, r.0[k], n as Real);
+    which: &[f64; VECTOR],
+) -> [[f64; VECTOR]; 3] {
+    let mut out = [[0.0; VECTOR]; 3];
+    for k in (0..VECTOR).filter(|&k| which[k] != 0.0) {
+        let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
         for axis in 0..3 {
-            out[axis].0[k] = exact[axis];
+            out[axis][k] = exact[axis];
         }
     }
     out
@@ -1154,6 +1203,73 @@ mod tests {
             check::<8>(f, &pts);
             check::<12>(f, &pts);
         }
+    }
+
+    #[test]
+    fn every_instruction_set_gives_the_scalar_orbit_bit_for_bit() {
+        // The kernel as each instruction set pulp can pick runs it (plain
+        // scalar always, AVX2 and AVX-512 where this processor has them),
+        // against `orbit` one point at a time: every field, to the bit.
+        use pulp::WithSimd;
+        let mut pts = points(96, 0.0..2.5, 9);
+        pts.extend([
+            DVec3::new(0.0, 0.0, 0.7),
+            DVec3::new(0.0, -0.6, 0.0),
+            DVec3::ZERO,
+        ]);
+        pts.extend([DVec3::new(40.0, -3.0, 2.0), IDLE_POINT]);
+        pts.resize(
+            pts.len().next_multiple_of(VECTOR),
+            DVec3::new(0.3, 0.2, -0.1),
+        );
+        let mut tried = 0;
+        for f in [
+            Fractal::default(),
+            Fractal {
+                formula: Formula::Asin,
+                bailout: 10.0,
+                ..Fractal::default()
+            },
+            Fractal {
+                formula: Formula::WhiteNylander,
+                power: 5.0,
+                julia: Some(DVec3::new(0.3, -0.5, 0.2)),
+                ..Fractal::default()
+            },
+        ] {
+            let n = whole_power(f.power).unwrap();
+            for chunk in pts.chunks_exact(VECTOR) {
+                let points: [DVec3; VECTOR] = chunk.try_into().unwrap();
+                let expected: Vec<String> = points
+                    .iter()
+                    .map(|p| format!("{:?}", f.orbit([p.x, p.y, p.z], f.iterations, true)))
+                    .collect();
+                let check = |orbits: [Orbit<f64>; VECTOR], arch: &str| {
+                    for (k, o) in orbits.iter().enumerate() {
+                        assert_eq!(format!("{o:?}"), expected[k], "{arch} at {}", points[k]);
+                    }
+                };
+                let kernel = || OrbitVector {
+                    fractal: &f,
+                    points,
+                    n,
+                };
+                check(kernel().with_simd(pulp::Scalar::new()), "scalar");
+                tried |= 1;
+                #[cfg(target_arch = "x86_64")]
+                {
+                    if let Some(v3) = pulp::x86::V3::try_new() {
+                        check(kernel().with_simd(v3), "AVX2");
+                        tried |= 2;
+                    }
+                    if let Some(v4) = pulp::x86::V4::try_new() {
+                        check(kernel().with_simd(v4), "AVX-512");
+                        tried |= 4;
+                    }
+                }
+            }
+        }
+        assert!(tried & 1 == 1);
     }
 
     #[test]

@@ -8,27 +8,22 @@ use std::ops::{Add, Div, Mul, Neg, Sub};
 /// The floating-point type of all geometry and distance estimation.
 pub type Real = f64;
 
-/// The arithmetic of the whole-power step: the four operations, constants
-/// and square roots. Implemented for the kernel's number types and for
-/// `Lanes`, so one formula serves one orbit and several side by side.
+/// The arithmetic of the whole-power step: the four operations and square
+/// roots. Implemented for the kernel's number types and for `Vector`s of
+/// them, so one formula serves one orbit and several side by side.
 pub trait Arith:
-    Copy
-    + Add<Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Div<Output = Self>
-    + Neg<Output = Self>
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
 {
-    fn from_real(v: Real) -> Self;
     fn sqrt(self) -> Self;
 }
 
 /// The arithmetic the fractal kernel needs. Implemented for f64, for f32 (to
 /// show what single precision costs) and for dual numbers (forward-mode
 /// derivatives), so one iteration driver serves all three.
-pub trait Number: Arith {
+pub trait Number: Arith + Neg<Output = Self> {
     /// Machine epsilon of the underlying float.
     const EPSILON: Real;
+    fn from_real(v: Real) -> Self;
     /// The plain value (for comparisons, traps and results).
     fn value(self) -> Real;
     fn acos(self) -> Self;
@@ -41,67 +36,46 @@ pub trait Number: Arith {
     fn clamp_unit(self) -> Self;
 }
 
-/// `N` f64 values under one name, every operation applied lane by lane in
-/// the order one value would take it: the same IEEE operations as `N`
-/// separate f64 computations, so bit-identical to them, written so the
-/// compiler can turn each into one vector instruction.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Lanes<const N: usize>(pub [f64; N]);
+/// One SIMD register of f64 (as many lanes as the instruction set `S`
+/// has: 8 with AVX-512, 4 with AVX2, 1 without), with the token that proves
+/// the instructions exist. Each operation is one IEEE instruction per lane,
+/// the same operation a lone f64 takes, so results are bit-identical.
+#[derive(Clone, Copy, Debug)]
+pub struct Vector<S: pulp::Simd>(pub S, pub S::f64s);
 
-impl<const N: usize> Lanes<N> {
+impl<S: pulp::Simd> Vector<S> {
     #[inline(always)]
-    pub fn map(self, f: impl Fn(f64) -> f64) -> Self {
-        Lanes(self.0.map(f))
-    }
-
-    #[inline(always)]
-    pub fn zip(self, o: Self, f: impl Fn(f64, f64) -> f64) -> Self {
-        Lanes(std::array::from_fn(|k| f(self.0[k], o.0[k])))
+    pub fn splat(simd: S, v: f64) -> Self {
+        Vector(simd, simd.splat_f64s(v))
     }
 }
 
-macro_rules! lanes_operator {
-    ($trait:ident, $method:ident, $op:tt) => {
-        impl<const N: usize> $trait for Lanes<N> {
+macro_rules! vector_operator {
+    ($trait:ident, $method:ident, $simd:ident) => {
+        impl<S: pulp::Simd> $trait for Vector<S> {
             type Output = Self;
             #[inline(always)]
             fn $method(self, o: Self) -> Self {
-                self.zip(o, |a, b| a $op b)
+                Vector(self.0, self.0.$simd(self.1, o.1))
             }
         }
     };
 }
-lanes_operator!(Add, add, +);
-lanes_operator!(Sub, sub, -);
-lanes_operator!(Mul, mul, *);
-lanes_operator!(Div, div, /);
+vector_operator!(Add, add, add_f64s);
+vector_operator!(Sub, sub, sub_f64s);
+vector_operator!(Mul, mul, mul_f64s);
+vector_operator!(Div, div, div_f64s);
 
-impl<const N: usize> Neg for Lanes<N> {
-    type Output = Self;
-    #[inline(always)]
-    fn neg(self) -> Self {
-        self.map(|a| -a)
-    }
-}
-
-impl<const N: usize> Arith for Lanes<N> {
-    #[inline(always)]
-    fn from_real(v: Real) -> Self {
-        Lanes([v; N])
-    }
+impl<S: pulp::Simd> Arith for Vector<S> {
     #[inline(always)]
     fn sqrt(self) -> Self {
-        self.map(f64::sqrt)
+        Vector(self.0, self.0.sqrt_f64s(self.1))
     }
 }
 
 macro_rules! impl_number_for_float {
     ($t:ty) => {
         impl Arith for $t {
-            #[inline(always)]
-            fn from_real(v: Real) -> Self {
-                v as $t
-            }
             #[inline(always)]
             fn sqrt(self) -> Self {
                 <$t>::sqrt(self)
@@ -110,6 +84,10 @@ macro_rules! impl_number_for_float {
 
         impl Number for $t {
             const EPSILON: Real = <$t>::EPSILON as Real;
+            #[inline(always)]
+            fn from_real(v: Real) -> Self {
+                v as $t
+            }
             #[inline]
             fn value(self) -> Real {
                 self as Real
@@ -238,9 +216,6 @@ impl<T: Number> Div for Dual<T> {
 }
 
 impl<T: Number> Arith for Dual<T> {
-    fn from_real(v: Real) -> Self {
-        Dual::constant(T::from_real(v))
-    }
     fn sqrt(self) -> Self {
         let s = self.v.sqrt();
         self.chain(s, T::from_real(0.5) / s)
@@ -249,6 +224,9 @@ impl<T: Number> Arith for Dual<T> {
 
 impl<T: Number> Number for Dual<T> {
     const EPSILON: Real = T::EPSILON;
+    fn from_real(v: Real) -> Self {
+        Dual::constant(T::from_real(v))
+    }
     fn value(self) -> Real {
         self.v.value()
     }
