@@ -710,9 +710,9 @@ impl Fractal {
 /// orbit ends before the first iteration.
 pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
 
-/// Orbits one vector of the lane kernel holds: eight f64, one AVX-512
-/// register (two AVX2 registers).
-pub const VECTOR: usize = 8;
+/// Orbits the lane kernel takes at once: two AVX-512 registers of eight
+/// f64 (four AVX2 registers).
+pub const VECTOR: usize = 16;
 
 /// `Fractal::orbit_lanes` on one vector of points, compiled for each
 /// instruction set and picked at run time by the processor (pulp's `Arch`:
@@ -737,157 +737,223 @@ impl pulp::WithSimd for OrbitVector<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
         let mut out = [Orbit::IDLE; VECTOR];
-        let lanes = S::F64_LANES.clamp(1, VECTOR);
-        for (points, out) in self.points.chunks(lanes).zip(out.chunks_mut(lanes)) {
+        let lanes = S::F64_LANES.clamp(1, VECTOR / 2);
+        // Two registers at a time: their dependency chains are independent,
+        // so the processor overlaps one's square roots and division with
+        // the other's multiplications instead of waiting.
+        for (points, out) in self.points.chunks(2 * lanes).zip(out.chunks_mut(2 * lanes)) {
             // One copy of the loop per convention and for power 8, so the
             // loop has no branch on either and power 8 unrolls.
             let f = self.fractal;
-            let done = match (f.formula, self.n) {
-                (Formula::Quilez, 8) => orbit_register(simd, f, points, 8, Formula::Quilez),
-                (Formula::Asin, 8) => orbit_register(simd, f, points, 8, Formula::Asin),
+            match (f.formula, self.n) {
+                (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez, out),
+                (Formula::Asin, 8) => orbit_registers(simd, f, points, 8, Formula::Asin, out),
                 (Formula::WhiteNylander, 8) => {
-                    orbit_register(simd, f, points, 8, Formula::WhiteNylander)
+                    orbit_registers(simd, f, points, 8, Formula::WhiteNylander, out)
                 }
-                (formula, n) => orbit_register(simd, f, points, n, formula),
-            };
-            for (o, d) in out.iter_mut().zip(done) {
-                *o = d;
+                (formula, n) => orbit_registers(simd, f, points, n, formula, out),
             }
         }
         out
     }
 }
 
-/// The lane-wise orbit loop on one register of points (at most
-/// `VECTOR`): `OrbitState::step` on `Vector`s, each lane's state frozen by
-/// selection once it has escaped. Lanes near the pole axis take the
-/// trigonometric form one at a time, as `whole_power_step` does.
+/// Two registers of orbits iterated in one loop (see `Register`).
 #[inline(always)]
-fn orbit_register<S: pulp::Simd>(
+fn orbit_registers<S: pulp::Simd>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3],
     n: u32,
     formula: Formula,
-) -> [Orbit<f64>; VECTOR] {
-    let lanes = points.len();
-    debug_assert_eq!(lanes, S::F64_LANES.min(VECTOR));
-    let store = |v: Vector<S>| {
-        let mut a = [0.0; VECTOR];
-        S::as_mut_simd_f64s(&mut a[..lanes]).0[0] = v.1;
-        a
-    };
-    let splat = |v: f64| Vector::splat(simd, v);
-    let select = |mask: S::m64s, new: Vector<S>, old: Vector<S>| {
-        Vector(simd, simd.select_f64s(mask, new.1, old.1))
-    };
-    let any = |mask: S::m64s| simd.first_true_m64s(mask) < lanes;
-    let mut z = [0, 1, 2].map(|axis| {
-        let mut a = [0.0; VECTOR];
-        for (a, p) in a.iter_mut().zip(points) {
-            *a = p[axis];
-        }
-        Vector(simd, S::as_simd_f64s(&a[..lanes]).0[0])
-    });
-    let (c, plus_one_value) = match fractal.julia {
-        Some(k) => ([splat(k.x), splat(k.y), splat(k.z)], 0.0),
-        None => (z, 1.0),
-    };
-    let (power, plus_one, one) = (splat(fractal.power), splat(plus_one_value), splat(1.0));
-    let mut r2 = length_squared(z);
-    let mut r = r2.sqrt();
-    let mut dr = one;
-    let infinity = splat(Real::INFINITY);
-    let mut origin = infinity;
-    let mut planes = [infinity; 3];
-    let mut i = splat(0.0);
-    let bailout2 = splat(fractal.bailout * fractal.bailout);
-    // Every lane holds a point (`VECTOR` is a multiple of the lane count).
-    let mut running = simd.equal_f64s(one.1, one.1);
+    out: &mut [Orbit<f64>],
+) {
+    let lanes = points.len() / 2;
+    let mut a = Register::start(simd, fractal, &points[..lanes]);
+    let mut b = Register::start(simd, fractal, &points[lanes..]);
     for _ in 0..fractal.iterations {
-        // `OrbitState::outside`: a NaN radius keeps iterating alike.
-        running = simd.and_m64s(
-            running,
-            simd.not_m64s(simd.greater_than_f64s(r2.1, bailout2.1)),
-        );
-        if !any(running) {
+        let (run_a, run_b) = (a.check(fractal), b.check(fractal));
+        if !(run_a || run_b) {
             break;
         }
+        if run_a {
+            a.step(formula, n);
+        }
+        if run_b {
+            b.step(formula, n);
+        }
+    }
+    a.finish(fractal, &mut out[..lanes]);
+    b.finish(fractal, &mut out[lanes..]);
+}
+
+/// One register of orbits: `OrbitState` on `Vector`s, each lane's state
+/// frozen by selection once it has escaped. Lanes near the pole axis take
+/// the trigonometric form one at a time, as `whole_power_step` does.
+#[derive(Clone, Copy)]
+struct Register<S: pulp::Simd> {
+    simd: S,
+    z: Triplex<Vector<S>>,
+    c: Triplex<Vector<S>>,
+    plus_one: f64,
+    r2: Vector<S>,
+    r: Vector<S>,
+    dr: Vector<S>,
+    origin: Vector<S>,
+    planes: Triplex<Vector<S>>,
+    i: Vector<S>,
+    running: S::m64s,
+}
+
+impl<S: pulp::Simd> Register<S> {
+    #[inline(always)]
+    fn splat(&self, v: f64) -> Vector<S> {
+        Vector::splat(self.simd, v)
+    }
+
+    #[inline(always)]
+    fn select(&self, mask: S::m64s, new: Vector<S>, old: Vector<S>) -> Vector<S> {
+        Vector(self.simd, self.simd.select_f64s(mask, new.1, old.1))
+    }
+
+    #[inline(always)]
+    fn any(&self, mask: S::m64s) -> bool {
+        self.simd.first_true_m64s(mask) < S::F64_LANES
+    }
+
+    #[inline(always)]
+    fn store(v: Vector<S>) -> [f64; VECTOR] {
+        let mut a = [0.0; VECTOR];
+        S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
+        a
+    }
+
+    #[inline(always)]
+    fn load(simd: S, a: &[f64; VECTOR]) -> Vector<S> {
+        Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
+    }
+
+    /// The orbits of `points` (one register's worth) before iterating.
+    #[inline(always)]
+    fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
+        debug_assert_eq!(points.len(), S::F64_LANES);
+        let z = [0, 1, 2].map(|axis| {
+            let mut a = [0.0; VECTOR];
+            for (a, p) in a.iter_mut().zip(points) {
+                *a = p[axis];
+            }
+            Self::load(simd, &a)
+        });
+        let splat = |v: f64| Vector::splat(simd, v);
+        let (c, plus_one) = match fractal.julia {
+            Some(k) => ([splat(k.x), splat(k.y), splat(k.z)], 0.0),
+            None => (z, 1.0),
+        };
+        let r2 = length_squared(z);
+        let infinity = splat(Real::INFINITY);
+        Register {
+            simd,
+            z,
+            c,
+            plus_one,
+            r2,
+            r: r2.sqrt(),
+            dr: splat(1.0),
+            origin: infinity,
+            planes: [infinity; 3],
+            i: splat(0.0),
+            running: simd.equal_f64s(infinity.1, infinity.1),
+        }
+    }
+
+    /// Stops the lanes past the bailout (`OrbitState::outside`: a NaN
+    /// radius keeps iterating alike); whether any lane still runs.
+    #[inline(always)]
+    fn check(&mut self, fractal: &Fractal) -> bool {
+        let simd = self.simd;
+        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
+        let outside = simd.greater_than_f64s(self.r2.1, bailout2.1);
+        self.running = simd.and_m64s(self.running, simd.not_m64s(outside));
+        self.any(self.running)
+    }
+
+    /// `OrbitState::step` on the running lanes.
+    #[inline(always)]
+    fn step(&mut self, formula: Formula, n: u32) {
+        let simd = self.simd;
+        let (one, infinity) = (self.splat(1.0), self.splat(Real::INFINITY));
+        let (z, running) = (self.z, self.running);
         let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n, one);
         // `triplex_power_int`'s test, lane by lane.
-        let finite = |v: Vector<S>| {
-            let a = simd.abs_f64s(v.1);
-            simd.less_than_f64s(a, infinity.1)
-        };
+        let finite = |v: Vector<S>| simd.less_than_f64s(simd.abs_f64s(v.1), infinity.1);
         let usable = simd.and_m64s(
             simd.and_m64s(
-                simd.greater_than_f64s(rho2.1, (splat(1e-12) * power_r2).1),
+                simd.greater_than_f64s(rho2.1, (self.splat(1e-12) * power_r2).1),
                 finite(power_r2),
             ),
             simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
         );
         let near_axis = simd.and_m64s(running, simd.not_m64s(usable));
-        if any(near_axis) {
-            let flags = store(select(near_axis, one, splat(0.0)));
-            let exact = near_axis_powers(
-                formula,
-                [store(z[0]), store(z[1]), store(z[2])],
-                store(r),
-                n,
-                &flags,
-            );
+        if self.any(near_axis) {
+            let flags = Self::store(self.select(near_axis, one, self.splat(0.0)));
+            let exact =
+                near_axis_powers(formula, z.map(Self::store), Self::store(self.r), n, &flags);
             for axis in 0..3 {
-                let fixed = Vector(simd, S::as_simd_f64s(&exact[axis][..lanes]).0[0]);
-                w[axis] = select(near_axis, fixed, w[axis]);
+                let fixed = Self::load(simd, &exact[axis]);
+                w[axis] = self.select(near_axis, fixed, w[axis]);
             }
         }
-        // `OrbitState::step`'s traps (f64::min: the smaller, never a NaN
-        // over a number), its derivative and its new point.
-        let min = |a: Vector<S>, b: Vector<S>| select(simd.less_than_f64s(b.1, a.1), b, a);
-        origin = select(running, min(origin, r2), origin);
-        for axis in 0..3 {
-            let next = min(planes[axis], Vector(simd, simd.abs_f64s(z[axis].1)));
-            planes[axis] = select(running, next, planes[axis]);
+        // The traps (f64::min: the smaller, never a NaN over a number), the
+        // derivative and the new point.
+        let min = |a: Vector<S>, b: Vector<S>| {
+            Vector(
+                simd,
+                simd.select_f64s(simd.less_than_f64s(b.1, a.1), b.1, a.1),
+            )
+        };
+        self.origin = self.select(running, min(self.origin, self.r2), self.origin);
+        for (plane, z) in self.planes.iter_mut().zip(z) {
+            let next = min(*plane, Vector(simd, simd.abs_f64s(z.1)));
+            *plane = Vector(simd, simd.select_f64s(running, next.1, plane.1));
         }
-        dr = select(
-            running,
-            power * powi(r, n - 1, |a, b| a * b) * dr + plus_one,
-            dr,
-        );
+        let power = self.splat(n as Real);
+        let dr = power * powi(self.r, n - 1, |a, b| a * b) * self.dr + self.splat(self.plus_one);
+        self.dr = self.select(running, dr, self.dr);
+        let c = self.c;
         let next_z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
         let next_r2 = length_squared(next_z);
-        r2 = select(running, next_r2, r2);
-        r = select(running, next_r2.sqrt(), r);
+        self.r2 = self.select(running, next_r2, self.r2);
+        self.r = self.select(running, next_r2.sqrt(), self.r);
         for axis in 0..3 {
-            z[axis] = select(running, next_z[axis], z[axis]);
+            self.z[axis] = self.select(running, next_z[axis], z[axis]);
         }
-        i = select(running, i + one, i);
+        self.i = self.select(running, self.i + one, self.i);
     }
-    let (z, c) = (
-        [store(z[0]), store(z[1]), store(z[2])],
-        [store(c[0]), store(c[1]), store(c[2])],
-    );
-    let planes = [store(planes[0]), store(planes[1]), store(planes[2])];
-    let (r2, r, dr, origin, i) = (store(r2), store(r), store(dr), store(origin), store(i));
-    let mut out = [Orbit::IDLE; VECTOR];
-    for (k, out) in out.iter_mut().enumerate().take(lanes) {
-        *out = OrbitState {
-            z: [z[0][k], z[1][k], z[2][k]],
-            c: [c[0][k], c[1][k], c[2][k]],
-            plus_one: plus_one_value,
-            n: fractal.power,
-            r2: r2[k],
-            r: r[k],
-            dr: dr[k],
-            traps: OrbitTraps {
-                origin: origin[k],
-                planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
-            },
-            i: i[k] as u32,
+
+    /// The finished orbits, into `out` (one per lane).
+    #[inline(always)]
+    fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
+        let [z, c, planes] = [self.z, self.c, self.planes].map(|v| v.map(Self::store));
+        let [r2, r, dr, origin, i] =
+            [self.r2, self.r, self.dr, self.origin, self.i].map(Self::store);
+        for (k, out) in out.iter_mut().enumerate() {
+            *out = OrbitState {
+                z: [z[0][k], z[1][k], z[2][k]],
+                c: [c[0][k], c[1][k], c[2][k]],
+                plus_one: self.plus_one,
+                n: fractal.power,
+                r2: r2[k],
+                r: r[k],
+                dr: dr[k],
+                traps: OrbitTraps {
+                    origin: origin[k],
+                    planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+                },
+                i: i[k] as u32,
+            }
+            .finish(fractal.bailout);
         }
-        .finish(fractal.bailout);
     }
-    out
 }
 
 /// The trigonometric power of the lanes flagged (non-zero) in `which`, as
