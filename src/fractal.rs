@@ -837,13 +837,15 @@ impl<S: pulp::Simd> Register<S> {
     #[inline(always)]
     fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
         debug_assert_eq!(points.len(), S::F64_LANES);
-        let z = [0, 1, 2].map(|axis| {
-            let mut a = [0.0; VECTOR];
-            for (a, p) in a.iter_mut().zip(points) {
-                *a = p[axis];
-            }
-            Self::load(simd, &a)
-        });
+        let mut xyz = [[0.0; VECTOR]; 3];
+        for (k, p) in points.iter().enumerate() {
+            (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
+        }
+        let z = [
+            Self::load(simd, &xyz[0]),
+            Self::load(simd, &xyz[1]),
+            Self::load(simd, &xyz[2]),
+        ];
         let splat = |v: f64| Vector::splat(simd, v);
         let (c, plus_one) = match fractal.julia {
             Some(k) => ([splat(k.x), splat(k.y), splat(k.z)], 0.0),
@@ -933,13 +935,20 @@ impl<S: pulp::Simd> Register<S> {
     /// The finished orbits, into `out` (one per lane).
     #[inline(always)]
     fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
-        let [z, c, planes] = [self.z, self.c, self.planes].map(|v| v.map(Self::store));
-        let [r2, r, dr, origin, i] =
-            [self.r2, self.r, self.dr, self.origin, self.i].map(Self::store);
+        let store = Self::store;
+        let (z0, z1, z2) = (store(self.z[0]), store(self.z[1]), store(self.z[2]));
+        let (c0, c1, c2) = (store(self.c[0]), store(self.c[1]), store(self.c[2]));
+        let (p0, p1, p2) = (
+            store(self.planes[0]),
+            store(self.planes[1]),
+            store(self.planes[2]),
+        );
+        let (r2, r, dr) = (store(self.r2), store(self.r), store(self.dr));
+        let (origin, i) = (store(self.origin), store(self.i));
         for (k, out) in out.iter_mut().enumerate() {
             *out = OrbitState {
-                z: [z[0][k], z[1][k], z[2][k]],
-                c: [c[0][k], c[1][k], c[2][k]],
+                z: [z0[k], z1[k], z2[k]],
+                c: [c0[k], c1[k], c2[k]],
                 plus_one: self.plus_one,
                 n: fractal.power,
                 r2: r2[k],
@@ -947,7 +956,7 @@ impl<S: pulp::Simd> Register<S> {
                 dr: dr[k],
                 traps: OrbitTraps {
                     origin: origin[k],
-                    planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+                    planes: DVec3::new(p0[k], p1[k], p2[k]),
                 },
                 i: i[k] as u32,
             }

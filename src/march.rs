@@ -182,10 +182,14 @@ pub fn walk_many<W: Walk>(
             return;
         }
         // Idle lanes estimate a point outside the bailout ball: no iterations.
-        let idle = (crate::fractal::IDLE_POINT, 1.0);
-        let asked: [(DVec3, Real); LANES] =
-            std::array::from_fn(|k| lanes[k].as_ref().map_or(idle, |(_, w)| w.next_point()));
-        let estimates = fractal.estimate_lanes(asked.map(|a| a.0), asked.map(|a| a.1));
+        let mut points = [crate::fractal::IDLE_POINT; LANES];
+        let mut footprints = [1.0; LANES];
+        for ((lane, point), footprint) in lanes.iter().zip(&mut points).zip(&mut footprints) {
+            if let Some((_, walk)) = lane {
+                (*point, *footprint) = walk.next_point();
+            }
+        }
+        let estimates = fractal.estimate_lanes(points, footprints);
         for (lane, estimate) in lanes.iter_mut().zip(estimates) {
             if let Some((i, walk)) = lane {
                 if let Some(output) = walk.advance(estimate, fractal, settings) {
