@@ -893,7 +893,10 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             100.0 * r.fraction_of_peak
         );
     }
-    for r in rows.iter().filter(|r| r.scene.contains('@')) {
+    for r in rows
+        .iter()
+        .filter(|r| r.scene.contains('@') && r.depth_error_mean_px.is_none())
+    {
         let _ = writeln!(
             md,
             "\nPeak memory, {}: {:.0} MiB against {:.0} MiB of output buffers \

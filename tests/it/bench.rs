@@ -146,6 +146,7 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         .all(|r| !r[col("scene")].contains("depth")
             || !r[col("renderer")].starts_with("mandelbulber2")));
     assert!(md.contains("| mandelreel (fitted) |"), "{md}");
+    assert_eq!(md.matches("Peak memory").count(), 1, "{md}");
 }
 
 #[test]
