@@ -400,10 +400,19 @@ fn render_rows(
                 // Each sample index at a time over the whole row, so the
                 // row's camera rays march side by side (`march_many`); each
                 // pixel still takes its samples in order.
-                let mut rays = Vec::with_capacity(w);
-                let mut marched = vec![MarchResult::default(); w];
-                let mut surfaces = Vec::with_capacity(w);
-                let (mut shadows, mut first_shadow) = (vec![], vec![]);
+                // This thread's buffers, kept from row to row: allocating
+                // and freeing them per row made the allocator hand pages
+                // back and fault them in again, flushing the other cores' TLBs.
+                let mut scratch = ROW_SCRATCH.take();
+                let RowScratch {
+                    rays,
+                    marched,
+                    surfaces,
+                    walks,
+                    shadows,
+                    first_shadow,
+                } = &mut scratch;
+                marched.resize(w, MarchResult::default());
                 for s in first..until {
                     let k = s as usize % scenes.len();
                     let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
@@ -419,10 +428,10 @@ fn render_rows(
                             camera.ray(x as Real + ox, y as Real + oy, width, height)
                         }
                     }));
-                    march_many(&rays, &scene.fractal, &scene.quality, &mut marched);
+                    march_many(rays, &scene.fractal, &scene.quality, marched);
                     // Where each ray met the surface, with what that cost.
                     surfaces.clear();
-                    surfaces.extend(rays.iter().zip(&marched).map(|(ray, result)| {
+                    surfaces.extend(rays.iter().zip(marched.iter()).map(|(ray, result)| {
                         let before = stats.stage_total();
                         let at = surface(scene, ray, result, &mut stats);
                         (at, stats.stage_total() - before)
@@ -431,8 +440,8 @@ fn render_rows(
                     shadows.clear();
                     first_shadow.clear();
                     if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
-                        let mut walks = vec![];
-                        for (at, _) in &surfaces {
+                        walks.clear();
+                        for (at, _) in surfaces.iter() {
                             first_shadow.push(walks.len());
                             if let Some(at) = at {
                                 let look = &scene.look;
@@ -440,13 +449,16 @@ fn render_rows(
                             }
                         }
                         shadows.resize(walks.len(), (1.0, 0));
-                        walk_many(walks, &scene.fractal, &scene.quality, |i, out| {
+                        walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
                             shadows[i] = out
                         });
                     }
                     first_shadow.push(shadows.len());
-                    for (x, ((ray, result), (at, surface_cost))) in
-                        rays.iter().zip(&marched).zip(&surfaces).enumerate()
+                    for (x, ((ray, result), (at, surface_cost))) in rays
+                        .iter()
+                        .zip(marched.iter())
+                        .zip(surfaces.iter())
+                        .enumerate()
                     {
                         let pixel = (y * w + x) as u64;
                         let before = stats.stage_total() - surface_cost;
@@ -504,6 +516,7 @@ fn render_rows(
                         spent_row[x] += stats.stage_total() - before;
                     }
                 }
+                ROW_SCRATCH.set(scratch);
                 stats.de_iterations +=
                     crate::fractal::iterations_on_this_thread() - iterations_before;
                 on_row();
@@ -513,6 +526,21 @@ fn render_rows(
         .reduce(FrameStats::default, |a, b| a + b);
     acc.stats = acc.stats + stats;
     acc.samples_done = until;
+}
+
+/// A row's working buffers (see `render_rows`).
+#[derive(Default)]
+struct RowScratch {
+    rays: Vec<crate::march::Ray>,
+    marched: Vec<MarchResult>,
+    surfaces: Vec<(Option<SurfacePoint>, u64)>,
+    walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
+    shadows: Vec<(f32, u64)>,
+    first_shadow: Vec<usize>,
+}
+
+thread_local! {
+    static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
 }
 
 /// Rows of an optional layer for the parallel zip: `Some(row)` per image row
