@@ -1,7 +1,8 @@
 //! `mandelreel bench`: whole renders timed against Mandelbulber2 on the same
 //! frames, the distance-estimator kernel measured against the machine's
-//! floating-point peak, thread scaling and peak memory; written to
-//! bench/results/<machine>.csv and a Markdown table for the README.
+//! floating-point peak, thread scaling, peak memory and depth error against
+//! the accuracy reference (Mandelbulber2's too, from its z-buffer); written
+//! to `bench/results/<machine>.csv` and a Markdown table for the README.
 //!
 //! Every render runs in its own process, timed from spawn to exit (start-up,
 //! parsing and PNG encoding included: what a user waits for), under a small

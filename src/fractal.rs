@@ -1,7 +1,9 @@
 //! The Mandelbulb itself: the triplex power for each angle convention (whole
 //! powers by complex squaring, without trigonometry), one iteration driver
 //! (bailout, running derivative, orbit traps, Julia mode) generic over f64, f32
-//! and dual numbers, and five distance estimators built on it.
+//! and dual numbers, its vector twin that iterates 16 orbits in SIMD registers
+//! bit-identically (`orbit_lanes`, `estimate_lanes`), and five distance
+//! estimators built on them.
 //!
 //! Sources: the spherical power and the scalar running derivative
 //! `dr ← n·r^(n−1)·dr (+1 in Mandelbrot mode)` with `DE = ½·ln(r)·r/dr`: seeds

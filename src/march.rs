@@ -1,7 +1,9 @@
 //! Sphere tracing of the distance field: where a ray first meets the surface,
 //! with a hit threshold that scales with the pixel footprint (distance × pixel
 //! angle) so a zoom keeps the same detail at every scale, and surface normals
-//! from the distance field.
+//! from the distance field. Marching is a `Walk` (a state machine between
+//! estimates) so that `walk_many` can march 16 rays side by side through the
+//! vector kernel, a new ray taking each lane as soon as its ray ends.
 //!
 //! Method: ../shared/seeds/004 (ray marching with signed distance bounds,
 //! central-difference normals) and 001 (Christensen on the fudge factor).

@@ -1,5 +1,6 @@
 //! Turning a scene into a film: camera rays, the deterministic sampler, rows of
-//! pixels spread over rayon's threads, and per-frame counters.
+//! pixels spread over rayon's threads (a row's camera rays and shadow rays
+//! marched side by side), and per-frame counters.
 //!
 //! Every pixel depends only on (scene, frame, pixel, sample), never on which
 //! thread ran it or in which order, so the image is identical for any thread count.
