@@ -632,6 +632,8 @@ pub fn fit_log_depths(
         .zip(cos)
         .filter_map(|((v, r), c)| Some((v.as_ref()?, r.as_ref()?, c)))
         .map(|(&v, &r, &c)| (v, (r * c).ln()))
+        // A hit at distance 0 (a camera inside the set) has no logarithm.
+        .filter(|(v, l)| v.is_finite() && l.is_finite())
         .collect();
     let n = pairs.len().max(1) as f64;
     let (mx, my) = pairs
@@ -714,7 +716,16 @@ fn depth_rows(
         );
         return Ok(rows);
     }
-    let (zw, zh, values) = read_mandelbulber_zbuffer(&zbuffer)?;
+    let (zw, zh, values) = match read_mandelbulber_zbuffer(&zbuffer) {
+        Ok(read) => read,
+        Err(e) => {
+            log(
+                options.quiet,
+                &format!("depth: {e}; Mandelbulber2's depth row is left out"),
+            );
+            return Ok(rows);
+        }
+    };
     if (zw, zh) != (w, h) {
         log(
             options.quiet,

@@ -10,8 +10,36 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     std::fs::create_dir_all(d.path().join("fract")).unwrap();
     d.write("scenes/tiny.ron", &tiny_timeline(2, 7.0));
     d.write("fract/tiny.fract", "[main_parameters]\n");
-    // Stands in for mandelbulber2: takes its arguments, writes nothing, succeeds.
-    let fake = d.write("fake-mandelbulber", "#!/bin/sh\nsleep 0.05\nexit 0\n");
+    // A z-buffer as Mandelbulber2 writes one (16-bit grey, log-scaled, 65535
+    // where its ray missed), for the depth comparison.
+    let zbuffer = d.path().join("zbuffer.png");
+    {
+        let mut encoder = png::Encoder::new(std::fs::File::create(&zbuffer).unwrap(), 24, 14);
+        encoder.set_color(png::ColorType::Grayscale);
+        encoder.set_depth(png::BitDepth::Sixteen);
+        let words: Vec<u16> = (0..24 * 14)
+            .map(|i| {
+                if i % 5 == 0 {
+                    u16::MAX
+                } else {
+                    (i * 150) as u16
+                }
+            })
+            .collect();
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_be_bytes()).collect();
+        let mut writer = encoder.write_header().unwrap();
+        writer.write_image_data(&bytes).unwrap();
+        writer.finish().unwrap();
+    }
+    // Stands in for mandelbulber2: takes its arguments, sleeps, writes that
+    // z-buffer beside whatever `-o` names, succeeds.
+    let fake = d.write(
+        "fake-mandelbulber",
+        &format!(
+            "#!/bin/sh\nsleep 0.05\nwhile [ $# -gt 0 ]; do\n  if [ \"$1\" = -o ]; then cp {} \"$2_zbuffer.png\"; fi\n  shift\ndone\nexit 0\n",
+            zbuffer.display()
+        ),
+    );
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -110,7 +138,7 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     assert!(num(memory, "peak_rss_mib") > 1.0, "{csv}");
     // The depth row is mandelreel's error against the accuracy reference:
     // the same figures as the accuracy sweep's own "scene" row at that size.
-    // The stand-in writes no z-buffer, so Mandelbulber2 has no depth row.
+    // The stand-in's z-buffer gives Mandelbulber2 a depth row of its own.
     let depth = row("tiny depth@24x14", "mandelreel", "0");
     d.ok(&[
         "accuracy",
@@ -141,10 +169,11 @@ fn bench_writes_results_with_counts_that_match_a_render() {
             "{ours}: {csv}\n{acc}"
         );
     }
-    assert!(rows
-        .iter()
-        .all(|r| !r[col("scene")].contains("depth")
-            || !r[col("renderer")].starts_with("mandelbulber2")));
+    let theirs = row("tiny depth@24x14", "mandelbulber2 (fitted)", "0");
+    let mismatch = num(theirs, "hit_mismatch");
+    assert!((0.0..=1.0).contains(&mismatch), "{csv}");
+    assert!(num(theirs, "depth_error_mean_px") >= 0.0, "{csv}");
+    assert!(md.contains("| mandelbulber2 (fitted) |"), "{md}");
     assert!(md.contains("| mandelreel (fitted) |"), "{md}");
     assert_eq!(md.matches("Peak memory").count(), 1, "{md}");
 }
