@@ -536,6 +536,10 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         rows.push(row);
     }
 
+    // The same frame rendered in this process on pools of each size: the
+    // renderer's own scaling, without start-up and file writing.
+    rows.extend(render_only_rows(first, &timeline, options, base()));
+
     // The kernel alone: analytic estimates at points where marching spends its time.
     rows.push(kernel_row(&timeline, peak, base()));
 
@@ -580,6 +584,82 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         rows.extend(depth_rows(first, options, (w, h), &out, base())?);
     }
     Ok(rows)
+}
+
+/// Frame 0 of `timeline` rendered in this process on a thread pool of each
+/// size in `options.threads`, alternating, medians over `options.runs`.
+fn render_only_rows(
+    scene: &BenchScene,
+    timeline: &Timeline,
+    options: &Options,
+    base: Row,
+) -> Vec<Row> {
+    let frame = timeline.scene_at(0);
+    let (w, h) = (timeline.width, timeline.height);
+    let pools: Vec<(usize, rayon::ThreadPool)> = options
+        .threads
+        .iter()
+        .filter_map(|&t| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .ok()?;
+            Some((t, pool))
+        })
+        .collect();
+    let mut walls: Vec<Vec<f64>> = vec![Vec::new(); pools.len()];
+    let mut counts = FrameStats::default();
+    for run in 0..options.runs {
+        let order: Vec<usize> = if run % 2 == 0 {
+            (0..pools.len()).collect()
+        } else {
+            (0..pools.len()).rev().collect()
+        };
+        for i in order {
+            let start = Instant::now();
+            let film = pools[i]
+                .1
+                .install(|| crate::render::render_frame(&frame, 0, w, h, &|| {}));
+            walls[i].push(start.elapsed().as_secs_f64());
+            counts = film.stats;
+        }
+    }
+    let medians: Vec<f64> = walls.iter().map(|w| median(w.clone())).collect();
+    let one = pools.iter().position(|(t, _)| *t == 1).map(|i| medians[i]);
+    let frames = Work {
+        frames: 1,
+        pixels: w as u64 * h as u64,
+        stats: counts,
+    };
+    pools
+        .iter()
+        .zip(walls)
+        .map(|((threads, _), walls)| {
+            let runs: Vec<Measurement> = walls
+                .iter()
+                .map(|&wall_s| Measurement {
+                    wall_s,
+                    peak_rss_kib: 0,
+                    exit_code: 0,
+                })
+                .collect();
+            let mut row = timing_row(
+                Row {
+                    scene: format!("{} (render only)", scene.name),
+                    renderer: "mandelreel".into(),
+                    threads: *threads,
+                    ..base.clone()
+                },
+                &runs,
+                Some(&frames),
+                &options.peak,
+            );
+            if let Some(one) = one {
+                row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
+            }
+            row
+        })
+        .collect()
 }
 
 /// What Mandelbulber2 writes for a pixel whose ray met nothing.
@@ -857,6 +937,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             && r.scene != "kernel"
             && !r.scene.contains('@')
             && !r.scene.ends_with("(scaling)")
+            && !r.scene.ends_with("(render only)")
     };
     for r in rows.iter().filter(|r| is_scene(r)) {
         let theirs = rows
@@ -879,16 +960,23 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         );
     }
     md.push_str(
-        "\n| threads | median | speed-up over 1 thread | DE iterations/s | share of FMA peak |\n",
+        "\n| threads | median | speed-up over 1 thread | render only (in-process) | DE iterations/s | share of FMA peak |\n",
     );
-    md.push_str("| ---: | ---: | ---: | ---: | ---: |\n");
+    md.push_str("| ---: | ---: | ---: | ---: | ---: | ---: |\n");
     for r in rows.iter().filter(|r| r.scene.ends_with("(scaling)")) {
+        let render_only = rows
+            .iter()
+            .find(|o| o.scene.ends_with("(render only)") && o.threads == r.threads)
+            .map_or("–".into(), |o| {
+                format!("{:.3} s, {:.2}×", o.median_s, o.scaling_vs_one_thread)
+            });
         let _ = writeln!(
             md,
-            "| {} | {:.3} s | {:.2}× | {:.3e} | {:.1}% |",
+            "| {} | {:.3} s | {:.2}× | {} | {:.3e} | {:.1}% |",
             r.threads,
             r.median_s,
             r.scaling_vs_one_thread,
+            render_only,
             r.de_iterations_per_s,
             100.0 * r.fraction_of_peak
         );

@@ -40,24 +40,6 @@ impl Film {
     /// depth, evaluations); the optional layers add to it.
     pub const BYTES_PER_PIXEL: usize =
         std::mem::size_of::<Vec3>() + std::mem::size_of::<f32>() * 2 + std::mem::size_of::<u32>();
-
-    /// Adds the rows of `band` below this film's (layers present in both).
-    fn append(&mut self, band: Film) {
-        fn extend<T>(all: &mut Option<Vec<T>>, part: Option<Vec<T>>) {
-            if let (Some(all), Some(part)) = (all.as_mut(), part) {
-                all.extend(part);
-            }
-        }
-        self.colour.extend(band.colour);
-        self.alpha.extend(band.alpha);
-        self.depth.extend(band.depth);
-        self.evaluations.extend(band.evaluations);
-        extend(&mut self.normal, band.normal);
-        extend(&mut self.albedo, band.albedo);
-        extend(&mut self.traps, band.traps);
-        // `+` keeps the larger per-pixel maximum.
-        self.stats = self.stats + band.stats;
-    }
 }
 
 /// Which extra per-pixel layers to collect. Each is averaged over the
@@ -183,46 +165,74 @@ pub fn render_frame_in_time(
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
     let n = scenes[0].samples_per_pixel.max(1);
-    // In bands of rows, so the running sums (f64 colour and counters, twice
-    // the film's size per pixel) exist for one band at a time, not the frame.
     let pixels = width as usize * height as usize;
+    let layer = |on: bool, value| on.then(|| filled(pixels, value));
     let mut film = Film {
         width,
         height,
-        colour: Vec::with_capacity(pixels),
-        alpha: Vec::with_capacity(pixels),
-        depth: Vec::with_capacity(pixels),
-        evaluations: Vec::with_capacity(pixels),
-        normal: layers.normal.then(|| Vec::with_capacity(pixels)),
-        albedo: layers.albedo.then(|| Vec::with_capacity(pixels)),
-        traps: layers.traps.then(|| Vec::with_capacity(pixels)),
+        colour: filled(pixels, Vec3::ZERO),
+        alpha: filled(pixels, 0.0),
+        depth: filled(pixels, 0.0),
+        evaluations: filled(pixels, 0),
+        normal: layer(layers.normal, Vec3::ZERO),
+        albedo: layer(layers.albedo, Vec3::ZERO),
+        traps: layers.traps.then(|| filled(pixels, [0.0; 4])),
         stats: FrameStats::default(),
     };
-    // Rows render in parallel, each into its own one-row accumulation that
-    // becomes a finished row at once; the rows of a band are appended in
-    // order. Only the band's finished rows exist besides the film, and
-    // threads meet only at the end of a band.
-    let mut first_row = 0;
-    while first_row < height {
-        let rows = BAND_ROWS.min(height - first_row);
-        let band: Vec<Film> = (first_row..first_row + rows)
-            .into_par_iter()
-            .map(|y| {
+    // Every row renders in parallel into its own one-row accumulation (the
+    // running sums, f64 colour and counters, exist for a row at a time, not
+    // the frame) and is finished straight into its place in the film: no
+    // copy of the frame, and no point where threads wait for each other.
+    let w = width as usize;
+    let (normal, albedo, traps) = (
+        film.normal.as_deref_mut().unwrap_or_default(),
+        film.albedo.as_deref_mut().unwrap_or_default(),
+        film.traps.as_deref_mut().unwrap_or_default(),
+    );
+    film.stats = film
+        .colour
+        .par_chunks_mut(w)
+        .zip(film.alpha.par_chunks_mut(w))
+        .zip(film.depth.par_chunks_mut(w))
+        .zip(film.evaluations.par_chunks_mut(w))
+        .zip(optional_rows(normal, w, height))
+        .zip(optional_rows(albedo, w, height))
+        .zip(optional_rows(traps, w, height))
+        .enumerate()
+        .map(
+            |(y, ((((((colour, alpha), depth), evaluations), normal), albedo), traps))| {
                 let mut acc = Accumulation::new(width, 1, layers);
-                render_rows(scenes, frame_index, &mut acc, n, y, height, on_row);
-                acc.finish(n)
-            })
-            .collect();
-        for row in band {
-            film.append(row);
-        }
-        first_row += rows;
-    }
+                render_rows(scenes, frame_index, &mut acc, n, y as u32, height, on_row);
+                let row = acc.finish(n);
+                colour.copy_from_slice(&row.colour);
+                alpha.copy_from_slice(&row.alpha);
+                depth.copy_from_slice(&row.depth);
+                evaluations.copy_from_slice(&row.evaluations);
+                for (to, from) in [(normal, &row.normal), (albedo, &row.albedo)] {
+                    if let (Some(to), Some(from)) = (to, from) {
+                        to.copy_from_slice(from);
+                    }
+                }
+                if let (Some(to), Some(from)) = (traps, &row.traps) {
+                    to.copy_from_slice(from);
+                }
+                row.stats
+            },
+        )
+        // `+` keeps the larger per-pixel maximum.
+        .reduce(FrameStats::default, |a, b| a + b);
     film
 }
 
-/// Rows per band of a frame rendered in one go: many per thread on 16 cores.
-const BAND_ROWS: u32 = 256;
+/// `n` copies of `value`, every one written rather than left to the
+/// allocator's zero pages: a zero page first read and then written is
+/// copied on write, and each copy flushes the TLB of every other core
+/// running the frame.
+fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
+    let mut v = Vec::with_capacity(n);
+    v.resize(n, value);
+    v
+}
 
 /// A frame in progress: per-pixel running sums over the samples done so far,
 /// enough to continue it later. Samples are always added to a pixel in
@@ -245,16 +255,8 @@ pub struct Accumulation {
 }
 
 impl Accumulation {
-    /// Empty sums for `height` rows. Every value is written here rather
-    /// than left to the allocator's zero pages: a zero page first read and
-    /// then written is copied on write, and each copy flushes the TLB of
-    /// every other core running the frame.
+    /// Empty sums for `height` rows (see `filled`).
     pub fn new(width: u32, height: u32, layers: Layers) -> Accumulation {
-        fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
-            let mut v = Vec::with_capacity(n);
-            v.resize(n, value);
-            v
-        }
         let pixels = width as usize * height as usize;
         let layer = |on: bool| if on { pixels } else { 0 };
         Accumulation {
@@ -818,8 +820,8 @@ mod tests {
             traps: true,
         };
         let scenes = std::slice::from_ref(&scene);
-        // Two whole bands of `BAND_ROWS` and part of a third.
-        let (w, h) = (12, 2 * BAND_ROWS + 2);
+        // Enough rows that every thread takes several.
+        let (w, h) = (12, 130);
         let at_once = render_frame_in_time(scenes, 3, w, h, layers, &|| {});
         let mut acc = Accumulation::new(w, h, layers);
         for until in [1, 2, 5, 6] {

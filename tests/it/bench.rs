@@ -123,6 +123,19 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
         "{csv}"
     );
+    // The same frame rendered in-process on pools of 1 and 2 threads.
+    let one = row("tiny (render only)", "mandelreel", "1");
+    let two = row("tiny (render only)", "mandelreel", "2");
+    assert_eq!(num(one, "scaling_vs_one_thread"), 1.0);
+    let expected = num(one, "median_s") / num(two, "median_s");
+    assert!(
+        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
+        "{csv}"
+    );
+    // Frame 0 alone: the same count on either pool, part of the two frames'.
+    assert_eq!(num(one, "de_evaluations"), num(two, "de_evaluations"));
+    assert!(num(two, "de_evaluations") > 0.0);
+    assert!(num(two, "de_evaluations") < num(ours, "de_evaluations"));
     // The kernel row measures a share of the nominal peak, and the memory row
     // a peak RSS against the output buffers (64×36 pixels × 24 bytes: RGB,
     // alpha, depth and the estimate count, 4 bytes each).
