@@ -36,6 +36,24 @@ pub struct Film {
 }
 
 impl Film {
+    /// A film of zeros with the layers asked for (see `filled`).
+    fn blank(width: u32, height: u32, layers: Layers) -> Film {
+        let pixels = width as usize * height as usize;
+        let layer = |on: bool| on.then(|| filled(pixels, Vec3::ZERO));
+        Film {
+            width,
+            height,
+            colour: filled(pixels, Vec3::ZERO),
+            alpha: filled(pixels, 0.0),
+            depth: filled(pixels, 0.0),
+            evaluations: filled(pixels, 0),
+            normal: layer(layers.normal),
+            albedo: layer(layers.albedo),
+            traps: layers.traps.then(|| filled(pixels, [0.0; 4])),
+            stats: FrameStats::default(),
+        }
+    }
+
     /// Bytes per pixel of the buffers every film holds (colour, alpha,
     /// depth, evaluations); the optional layers add to it.
     pub const BYTES_PER_PIXEL: usize =
@@ -49,13 +67,6 @@ pub struct Layers {
     pub normal: bool,
     pub albedo: bool,
     pub traps: bool,
-}
-
-/// What one camera sample met.
-struct SampleResult {
-    colour: Vec3,
-    /// Distance, normal and orbit traps of the hit.
-    hit: Option<(Real, crate::math::DVec3, crate::fractal::OrbitTraps)>,
 }
 
 /// Work counted while rendering one frame.
@@ -165,60 +176,27 @@ pub fn render_frame_in_time(
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
     let n = scenes[0].samples_per_pixel.max(1);
-    let pixels = width as usize * height as usize;
-    let layer = |on: bool, value| on.then(|| filled(pixels, value));
-    let mut film = Film {
-        width,
-        height,
-        colour: filled(pixels, Vec3::ZERO),
-        alpha: filled(pixels, 0.0),
-        depth: filled(pixels, 0.0),
-        evaluations: filled(pixels, 0),
-        normal: layer(layers.normal, Vec3::ZERO),
-        albedo: layer(layers.albedo, Vec3::ZERO),
-        traps: layers.traps.then(|| filled(pixels, [0.0; 4])),
-        stats: FrameStats::default(),
-    };
-    // Every row renders in parallel into its own one-row accumulation (the
+    let mut film = Film::blank(width, height, layers);
+    // Every row renders in parallel into this thread's one-row sums (the
     // running sums, f64 colour and counters, exist for a row at a time, not
     // the frame) and is finished straight into its place in the film: no
-    // copy of the frame, and no point where threads wait for each other.
-    let w = width as usize;
-    let (normal, albedo, traps) = (
-        film.normal.as_deref_mut().unwrap_or_default(),
-        film.albedo.as_deref_mut().unwrap_or_default(),
-        film.traps.as_deref_mut().unwrap_or_default(),
-    );
+    // point where threads wait for each other.
+    let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     film.stats = film
-        .colour
-        .par_chunks_mut(w)
-        .zip(film.alpha.par_chunks_mut(w))
-        .zip(film.depth.par_chunks_mut(w))
-        .zip(film.evaluations.par_chunks_mut(w))
-        .zip(optional_rows(normal, w, height))
-        .zip(optional_rows(albedo, w, height))
-        .zip(optional_rows(traps, w, height))
+        .rows_mut()
         .enumerate()
-        .map(
-            |(y, ((((((colour, alpha), depth), evaluations), normal), albedo), traps))| {
-                let mut acc = Accumulation::new(width, 1, layers);
-                render_rows(scenes, frame_index, &mut acc, n, y as u32, height, on_row);
-                let row = acc.finish(n);
-                colour.copy_from_slice(&row.colour);
-                alpha.copy_from_slice(&row.alpha);
-                depth.copy_from_slice(&row.depth);
-                evaluations.copy_from_slice(&row.evaluations);
-                for (to, from) in [(normal, &row.normal), (albedo, &row.albedo)] {
-                    if let (Some(to), Some(from)) = (to, from) {
-                        to.copy_from_slice(from);
-                    }
-                }
-                if let (Some(to), Some(from)) = (traps, &row.traps) {
-                    to.copy_from_slice(from);
-                }
-                row.stats
-            },
-        )
+        .map(|(y, pixels)| {
+            let mut sums = ROW_SUMS.take();
+            sums.reset(width, 1, layers);
+            let stats = render_row(&frame, y, sums.all_mut());
+            let max_pixel = finish_pixels(&sums, n, pixels);
+            ROW_SUMS.set(sums);
+            FrameStats {
+                de_evaluations: stats.stage_total(),
+                max_pixel_evaluations: max_pixel,
+                ..stats
+            }
+        })
         // `+` keeps the larger per-pixel maximum.
         .reduce(FrameStats::default, |a, b| a + b);
     film
@@ -238,7 +216,7 @@ fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
 /// enough to continue it later. Samples are always added to a pixel in
 /// sample order, so a frame rendered in waves, or resumed from a saved
 /// accumulation, ends bit-identical to one rendered in one go.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Accumulation {
     pub width: u32,
     pub height: u32,
@@ -257,79 +235,185 @@ pub struct Accumulation {
 impl Accumulation {
     /// Empty sums for `height` rows (see `filled`).
     pub fn new(width: u32, height: u32, layers: Layers) -> Accumulation {
+        let mut acc = Accumulation::default();
+        acc.reset(width, height, layers);
+        acc
+    }
+
+    /// Empties the sums for `height` rows of `width`, keeping their memory.
+    fn reset(&mut self, width: u32, height: u32, layers: Layers) {
+        fn refill<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+            v.clear();
+            v.resize(n, value);
+        }
         let pixels = width as usize * height as usize;
         let layer = |on: bool| if on { pixels } else { 0 };
-        Accumulation {
-            width,
-            height,
-            samples_done: 0,
-            colour: filled(pixels, [0.0; 3]),
-            hits: filled(pixels, 0),
-            depth: filled(pixels, BACKGROUND_DEPTH),
-            spent: filled(pixels, 0),
-            normal: filled(layer(layers.normal), Vec3::ZERO),
-            albedo: filled(layer(layers.albedo), Vec3::ZERO),
-            traps: filled(layer(layers.traps), [0.0; 4]),
-            stats: FrameStats::default(),
+        (self.width, self.height, self.samples_done) = (width, height, 0);
+        refill(&mut self.colour, pixels, [0.0; 3]);
+        refill(&mut self.hits, pixels, 0);
+        refill(&mut self.depth, pixels, BACKGROUND_DEPTH);
+        refill(&mut self.spent, pixels, 0);
+        refill(&mut self.normal, layer(layers.normal), Vec3::ZERO);
+        refill(&mut self.albedo, layer(layers.albedo), Vec3::ZERO);
+        refill(&mut self.traps, layer(layers.traps), [0.0; 4]);
+        self.stats = FrameStats::default();
+    }
+
+    /// The layers these sums collect.
+    fn layers(&self) -> Layers {
+        Layers {
+            normal: !self.normal.is_empty(),
+            albedo: !self.albedo.is_empty(),
+            traps: !self.traps.is_empty(),
         }
+    }
+
+    /// All the sums as one run of pixels (for a one-row accumulation, its row).
+    fn all_mut(&mut self) -> RowSums<'_> {
+        RowSums {
+            colour: &mut self.colour,
+            hits: &mut self.hits,
+            depth: &mut self.depth,
+            spent: &mut self.spent,
+            normal: (!self.normal.is_empty()).then_some(&mut self.normal[..]),
+            albedo: (!self.albedo.is_empty()).then_some(&mut self.albedo[..]),
+            traps: (!self.traps.is_empty()).then_some(&mut self.traps[..]),
+        }
+    }
+
+    /// The sums row by row, for rendering rows in parallel.
+    fn rows_mut(&mut self) -> impl IndexedParallelIterator<Item = RowSums<'_>> {
+        let (w, h) = (self.width as usize, self.height);
+        self.colour
+            .par_chunks_mut(w)
+            .zip(self.hits.par_chunks_mut(w))
+            .zip(self.depth.par_chunks_mut(w))
+            .zip(self.spent.par_chunks_mut(w))
+            .zip(optional_rows(&mut self.normal, w, h))
+            .zip(optional_rows(&mut self.albedo, w, h))
+            .zip(optional_rows(&mut self.traps, w, h))
+            .map(
+                |((((((colour, hits), depth), spent), normal), albedo), traps)| RowSums {
+                    colour,
+                    hits,
+                    depth,
+                    spent,
+                    normal,
+                    albedo,
+                    traps,
+                },
+            )
     }
 
     /// The finished film, with `n` samples per pixel.
     pub fn finish(self, n: u32) -> Film {
-        let inv = 1.0 / n as f64;
-        let colour = self
-            .colour
-            .iter()
-            .map(|s| {
-                Vec3::new(
-                    (s[0] * inv) as f32,
-                    (s[1] * inv) as f32,
-                    (s[2] * inv) as f32,
-                )
-            })
-            .collect();
-        let alpha = self.hits.iter().map(|&h| h as f32 / n as f32).collect();
-        // A pixel no sample hit has zero layer sums, which stay zero.
-        let per_hit = |i: usize| 1.0 / self.hits[i].max(1) as f32;
-        let normal = (!self.normal.is_empty())
-            .then(|| self.normal.iter().map(|v| v.normalize_or_zero()).collect());
-        let albedo = (!self.albedo.is_empty()).then(|| {
-            self.albedo
-                .iter()
-                .enumerate()
-                .map(|(i, &v)| v * per_hit(i))
-                .collect()
-        });
-        let traps = (!self.traps.is_empty()).then(|| {
-            self.traps
-                .iter()
-                .enumerate()
-                .map(|(i, v)| v.map(|x| x * per_hit(i)))
-                .collect()
-        });
-        let max_pixel = self.spent.iter().copied().max().unwrap_or(0);
-        let stats = FrameStats {
+        let mut film = Film::blank(self.width, self.height, self.layers());
+        let all = FilmPixels {
+            colour: &mut film.colour,
+            alpha: &mut film.alpha,
+            depth: &mut film.depth,
+            evaluations: &mut film.evaluations,
+            normal: film.normal.as_deref_mut(),
+            albedo: film.albedo.as_deref_mut(),
+            traps: film.traps.as_deref_mut(),
+        };
+        let max_pixel = finish_pixels(&self, n, all);
+        film.stats = FrameStats {
             de_evaluations: self.stats.stage_total(),
             max_pixel_evaluations: max_pixel,
             ..self.stats
         };
-        Film {
-            width: self.width,
-            height: self.height,
-            colour,
-            alpha,
-            depth: self.depth,
-            evaluations: self
-                .spent
-                .iter()
-                .map(|&e| e.min(u32::MAX as u64) as u32)
-                .collect(),
-            normal,
-            albedo,
-            traps,
-            stats,
+        film
+    }
+}
+
+/// One row of an accumulation's sums.
+struct RowSums<'a> {
+    colour: &'a mut [[f64; 3]],
+    hits: &'a mut [u32],
+    depth: &'a mut [f32],
+    spent: &'a mut [u64],
+    normal: Option<&'a mut [Vec3]>,
+    albedo: Option<&'a mut [Vec3]>,
+    traps: Option<&'a mut [[f32; 4]]>,
+}
+
+/// Pixels of a film (a row, or all of them).
+struct FilmPixels<'a> {
+    colour: &'a mut [Vec3],
+    alpha: &'a mut [f32],
+    depth: &'a mut [f32],
+    evaluations: &'a mut [u32],
+    normal: Option<&'a mut [Vec3]>,
+    albedo: Option<&'a mut [Vec3]>,
+    traps: Option<&'a mut [[f32; 4]]>,
+}
+
+impl Film {
+    /// The film row by row, for finishing rows in parallel.
+    fn rows_mut(&mut self) -> impl IndexedParallelIterator<Item = FilmPixels<'_>> {
+        let (w, h) = (self.width as usize, self.height);
+        let normal = self.normal.as_deref_mut().unwrap_or_default();
+        let albedo = self.albedo.as_deref_mut().unwrap_or_default();
+        let traps = self.traps.as_deref_mut().unwrap_or_default();
+        self.colour
+            .par_chunks_mut(w)
+            .zip(self.alpha.par_chunks_mut(w))
+            .zip(self.depth.par_chunks_mut(w))
+            .zip(self.evaluations.par_chunks_mut(w))
+            .zip(optional_rows(normal, w, h))
+            .zip(optional_rows(albedo, w, h))
+            .zip(optional_rows(traps, w, h))
+            .map(
+                |((((((colour, alpha), depth), evaluations), normal), albedo), traps)| FilmPixels {
+                    colour,
+                    alpha,
+                    depth,
+                    evaluations,
+                    normal,
+                    albedo,
+                    traps,
+                },
+            )
+    }
+}
+
+/// Averages the sums of `sums` (all its pixels) over `n` samples into
+/// `out`, pixel for pixel; returns the most estimates one pixel took.
+fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64 {
+    let inv = 1.0 / n as f64;
+    for (c, s) in out.colour.iter_mut().zip(&sums.colour) {
+        *c = Vec3::new(
+            (s[0] * inv) as f32,
+            (s[1] * inv) as f32,
+            (s[2] * inv) as f32,
+        );
+    }
+    for (a, &h) in out.alpha.iter_mut().zip(&sums.hits) {
+        *a = h as f32 / n as f32;
+    }
+    out.depth.copy_from_slice(&sums.depth);
+    for (e, &s) in out.evaluations.iter_mut().zip(&sums.spent) {
+        *e = s.min(u32::MAX as u64) as u32;
+    }
+    // A pixel no sample hit has zero layer sums, which stay zero.
+    let per_hit = |i: usize| 1.0 / sums.hits[i].max(1) as f32;
+    if let Some(normal) = out.normal {
+        for (o, v) in normal.iter_mut().zip(&sums.normal) {
+            *o = v.normalize_or_zero();
         }
     }
+    if let Some(albedo) = out.albedo {
+        for (i, (o, &v)) in albedo.iter_mut().zip(&sums.albedo).enumerate() {
+            *o = v * per_hit(i);
+        }
+    }
+    if let Some(traps) = out.traps {
+        for (i, (o, v)) in traps.iter_mut().zip(&sums.traps).enumerate() {
+            *o = v.map(|x| x * per_hit(i));
+        }
+    }
+    sums.spent.iter().copied().max().unwrap_or(0)
 }
 
 /// Adds samples `acc.samples_done .. until` of every pixel to `acc`.
@@ -340,198 +424,222 @@ pub fn render_samples(
     until: u32,
     on_row: &(dyn Fn() + Sync),
 ) {
-    let height = acc.height;
-    render_rows(scenes, frame_index, acc, until, 0, height, on_row);
-}
-
-/// Adds samples to `acc`, which holds the band of rows starting at image row
-/// `first_row` of an image `image_height` rows high.
-fn render_rows(
-    scenes: &[Scene],
-    frame_index: u32,
-    acc: &mut Accumulation,
-    until: u32,
-    first_row: u32,
-    image_height: u32,
-    on_row: &(dyn Fn() + Sync),
-) {
-    let (width, band_height) = (acc.width, acc.height);
-    let height = image_height;
-    let cameras: Vec<_> = scenes.iter().map(|s| s.camera.frame()).collect();
-    let n = scenes[0].samples_per_pixel.max(1);
-    let first = acc.samples_done;
-    // Fog is measured in camera–target distances, so zooms keep their haze.
-    let scales: Vec<Real> = scenes
-        .iter()
-        .map(|s| (s.camera.position - s.camera.target).length())
-        .collect();
-    let w = width as usize;
-    // An environment map is looked up once per frame, not per ray.
-    let environment = scenes[0]
-        .effects
-        .path_tracing
-        .as_ref()
-        .and_then(|pt| pt.sky.environment());
+    let samples = acc.samples_done..until;
+    let frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
     // One row per task; rayon spreads rows over threads and each pixel depends
     // only on its own samples, so the result is independent of the split.
     let stats = acc
-        .colour
-        .par_chunks_mut(w)
-        .zip(acc.hits.par_chunks_mut(w))
-        .zip(acc.depth.par_chunks_mut(w))
-        .zip(acc.spent.par_chunks_mut(w))
-        .zip(optional_rows(&mut acc.normal, w, band_height))
-        .zip(optional_rows(&mut acc.albedo, w, band_height))
-        .zip(optional_rows(&mut acc.traps, w, band_height))
+        .rows_mut()
         .enumerate()
-        .map(
-            |(
-                y,
-                (
-                    (
-                        ((((colour_row, hits_row), depth_row), spent_row), mut normal_row),
-                        mut albedo_row,
-                    ),
-                    mut traps_row,
-                ),
-            )| {
-                let y = y + first_row as usize;
-                let mut stats = FrameStats::default();
-                // A row runs start to end on one thread, so this thread's
-                // count of orbit iterations measures exactly the row's.
-                let iterations_before = crate::fractal::iterations_on_this_thread();
-                // Each sample index at a time over the whole row, so the
-                // row's camera rays march side by side (`march_many`); each
-                // pixel still takes its samples in order.
-                // This thread's buffers, kept from row to row: allocating
-                // and freeing them per row made the allocator hand pages
-                // back and fault them in again, flushing the other cores' TLBs.
-                let mut scratch = ROW_SCRATCH.take();
-                let RowScratch {
-                    rays,
-                    marched,
-                    surfaces,
-                    walks,
-                    shadows,
-                    first_shadow,
-                } = &mut scratch;
-                marched.resize(w, MarchResult::default());
-                for s in first..until {
-                    let k = s as usize % scenes.len();
-                    let (scene, camera, scale) = (&scenes[k], &cameras[k], scales[k]);
-                    rays.clear();
-                    rays.extend((0..w).map(|x| {
-                        let pixel = (y * w + x) as u64;
-                        let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
-                        if camera.has_lens() {
-                            let u = sample_1d(scene.seed, frame_index, pixel, s, 2);
-                            let v = sample_1d(scene.seed, frame_index, pixel, s, 3);
-                            camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
-                        } else {
-                            camera.ray(x as Real + ox, y as Real + oy, width, height)
-                        }
-                    }));
-                    march_many(rays, &scene.fractal, &scene.quality, marched);
-                    // Where each ray met the surface, with what that cost.
-                    surfaces.clear();
-                    surfaces.extend(rays.iter().zip(marched.iter()).map(|(ray, result)| {
-                        let before = stats.stage_total();
-                        let at = surface(scene, ray, result, &mut stats);
-                        (at, stats.stage_total() - before)
-                    }));
-                    // The row's shadow rays, walked side by side.
-                    shadows.clear();
-                    first_shadow.clear();
-                    if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
-                        walks.clear();
-                        for (at, _) in surfaces.iter() {
-                            first_shadow.push(walks.len());
-                            if let Some(at) = at {
-                                let look = &scene.look;
-                                walks.extend(look.shadow_walks(&scene.effects, &scene.quality, at));
-                            }
-                        }
-                        shadows.resize(walks.len(), (1.0, 0));
-                        walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
-                            shadows[i] = out
-                        });
-                    }
-                    first_shadow.push(shadows.len());
-                    for (x, ((ray, result), (at, surface_cost))) in rays
-                        .iter()
-                        .zip(marched.iter())
-                        .zip(surfaces.iter())
-                        .enumerate()
-                    {
-                        let pixel = (y * w + x) as u64;
-                        let before = stats.stage_total() - surface_cost;
-                        let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
-                        let mut outcomes = first_shadow
-                            .get(x..x + 2)
-                            .map_or(&[][..], |range| &shadows[range[0]..range[1]])
-                            .iter()
-                            .copied();
-                        let sample = trace(
-                            scene,
-                            ray,
-                            result,
-                            at.as_ref(),
-                            &mut |_| outcomes.next().expect("one outcome per shadow ray"),
-                            camera.up,
-                            scale,
-                            environment.as_deref(),
-                            &random,
-                            &mut stats,
-                        );
-                        let c = sample.colour;
-                        if let Some((t, nrm, traps)) = sample.hit {
-                            hits_row[x] += 1;
-                            stats.hits += 1;
-                            depth_row[x] = depth_row[x].min(t as f32);
-                            if let Some(row) = normal_row.as_deref_mut() {
-                                row[x] += nrm.as_vec3();
-                            }
-                            // Only a requested albedo layer pays for the albedo.
-                            if let Some(row) = albedo_row.as_deref_mut() {
-                                row[x] += scene.look.albedo(&traps);
-                            }
-                            if let Some(row) = traps_row.as_deref_mut() {
-                                let v = [
-                                    traps.origin as f32,
-                                    traps.planes.x as f32,
-                                    traps.planes.y as f32,
-                                    traps.planes.z as f32,
-                                ];
-                                for k in 0..4 {
-                                    row[x][k] += v[k];
-                                }
-                            }
-                        }
-                        debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
-                        if !c.is_finite() {
-                            stats.repaired_samples += 1;
-                        }
-                        let c = finite_or_zero(c);
-                        colour_row[x][0] += c.x as f64;
-                        colour_row[x][1] += c.y as f64;
-                        colour_row[x][2] += c.z as f64;
-                        stats.samples += 1;
-                        spent_row[x] += stats.stage_total() - before;
-                    }
-                }
-                ROW_SCRATCH.set(scratch);
-                stats.de_iterations +=
-                    crate::fractal::iterations_on_this_thread() - iterations_before;
-                on_row();
-                stats
-            },
-        )
+        .map(|(y, sums)| render_row(&frame, y, sums))
         .reduce(FrameStats::default, |a, b| a + b);
     acc.stats = acc.stats + stats;
     acc.samples_done = until;
 }
 
-/// A row's working buffers (see `render_rows`).
+/// What every row of one frame's rendering shares, worked out once.
+struct FrameSetup<'a> {
+    scenes: &'a [Scene],
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    /// Samples per pixel, and the ones to take now.
+    n: u32,
+    samples: std::ops::Range<u32>,
+    cameras: Vec<crate::scene::CameraFrame>,
+    /// Fog is measured in camera–target distances, so zooms keep their haze.
+    scales: Vec<Real>,
+    /// An environment map is looked up once per frame, not per ray.
+    environment: Option<std::sync::Arc<crate::environment::EnvironmentMap>>,
+    on_row: &'a (dyn Fn() + Sync),
+}
+
+impl<'a> FrameSetup<'a> {
+    fn new(
+        scenes: &'a [Scene],
+        frame_index: u32,
+        width: u32,
+        height: u32,
+        samples: std::ops::Range<u32>,
+        on_row: &'a (dyn Fn() + Sync),
+    ) -> Self {
+        FrameSetup {
+            scenes,
+            frame_index,
+            width,
+            height,
+            n: scenes[0].samples_per_pixel.max(1),
+            samples,
+            cameras: scenes.iter().map(|s| s.camera.frame()).collect(),
+            scales: scenes
+                .iter()
+                .map(|s| (s.camera.position - s.camera.target).length())
+                .collect(),
+            environment: scenes[0]
+                .effects
+                .path_tracing
+                .as_ref()
+                .and_then(|pt| pt.sky.environment()),
+            on_row,
+        }
+    }
+}
+
+/// Adds `frame.samples` of every pixel of image row `y` to `sums`.
+fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
+    let FrameSetup {
+        scenes,
+        frame_index,
+        width,
+        height,
+        n,
+        ..
+    } = *frame;
+    let w = width as usize;
+    let RowSums {
+        colour: colour_row,
+        hits: hits_row,
+        depth: depth_row,
+        spent: spent_row,
+        normal: mut normal_row,
+        albedo: mut albedo_row,
+        traps: mut traps_row,
+    } = sums;
+    let mut stats = FrameStats::default();
+    // A row runs start to end on one thread, so this thread's
+    // count of orbit iterations measures exactly the row's.
+    let iterations_before = crate::fractal::iterations_on_this_thread();
+    // Each sample index at a time over the whole row, so the
+    // row's camera rays march side by side (`march_many`); each
+    // pixel still takes its samples in order.
+    // This thread's buffers, kept from row to row: allocating
+    // and freeing them per row made the allocator hand pages
+    // back and fault them in again, flushing the other cores' TLBs.
+    let mut scratch = ROW_SCRATCH.take();
+    let RowScratch {
+        rays,
+        marched,
+        surfaces,
+        walks,
+        shadows,
+        first_shadow,
+    } = &mut scratch;
+    marched.resize(w, MarchResult::default());
+    for s in frame.samples.clone() {
+        let k = s as usize % scenes.len();
+        let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
+        rays.clear();
+        rays.extend((0..w).map(|x| {
+            let pixel = (y * w + x) as u64;
+            let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
+            if camera.has_lens() {
+                let u = sample_1d(scene.seed, frame_index, pixel, s, 2);
+                let v = sample_1d(scene.seed, frame_index, pixel, s, 3);
+                camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
+            } else {
+                camera.ray(x as Real + ox, y as Real + oy, width, height)
+            }
+        }));
+        march_many(rays, &scene.fractal, &scene.quality, marched);
+        // Where each ray met the surface, with what that cost.
+        surfaces.clear();
+        surfaces.extend(rays.iter().zip(marched.iter()).map(|(ray, result)| {
+            let before = stats.stage_total();
+            let at = surface(scene, ray, result, &mut stats);
+            (at, stats.stage_total() - before)
+        }));
+        // The row's shadow rays, walked side by side.
+        shadows.clear();
+        first_shadow.clear();
+        if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
+            walks.clear();
+            for (at, _) in surfaces.iter() {
+                first_shadow.push(walks.len());
+                if let Some(at) = at {
+                    let look = &scene.look;
+                    walks.extend(look.shadow_walks(&scene.effects, &scene.quality, at));
+                }
+            }
+            shadows.resize(walks.len(), (1.0, 0));
+            walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
+                shadows[i] = out
+            });
+        }
+        first_shadow.push(shadows.len());
+        for (x, ((ray, result), (at, surface_cost))) in rays
+            .iter()
+            .zip(marched.iter())
+            .zip(surfaces.iter())
+            .enumerate()
+        {
+            let pixel = (y * w + x) as u64;
+            let before = stats.stage_total();
+            let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
+            let mut outcomes = first_shadow
+                .get(x..x + 2)
+                .map_or(&[][..], |range| &shadows[range[0]..range[1]])
+                .iter()
+                .copied();
+            let c = trace(
+                scene,
+                ray,
+                result,
+                at.as_ref(),
+                &mut outcomes,
+                camera.up,
+                scale,
+                frame.environment.as_deref(),
+                &random,
+                &mut stats,
+            );
+            if let Some(&SurfacePoint {
+                t,
+                normal: nrm,
+                traps,
+                ..
+            }) = at.as_ref()
+            {
+                hits_row[x] += 1;
+                stats.hits += 1;
+                depth_row[x] = depth_row[x].min(t as f32);
+                if let Some(row) = normal_row.as_deref_mut() {
+                    row[x] += nrm.as_vec3();
+                }
+                // Only a requested albedo layer pays for the albedo.
+                if let Some(row) = albedo_row.as_deref_mut() {
+                    row[x] += scene.look.albedo(&traps);
+                }
+                if let Some(row) = traps_row.as_deref_mut() {
+                    let v = [
+                        traps.origin as f32,
+                        traps.planes.x as f32,
+                        traps.planes.y as f32,
+                        traps.planes.z as f32,
+                    ];
+                    for k in 0..4 {
+                        row[x][k] += v[k];
+                    }
+                }
+            }
+            debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
+            if !c.is_finite() {
+                stats.repaired_samples += 1;
+            }
+            let c = finite_or_zero(c);
+            colour_row[x][0] += c.x as f64;
+            colour_row[x][1] += c.y as f64;
+            colour_row[x][2] += c.z as f64;
+            stats.samples += 1;
+            spent_row[x] += surface_cost + stats.stage_total() - before;
+        }
+    }
+    ROW_SCRATCH.set(scratch);
+    stats.de_iterations += crate::fractal::iterations_on_this_thread() - iterations_before;
+    (frame.on_row)();
+    stats
+}
+
+/// A row's working buffers (see `render_row`).
 #[derive(Default)]
 struct RowScratch {
     rays: Vec<crate::march::Ray>,
@@ -544,6 +652,8 @@ struct RowScratch {
 
 thread_local! {
     static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
+    /// One row's sums for `render_frame_in_time`, kept like `ROW_SCRATCH`.
+    static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
 }
 
 /// Rows of an optional layer for the parallel zip: `Some(row)` per image row
@@ -584,8 +694,8 @@ fn surface(
     })
 }
 
-/// One camera sample: its radiance and, if it met the surface (`at`), the
-/// distance. Shadow rays' outcomes come from `shadow_of` (see
+/// The radiance of one camera sample, which met the surface at `at` or
+/// nothing. Shadow rays' outcomes come from `shadows` (see
 /// `Look::shade_with`). Only the stages of the scene's enabled effects run;
 /// `stats` counts each.
 #[allow(clippy::too_many_arguments)]
@@ -594,13 +704,13 @@ fn trace(
     ray: &crate::march::Ray,
     result: &MarchResult,
     at: Option<&SurfacePoint>,
-    shadow_of: &mut dyn FnMut(crate::math::DVec3) -> (f32, u64),
+    shadows: &mut dyn Iterator<Item = (f32, u64)>,
     up: crate::math::DVec3,
     scale: Real,
     environment: Option<&crate::environment::EnvironmentMap>,
     random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
-) -> SampleResult {
+) -> Vec3 {
     let Some(at) = at else {
         let sky = match &scene.effects.path_tracing {
             Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
@@ -610,7 +720,7 @@ fn trace(
             Some(g) => sky + glow(g, result.closest),
             None => sky,
         };
-        return SampleResult { colour, hit: None };
+        return colour;
     };
     let mut stages = StageCounts::default();
     let lit = match &scene.effects.path_tracing {
@@ -627,19 +737,15 @@ fn trace(
         ),
         None => scene
             .look
-            .shade_with(&scene.effects, &scene.fractal, at, &mut stages, shadow_of),
+            .shade_with(&scene.effects, &scene.fractal, at, &mut stages, shadows),
     };
     stats.shadow_evaluations += stages.shadows;
     stats.occlusion_evaluations += stages.occlusion;
     stats.bounce_evaluations += stages.bounces;
     stats.sun_evaluations += stages.sun_rays;
-    let colour = match &scene.effects.fog {
+    match &scene.effects.fog {
         Some(fog) => fogged(lit, fog, at.t, scale),
         None => lit,
-    };
-    SampleResult {
-        colour,
-        hit: Some((at.t, at.normal, at.traps)),
     }
 }
 

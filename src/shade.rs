@@ -494,23 +494,10 @@ impl Look {
         at: &SurfacePoint,
         counts: &mut StageCounts,
     ) -> Vec3 {
-        self.shade_with(
-            effects,
-            fractal,
-            at,
-            counts,
-            &mut |to_light| match &effects.shadows {
-                Some(sh) => shadow(
-                    fractal,
-                    settings,
-                    sh,
-                    shadow_origin(at),
-                    to_light,
-                    at.footprint,
-                ),
-                None => (1.0, 0),
-            },
-        )
+        let mut shadows = self
+            .shadow_walks(effects, settings, at)
+            .map(|walk| crate::march::walk_one(walk, fractal, settings));
+        self.shade_with(effects, fractal, at, counts, &mut shadows)
     }
 
     /// The lights that face the surface at `at`: (direction towards the
@@ -538,15 +525,15 @@ impl Look {
     }
 
     /// `shade` with the shadow rays' outcomes (factor, estimates spent)
-    /// given by `shadow_of(direction to the light)`, asked only with shadows
-    /// on, for the lights `shadow_walks` lists, in its order.
+    /// taken from `shadows`, one per ray `shadow_walks` lists, in its order
+    /// (asked only with shadows on).
     pub fn shade_with(
         &self,
         effects: &Effects,
         fractal: &Fractal,
         at: &SurfacePoint,
         counts: &mut StageCounts,
-        shadow_of: &mut dyn FnMut(DVec3) -> (f32, u64),
+        shadows: &mut dyn Iterator<Item = (f32, u64)>,
     ) -> Vec3 {
         let mut ambient = 1.0f32;
         if let Some(ao) = &effects.ambient_occlusion {
@@ -559,7 +546,7 @@ impl Look {
         for (to_light, brightness, lambert) in self.facing(at) {
             let mut light = 1.0f32;
             if effects.shadows.is_some() {
-                let (f, spent) = shadow_of(to_light);
+                let (f, spent) = shadows.next().expect("an outcome per shadow ray");
                 light = f;
                 counts.shadows += spent;
             }
@@ -913,12 +900,13 @@ mod tests {
         for at in &points {
             let (mut one, mut many) = (StageCounts::default(), StageCounts::default());
             let alone = look.shade(&effects, &fractal, &settings, at, &mut one);
-            let batched = look.shade_with(&effects, &fractal, at, &mut many, &mut |_| {
+            let mut next = std::iter::from_fn(|| {
                 let out = outcomes.next().expect("an outcome per walk");
                 shaded += (out.0 < 1.0) as u32;
                 partly += (out.0 > 0.0 && out.0 < 1.0) as u32;
-                out
+                Some(out)
             });
+            let batched = look.shade_with(&effects, &fractal, at, &mut many, &mut next);
             assert_eq!(
                 alone.to_array().map(f32::to_bits),
                 batched.to_array().map(f32::to_bits)
