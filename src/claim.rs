@@ -330,11 +330,17 @@ mod tests {
         let Attempt::Claimed(ours) = first else {
             panic!("a claim two minutes old is taken over");
         };
-        // A second worker that also saw the dead claim loses the takeover.
+        // A second worker that read the dead claim before ours replaced it
+        // (put back here, to be what it sees) loses the takeover: our marker
+        // for that dead claim stands, and it is told the frame is held.
+        let ours_record = read_claim(&claim_path(dir.path(), 7)).unwrap();
+        let dead = write_dead_claim(dir.path(), 7);
+        assert!(takeover_path(dir.path(), 7, &dead.token).exists());
         assert!(matches!(
             try_claim(dir.path(), 7, timeout).unwrap(),
-            Attempt::Held(_)
+            Attempt::Held(held) if held == dead
         ));
+        write_record(&claim_path(dir.path(), 7), &ours_record).unwrap();
         let now = read_claim(&claim_path(dir.path(), 7)).unwrap();
         assert_eq!(now.pid, std::process::id());
         drop(ours);

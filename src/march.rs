@@ -8,7 +8,7 @@
 //! Method: ../shared/seeds/004 (ray marching with signed distance bounds,
 //! central-difference normals) and 001 (Christensen on the fudge factor).
 
-use crate::fractal::{Estimate, Fractal, TETRAHEDRON};
+use crate::fractal::{Estimate, Fractal, TETRAHEDRON, VECTOR};
 use crate::math::{normalize_or, sphere_interval, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
@@ -59,6 +59,12 @@ pub struct Ray {
 }
 
 impl Ray {
+    /// The point at distance `t` along the ray.
+    #[inline]
+    pub fn at(&self, t: Real) -> DVec3 {
+        self.origin + self.dir * t
+    }
+
     /// Width of one pixel's cone at distance `t` along the ray.
     #[inline]
     pub fn footprint(&self, t: Real) -> Real {
@@ -155,7 +161,7 @@ pub fn walk_one<W: Walk>(
     }
 }
 
-/// Drives many walks, `LANES` at a time: each step's estimates are taken
+/// Drives many walks, `VECTOR` at a time (one call of the lane kernel): each step's estimates are taken
 /// side by side through `Fractal::estimate_lanes`, and a lane whose walk
 /// ends takes the next walk at once, so the lanes stay full. Each walk's
 /// output, bit-identical to `walk_one`'s, goes to `done` with its index
@@ -167,7 +173,7 @@ pub fn walk_many<W: Walk>(
     mut done: impl FnMut(usize, W::Output),
 ) {
     let mut walks = walks.into_iter().enumerate();
-    let mut lanes: [Option<(usize, W)>; LANES] = [None; LANES];
+    let mut lanes: [Option<(usize, W)>; VECTOR] = [None; VECTOR];
     loop {
         for lane in lanes.iter_mut().filter(|lane| lane.is_none()) {
             for (i, walk) in walks.by_ref() {
@@ -184,8 +190,8 @@ pub fn walk_many<W: Walk>(
             return;
         }
         // Idle lanes estimate a point outside the bailout ball: no iterations.
-        let mut points = [crate::fractal::IDLE_POINT; LANES];
-        let mut footprints = [1.0; LANES];
+        let mut points = [crate::fractal::IDLE_POINT; VECTOR];
+        let mut footprints = [1.0; VECTOR];
         for ((lane, point), footprint) in lanes.iter().zip(&mut points).zip(&mut footprints) {
             if let Some((_, walk)) = lane {
                 (*point, *footprint) = walk.next_point();
@@ -202,9 +208,6 @@ pub fn walk_many<W: Walk>(
         }
     }
 }
-
-/// Walks `walk_many` takes side by side: one vector of the lane kernel.
-pub const LANES: usize = crate::fractal::VECTOR;
 
 /// One ray's march between estimates: where to estimate next, and what to
 /// do with the estimate. `march` and `march_many` both drive it, so the
@@ -246,15 +249,18 @@ impl Marcher {
         })
     }
 
-    fn at(&self, t: Real) -> DVec3 {
-        self.ray.origin + self.ray.dir * t
+    /// Replaces the last over-relaxed step by the plain one and stops
+    /// over-relaxing.
+    fn take_back(&mut self) {
+        self.t += self.previous_distance - self.previous_step;
+        self.omega = 1.0;
     }
 
     fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
         MarchResult {
             hit: Some(Hit {
                 t,
-                point: self.at(t),
+                point: self.ray.at(t),
                 estimate,
             }),
             evaluations: self.evaluations,
@@ -267,7 +273,7 @@ impl Walk for Marcher {
     type Output = MarchResult;
 
     fn next_point(&self) -> (DVec3, Real) {
-        (self.at(self.t), self.ray.footprint(self.t))
+        (self.ray.at(self.t), self.ray.footprint(self.t))
     }
 
     fn advance(
@@ -295,14 +301,13 @@ impl Walk for Marcher {
             // The spheres of free space around this point and the last one do
             // not overlap: the long step may have jumped over surface. Go from
             // the last point by the plain step instead, without relaxation.
-            self.t += self.previous_distance - self.previous_step;
-            self.omega = 1.0;
+            self.take_back();
             return None;
         }
         if !estimate.escaped {
             if let Some((t_out, estimate_out)) = self.outside {
                 // Overshot: bisect [outside, t (inside)] down to the threshold.
-                let at = |t: Real| ray.origin + ray.dir * t;
+                let at = |t: Real| ray.at(t);
                 let (lo, tests) = bisect_membership(fractal, &at, t_out, t, |lo| {
                     settings.hit_threshold * ray.footprint(lo)
                 });
@@ -329,8 +334,7 @@ impl Walk for Marcher {
         self.previous_step = step * self.omega;
         self.t += self.previous_step;
         if self.t > self.t_exit && self.previous_step > self.previous_distance {
-            self.t += self.previous_distance - self.previous_step;
-            self.omega = 1.0;
+            self.take_back();
         }
         if self.t > self.t_exit {
             return Some(MarchResult {
@@ -361,7 +365,7 @@ pub fn march_by_membership(
     else {
         return (None, 0);
     };
-    let at = |t: Real| ray.origin + ray.dir * t;
+    let at = |t: Real| ray.at(t);
     let mut tests = 1;
     if fractal.contains(at(t_enter)) {
         return (Some(t_enter), tests);

@@ -1,5 +1,6 @@
-//! Plain data for one frame: camera, fractal, marcher quality and look. A
-//! timeline produces one `Scene` per frame; the renderer consumes it. Its serde
+//! Plain data for one instant of a frame: camera, fractal, marcher quality,
+//! look and effects. A timeline produces one `Scene` per frame (one per
+//! sample under motion blur); the renderer consumes it. Its serde
 //! form is also the timeline's `scene:` block, and its JSON serialisation is
 //! what each frame's content hash is taken over.
 
@@ -8,7 +9,7 @@ use crate::march::{MarchSettings, Ray};
 use crate::math::{normalize_or, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
-/// A pinhole camera.
+/// A camera: a pinhole, or a thin lens when its aperture is open.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct Camera {

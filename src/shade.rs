@@ -635,8 +635,9 @@ impl Sky {
         }
     }
 
-    /// The loaded map of an `Environment` sky (loaded and checked when the
-    /// timeline was read, so it is in the cache).
+    /// The loaded map of an `Environment` sky. A timeline loads and checks
+    /// it when read, so it is in the cache; for a scene built otherwise a
+    /// map that fails to load gives `None`, a black sky.
     pub fn environment(&self) -> Option<std::sync::Arc<crate::environment::EnvironmentMap>> {
         match self {
             Sky::Environment { path, digest, .. } => crate::environment::cached(path, digest).ok(),
