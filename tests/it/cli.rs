@@ -72,37 +72,16 @@ fn same_frame_is_byte_identical_with_one_or_two_threads() {
             .replace("position: (0, 0.5, 3.0)", "position: (0, 0.5, 3.0), aperture_radius: 0.05")
             .replace("size: (48, 27)", "size: (160, 96)"),
     );
-    d.ok(&[
-        "render",
+    d.same_on_one_and_two_threads(
         "t.ron",
-        "--threads",
-        "1",
-        "--out",
-        "one",
-        "--format",
-        "png,exr",
-    ]);
-    d.ok(&[
-        "render",
-        "t.ron",
-        "--threads",
-        "2",
-        "--out",
-        "two",
-        "--format",
-        "png,exr",
-    ]);
-    for f in [
-        "frame_00000.png",
-        "frame_00001.png",
-        "frame_00000.exr",
-        "frame_00001.exr",
-    ] {
-        assert!(
-            d.bytes(&format!("one/{f}")) == d.bytes(&format!("two/{f}")),
-            "frame {f} differs"
-        );
-    }
+        &["--format", "png,exr"],
+        &[
+            "frame_00000.png",
+            "frame_00001.png",
+            "frame_00000.exr",
+            "frame_00001.exr",
+        ],
+    );
 }
 
 #[test]
@@ -115,27 +94,7 @@ fn path_traced_frame_is_byte_identical_with_one_or_two_threads() {
             "fractal: (iterations: 8), samples_per_pixel: 4, effects: (path_tracing: (max_bounces: 4))",
         ),
     );
-    d.ok(&[
-        "render",
-        "t.ron",
-        "--threads",
-        "1",
-        "--out",
-        "one",
-        "--format",
-        "exr",
-    ]);
-    d.ok(&[
-        "render",
-        "t.ron",
-        "--threads",
-        "2",
-        "--out",
-        "two",
-        "--format",
-        "exr",
-    ]);
-    assert!(d.bytes("one/frame_00000.exr") == d.bytes("two/frame_00000.exr"));
+    d.same_on_one_and_two_threads("t.ron", &["--format", "exr"], &["frame_00000.exr"]);
     // And it is a different picture from the direct-lit one.
     d.write("plain.ron", &tiny_timeline(1, 8.0));
     d.ok(&["render", "plain.ron", "--out", "plain", "--format", "exr"]);

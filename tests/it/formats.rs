@@ -91,4 +91,9 @@ fn extra_layers_are_written_only_when_asked() {
     // Asking for layers is part of what made the frame: a re-render without them re-renders.
     let out = d.ok(&["render", "t.ron", "--format", "exr"]);
     assert!(!crate::util::stderr(&out).contains("already complete"));
+    // … and without them the file holds only the standard channels.
+    assert_eq!(
+        d.exr("out/t/frame_00000.exr").names(),
+        ["A", "B", "G", "R", "Z"]
+    );
 }

@@ -187,8 +187,8 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
         );
     d.write("t.ron", &text);
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
-    let mut child = d
-        .command(&[
+    let mut child = d.spawn_until(
+        &[
             "render",
             "t.ron",
             "--checkpoint-seconds",
@@ -196,21 +196,10 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
             "--threads",
             "1",
             "--quiet",
-        ])
-        .spawn()
-        .unwrap();
-    let start = Instant::now();
-    while !d.files("out/t").iter().any(|f| f.ends_with(".ckpt")) {
-        assert!(
-            start.elapsed() < Duration::from_secs(120),
-            "no checkpoint appeared"
-        );
-        assert!(
-            child.try_wait().unwrap().is_none(),
-            "finished before a checkpoint"
-        );
-        std::thread::sleep(Duration::from_millis(2));
-    }
+        ],
+        "out/t",
+        ".ckpt",
+    );
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(

@@ -74,6 +74,42 @@ impl Dir {
         v
     }
 
+    /// Renders `timeline` with 1 and with 2 threads (into `one` and `two`,
+    /// with `extra` arguments) and asserts each of `files` came out
+    /// byte-identical.
+    pub fn same_on_one_and_two_threads(&self, timeline: &str, extra: &[&str], files: &[&str]) {
+        for (threads, out) in [("1", "one"), ("2", "two")] {
+            let mut args = vec!["render", timeline, "--threads", threads, "--out", out];
+            args.extend_from_slice(extra);
+            self.ok(&args);
+        }
+        for f in files {
+            assert!(
+                self.bytes(&format!("one/{f}")) == self.bytes(&format!("two/{f}")),
+                "{f} differs between 1 and 2 threads"
+            );
+        }
+    }
+
+    /// Starts the binary and waits until a file in `sub` ends with
+    /// `suffix`, asserting that it is still running then; returns it running.
+    pub fn spawn_until(&self, args: &[&str], sub: &str, suffix: &str) -> std::process::Child {
+        let mut child = self.command(args).spawn().expect("start mandelreel");
+        let start = std::time::Instant::now();
+        while !self.files(sub).iter().any(|f| f.ends_with(suffix)) {
+            assert!(
+                start.elapsed() < std::time::Duration::from_secs(120),
+                "no {suffix} file appeared in {sub}"
+            );
+            assert!(
+                child.try_wait().unwrap().is_none(),
+                "finished before a {suffix} file appeared"
+            );
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        child
+    }
+
     pub fn bytes(&self, rel: &str) -> Vec<u8> {
         std::fs::read(self.path().join(rel)).unwrap_or_else(|e| panic!("read {rel}: {e}"))
     }
