@@ -381,16 +381,10 @@ pub fn measure(
 
     // The same depths at twice the step: how far the reference itself has settled.
     let (coarse, _) = reference_depths(reference, width, height, 2.0 * REFERENCE_STEP);
-    let settled = compare(
-        &coarse,
-        &reference_image,
-        &reference_image,
-        &reference_depth,
-        &footprint_at_reference,
-    );
+    let settled = depth_errors(&coarse, &reference_depth, &footprint_at_reference);
     let convergence = Convergence {
-        depth_change_mean_px: settled.depth.mean_px,
-        hit_change: settled.depth.hit_mismatch,
+        depth_change_mean_px: settled.mean_px,
+        hit_change: settled.hit_mismatch,
     };
 
     let measurement = |variant: &Variant, seconds: f64, evaluations: u64, e: Errors| Measurement {

@@ -419,6 +419,8 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         ),
     );
 
+    // Each timeline is loaded and its work counted once.
+    let mut loaded = Vec::new();
     for scene in &scenes {
         let timeline = Timeline::load(&scene.timeline)?;
         let work = count_work(&timeline, (timeline.width, timeline.height));
@@ -489,12 +491,12 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         } else {
             rows.push(ours_row);
         }
+        loaded.push((timeline, work));
     }
 
     // Thread scaling on the first scene, counts alternating low/high.
     let first = &scenes[0];
-    let timeline = Timeline::load(&first.timeline)?;
-    let work = count_work(&timeline, (timeline.width, timeline.height));
+    let (timeline, work) = loaded.swap_remove(0);
     let mut by_threads: Vec<(usize, Vec<Measurement>)> =
         options.threads.iter().map(|&t| (t, Vec::new())).collect();
     for run in 0..options.runs {
@@ -581,7 +583,7 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         );
         let out = scratch.path().join("depth");
         std::fs::create_dir_all(&out).map_err(|e| Error::io(&out, e))?;
-        rows.extend(depth_rows(first, options, (w, h), &out, base())?);
+        rows.extend(depth_rows(first, &timeline, options, (w, h), &out, base())?);
     }
     Ok(rows)
 }
@@ -742,13 +744,13 @@ pub fn fit_log_depths(
 /// reference of the accuracy sweep.
 fn depth_rows(
     scene: &BenchScene,
+    timeline: &Timeline,
     options: &Options,
     (w, h): (u32, u32),
     out: &Path,
     base: Row,
 ) -> Result<Vec<Row>> {
     use crate::accuracy::{depth_errors, film_hits, footprints_at, reference_depths};
-    let timeline = Timeline::load(&scene.timeline)?;
     let frame = timeline.scene_at(0);
     let reference_scene = crate::accuracy::reference_scene(&frame);
     let (reference, _) = reference_depths(&reference_scene, w, h, crate::accuracy::REFERENCE_STEP);
