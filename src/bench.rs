@@ -23,7 +23,7 @@ use std::process::Command;
 use std::time::Instant;
 
 /// Floating-point operations in one power-8 orbit iteration of the vector
-/// kernel (`Fractal::orbit_lanes`, what rendering runs), counted from the
+/// kernel (`Fractal::estimate_lanes`, what rendering runs), counted from the
 /// code, with a multiply, add, subtract, divide or square root each one
 /// operation (comparisons, min and abs not counted): triplex power 50 (ρ²
 /// and r² 5, ρ 1, the axis test 1, ρ⁸ from ρ² 2, its reciprocal 1, the

@@ -132,6 +132,23 @@ pub struct OrbitTraps {
     pub planes: DVec3,
 }
 
+impl OrbitTraps {
+    /// The traps of an orbit that ended at `z`: those it met, or `z`'s own
+    /// for a point outside the bailout from the start, which met none.
+    #[inline(always)]
+    fn ended(self, z: [Real; 3]) -> OrbitTraps {
+        if self.origin == Real::INFINITY {
+            let zv = DVec3::from_array(z);
+            OrbitTraps {
+                origin: zv.length_squared(),
+                planes: zv.abs(),
+            }
+        } else {
+            self
+        }
+    }
+}
+
 /// What one evaluation of the distance estimator returns.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate {
@@ -143,6 +160,20 @@ pub struct Estimate {
     pub escaped: bool,
     /// Orbits computed for this estimate (the cost: 1 for analytic, 5 for gradient methods).
     pub orbits: u32,
+}
+
+impl Estimate {
+    /// A placeholder, overwritten before use.
+    const IDLE: Estimate = Estimate {
+        distance: 0.0,
+        traps: OrbitTraps {
+            origin: 0.0,
+            planes: DVec3::ZERO,
+        },
+        iterations: 0,
+        escaped: false,
+        orbits: 0,
+    };
 }
 
 /// A point of the kernel's number type.
@@ -463,21 +494,15 @@ impl<T: Number> Orbit<T> {
         r2: T,
         r: T,
         dr: T,
-        mut traps: OrbitTraps,
+        traps: OrbitTraps,
         i: u32,
         bailout: Real,
     ) -> Orbit<T> {
-        if traps.origin == Real::INFINITY {
-            // The point was outside the bailout from the start.
-            let zv = DVec3::new(z[0].value(), z[1].value(), z[2].value());
-            traps.origin = zv.length_squared();
-            traps.planes = zv.abs();
-        }
         Orbit {
             z,
             r,
             dr,
-            traps,
+            traps: traps.ended([z[0].value(), z[1].value(), z[2].value()]),
             iterations: i,
             // `OrbitState::outside`.
             escaped: r2.value() > bailout * bailout,
@@ -549,38 +574,51 @@ impl Fractal {
     #[inline]
     pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
-        // Always a full vector of `VECTOR` orbits: lanes past the points
-        // start outside the bailout ball and cost no iterations.
-        let mut orbits = [Orbit::IDLE; N];
-        for (chunk, out) in points.chunks(VECTOR).zip(orbits.chunks_mut(VECTOR)) {
-            let lanes: [DVec3; VECTOR] = match <[DVec3; VECTOR]>::try_from(chunk) {
-                Ok(full) => full,
-                Err(_) => std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT)),
-            };
-            let done = orbit_vector(self, lanes, n);
-            out.copy_from_slice(&done[..out.len()]);
-        }
-        let iterations: u64 = orbits.iter().map(|o| o.iterations as u64).sum();
-        ITERATIONS.with(|count| count.set(count.get() + iterations));
-        Some(orbits)
+        Some(self.in_vectors(points, |lanes| {
+            pulp::Arch::new().dispatch(Kernel::new(self, lanes, n))
+        }))
     }
 
-    /// Analytic estimates at `N` points at once through `orbit_lanes`:
-    /// bit-identical to `estimate` at each point, faster in bulk. Other
-    /// estimators, precisions and powers fall back to one `estimate` per point.
+    /// Analytic estimates at `N` points at once, finished in the vector
+    /// registers their orbits ran in: bit-identical to `estimate` at each
+    /// point, faster in bulk. Other estimators, precisions and powers fall
+    /// back to one `estimate` per point.
     pub fn estimate_lanes<const N: usize>(
         &self,
         points: [DVec3; N],
         scales: [Real; N],
     ) -> [Estimate; N] {
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
-            if let Some(orbits) = self.orbit_lanes(points) {
-                return std::array::from_fn(|k| {
-                    self.estimate_from_orbit(points[k], scales[k], &orbits[k], None)
+            if let Some(n) = whole_power(self.power) {
+                return self.in_vectors(points, |lanes| {
+                    pulp::Arch::new().dispatch(Kernel::new(self, lanes, n))
                 });
             }
         }
         std::array::from_fn(|k| self.estimate(points[k], scales[k]))
+    }
+
+    /// `points` run through `kernel` one vector at a time (lanes past the
+    /// points start outside the bailout ball and cost no iterations), with
+    /// the iterations counted for this thread.
+    #[inline(always)]
+    fn in_vectors<const N: usize, Out: Finished>(
+        &self,
+        points: [DVec3; N],
+        kernel: impl Fn([DVec3; VECTOR]) -> [Out; VECTOR],
+    ) -> [Out; N] {
+        let mut out = [Out::IDLE; N];
+        for (chunk, out) in points.chunks(VECTOR).zip(out.chunks_mut(VECTOR)) {
+            let lanes: [DVec3; VECTOR] = match <[DVec3; VECTOR]>::try_from(chunk) {
+                Ok(full) => full,
+                Err(_) => std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT)),
+            };
+            let done = kernel(lanes);
+            out.copy_from_slice(&done[..out.len()]);
+        }
+        let iterations: u64 = out.iter().map(|o| o.iterations() as u64).sum();
+        ITERATIONS.with(|count| count.set(count.get() + iterations));
+        out
     }
 
     /// Whether `p` belongs to the set at this iteration count: its orbit never
@@ -653,12 +691,7 @@ impl Fractal {
         let distance = if !centre.escaped {
             0.0
         } else if centre.iterations == 0 {
-            // Outside the bailout ball before iterating. The set lies inside that
-            // ball by definition, so the distance to it is a bound, where the
-            // estimators' asymptotics (½·r·ln r) are not. Measured without
-            // overflow, for points out to f64's largest.
-            let scale = p.abs().max_element();
-            (scale * (p / scale).length() - self.bailout).max(0.0)
+            distance_to_ball(p, self.bailout)
         } else {
             let r = centre.r.value();
             let d = match self.de {
@@ -707,7 +740,7 @@ impl Fractal {
                 }
             };
             if d.is_finite() {
-                d.max(0.0)
+                analytic_distance(d)
             } else {
                 guarded_distance(centre)
             }
@@ -730,48 +763,116 @@ pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
 /// f64 in flight at once (with AVX2, two registers of four at a time, twice).
 pub const VECTOR: usize = 16;
 
-/// `Fractal::orbit_lanes` on one vector of points, compiled for each
-/// instruction set and picked at run time by the processor (pulp's `Arch`:
-/// AVX-512, AVX2 with FMA, or plain scalar code), so one binary runs
+/// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
+/// each instruction set and picked at run time by the processor (pulp's
+/// `Arch`: AVX-512, AVX2 with FMA, or plain scalar code), so one binary runs
 /// everywhere and uses the widest registers it finds. Each operation is
 /// written out as the vector instruction it is, so the speed does not rest
 /// on the compiler vectorising; Rust never fuses a multiply and an add
 /// unasked, so every version rounds exactly as the scalar `orbit` does.
-fn orbit_vector(fractal: &Fractal, points: [DVec3; VECTOR], n: u32) -> [Orbit<f64>; VECTOR] {
-    pulp::Arch::new().dispatch(OrbitVector { fractal, points, n })
+/// `Kernel<Orbit<f64>>` hands back the orbits, `Kernel<Estimate>` the
+/// analytic estimates, finished in the registers.
+struct Kernel<'a, Out>(
+    &'a Fractal,
+    [DVec3; VECTOR],
+    u32,
+    std::marker::PhantomData<Out>,
+);
+
+impl<'a, Out: Finished> Kernel<'a, Out> {
+    /// The kernel on `points` for a fractal of whole power `n`.
+    fn new(fractal: &'a Fractal, points: [DVec3; VECTOR], n: u32) -> Self {
+        Kernel(fractal, points, n, std::marker::PhantomData)
+    }
 }
 
-struct OrbitVector<'a> {
-    fractal: &'a Fractal,
-    points: [DVec3; VECTOR],
-    n: u32,
-}
-
-impl pulp::WithSimd for OrbitVector<'_> {
-    type Output = [Orbit<f64>; VECTOR];
+impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
+    type Output = [Out; VECTOR];
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
-        let mut out = [Orbit::IDLE; VECTOR];
-        let lanes = S::F64_LANES.clamp(1, VECTOR / 2);
-        // Two registers at a time: their dependency chains are independent,
-        // so the processor overlaps one's square roots and division with
-        // the other's multiplications instead of waiting.
-        for (points, out) in self.points.chunks(2 * lanes).zip(out.chunks_mut(2 * lanes)) {
-            // One copy of the loop per convention and for power 8, so the
-            // loop has no branch on either and power 8 unrolls.
-            let f = self.fractal;
-            match (f.formula, self.n) {
-                (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez, out),
-                (Formula::Asin, 8) => orbit_registers(simd, f, points, 8, Formula::Asin, out),
-                (Formula::WhiteNylander, 8) => {
-                    orbit_registers(simd, f, points, 8, Formula::WhiteNylander, out)
-                }
-                (formula, n) => orbit_registers(simd, f, points, n, formula, out),
-            }
-        }
-        out
+        let Self(fractal, points, n, _) = self;
+        run_vector(simd, fractal, &points, n)
     }
+}
+
+/// What a register's finished lanes become. A trait rather than a closure
+/// so it is inlined into the code compiled for the instruction set.
+trait Finished: Copy {
+    const IDLE: Self;
+    /// The orbit iterations this result took.
+    fn iterations(&self) -> u32;
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Self],
+    );
+}
+
+impl Finished for Orbit<f64> {
+    const IDLE: Self = Orbit::IDLE;
+    fn iterations(&self) -> u32 {
+        self.iterations
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        _: &[DVec3],
+        out: &mut [Self],
+    ) {
+        register.finish(fractal, out)
+    }
+}
+
+impl Finished for Estimate {
+    const IDLE: Self = Estimate::IDLE;
+    fn iterations(&self) -> u32 {
+        self.iterations
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Self],
+    ) {
+        register.estimates(fractal, points, out)
+    }
+}
+
+/// Runs `points` two registers at a time; each register, with its points,
+/// writes its lanes' results (`Finished::write`).
+#[inline(always)]
+fn run_vector<S: pulp::Simd, Out: Finished>(
+    simd: S,
+    fractal: &Fractal,
+    points: &[DVec3; VECTOR],
+    n: u32,
+) -> [Out; VECTOR] {
+    let mut out = [Out::IDLE; VECTOR];
+    let lanes = S::F64_LANES.clamp(1, VECTOR / 2);
+    // Two registers at a time: their dependency chains are independent,
+    // so the processor overlaps one's square roots and division with
+    // the other's multiplications instead of waiting.
+    for (points, out) in points.chunks(2 * lanes).zip(out.chunks_mut(2 * lanes)) {
+        // One copy of the loop per convention and for power 8, so the
+        // loop has no branch on either and power 8 unrolls.
+        let f = fractal;
+        let (a, b) = match (f.formula, n) {
+            (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez),
+            (Formula::Asin, 8) => orbit_registers(simd, f, points, 8, Formula::Asin),
+            (Formula::WhiteNylander, 8) => {
+                orbit_registers(simd, f, points, 8, Formula::WhiteNylander)
+            }
+            (formula, n) => orbit_registers(simd, f, points, n, formula),
+        };
+        let (first, second) = out.split_at_mut(lanes);
+        Out::write(&a, f, &points[..lanes], first);
+        Out::write(&b, f, &points[lanes..], second);
+    }
+    out
 }
 
 /// Two registers of orbits iterated in one loop (see `Register`).
@@ -782,8 +883,7 @@ fn orbit_registers<S: pulp::Simd>(
     points: &[DVec3],
     n: u32,
     formula: Formula,
-    out: &mut [Orbit<f64>],
-) {
+) -> (Register<S>, Register<S>) {
     let lanes = points.len() / 2;
     let mut a = Register::start(simd, fractal, &points[..lanes]);
     let mut b = Register::start(simd, fractal, &points[lanes..]);
@@ -799,8 +899,7 @@ fn orbit_registers<S: pulp::Simd>(
             b.step(formula, n);
         }
     }
-    a.finish(fractal, &mut out[..lanes]);
-    b.finish(fractal, &mut out[lanes..]);
+    (a, b)
 }
 
 /// One register of orbits: `OrbitState` on `Vector`s, each lane's state
@@ -971,6 +1070,49 @@ impl<S: pulp::Simd> Register<S> {
             *out = Orbit::ended(z, r2[k], r[k], dr[k], traps, i[k] as u32, fractal.bailout);
         }
     }
+
+    /// The analytic estimates at `points` (one per lane) from the finished
+    /// orbits, into `out`: `estimate_from_orbit`'s formula, its logarithm
+    /// and division taken in the registers.
+    #[inline(always)]
+    fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
+        let store = Self::store;
+        let (r, dr) = (self.r, self.dr);
+        // `half_r_ln_r_over`, operation for operation.
+        let raw = store(self.splat(0.5) * crate::math::ln_in_range(r) * r / dr);
+        let (r2, r, dr) = (store(self.r2), store(r), store(dr));
+        let (z0, z1, z2) = (store(self.z[0]), store(self.z[1]), store(self.z[2]));
+        let (p0, p1, p2) = (
+            store(self.planes[0]),
+            store(self.planes[1]),
+            store(self.planes[2]),
+        );
+        let (origin, i) = (store(self.origin), store(self.i));
+        for (k, out) in out.iter_mut().enumerate() {
+            let traps = OrbitTraps {
+                origin: origin[k],
+                planes: DVec3::new(p0[k], p1[k], p2[k]),
+            };
+            let traps = traps.ended([z0[k], z1[k], z2[k]]);
+            let (escaped, iterations) = (r2[k] > fractal.bailout * fractal.bailout, i[k] as u32);
+            let distance = if !escaped {
+                0.0
+            } else if iterations == 0 {
+                distance_to_ball(points[k], fractal.bailout)
+            } else if crate::math::in_ln_range(r[k]) {
+                analytic_distance(raw[k])
+            } else {
+                analytic_distance(half_r_ln_r_over(r[k], dr[k]))
+            };
+            *out = Estimate {
+                distance,
+                traps,
+                iterations,
+                escaped,
+                orbits: 1,
+            };
+        }
+    }
 }
 
 /// The trigonometric power of the lanes flagged (non-zero) in `which`, as
@@ -1030,19 +1172,35 @@ pub fn spectral_norm(m: glam::DMat3) -> Real {
 /// orbit if that is finite, else 0, which the marcher treats as a hit: it may
 /// stop early but never skips surface.
 fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
-    let analytic = half_r_ln_r_over(centre.r.value(), centre.dr.value());
-    if analytic.is_finite() && analytic >= 0.0 {
-        analytic
+    analytic_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
+}
+
+/// An estimate `d` as a distance: 0 where it is negative or not finite.
+#[inline(always)]
+fn analytic_distance(d: Real) -> Real {
+    if d.is_finite() {
+        d.max(0.0)
     } else {
         0.0
     }
 }
 
+/// The distance from `p` to the bailout ball, for a point outside it before
+/// iterating. The set lies inside that ball by definition, so the distance
+/// to it is a bound, where the estimators' asymptotics (½·r·ln r) are not.
+/// Measured without overflow, for points out to f64's largest.
+#[inline]
+fn distance_to_ball(p: DVec3, bailout: Real) -> Real {
+    let scale = p.abs().max_element();
+    (scale * (p / scale).length() - bailout).max(0.0)
+}
+
 /// ½·r·ln r / `slope`: the distance bound of an orbit that escaped to radius
 /// r, given how fast |z| grows with the starting point (seed 001, part V).
+/// The logarithm is `math::ln`, which the vector kernel repeats to the bit.
 #[inline]
 fn half_r_ln_r_over(r: Real, slope: Real) -> Real {
-    0.5 * r.ln() * r / slope
+    0.5 * crate::math::ln(r) * r / slope
 }
 
 /// Tetrahedral stencil for gradients: four corners of a cube, summing to zero.
@@ -1335,26 +1493,49 @@ mod tests {
                     .iter()
                     .map(|p| format!("{:?}", f.orbit([p.x, p.y, p.z], f.iterations, true)))
                     .collect();
-                let check = |orbits: [Orbit<f64>; VECTOR], arch: &str| {
-                    for (k, o) in orbits.iter().enumerate() {
-                        assert_eq!(format!("{o:?}"), expected[k], "{arch} at {}", points[k]);
-                    }
-                };
-                let kernel = || OrbitVector {
-                    fractal: &f,
-                    points,
-                    n,
-                };
+                // Estimates too: their logarithm and division run in the registers.
+                let estimated: Vec<String> = points
+                    .iter()
+                    .map(|&p| format!("{:?}", f.estimate(p, 1e-4)))
+                    .collect();
+                let check =
+                    |orbits: [Orbit<f64>; VECTOR], estimates: [Estimate; VECTOR], arch: &str| {
+                        for (k, o) in orbits.iter().enumerate() {
+                            assert_eq!(format!("{o:?}"), expected[k], "{arch} at {}", points[k]);
+                        }
+                        for (k, e) in estimates.iter().enumerate() {
+                            assert_eq!(format!("{e:?}"), estimated[k], "{arch} at {}", points[k]);
+                        }
+                    };
                 // What rendering runs (the widest set found), then each set.
-                check(orbit_vector(&f, points, n), "dispatched");
-                check(kernel().with_simd(pulp::Scalar::new()), "scalar");
+                let arch = pulp::Arch::new();
+                check(
+                    arch.dispatch(Kernel::new(&f, points, n)),
+                    arch.dispatch(Kernel::new(&f, points, n)),
+                    "dispatched",
+                );
+                fn on<S: pulp::Simd>(
+                    simd: S,
+                    f: &Fractal,
+                    points: [DVec3; VECTOR],
+                    n: u32,
+                ) -> ([Orbit<f64>; VECTOR], [Estimate; VECTOR]) {
+                    (
+                        Kernel::new(f, points, n).with_simd(simd),
+                        Kernel::new(f, points, n).with_simd(simd),
+                    )
+                }
+                let (o, e) = on(pulp::Scalar::new(), &f, points, n);
+                check(o, e, "scalar");
                 #[cfg(target_arch = "x86_64")]
                 {
                     if let Some(v3) = pulp::x86::V3::try_new() {
-                        check(kernel().with_simd(v3), "AVX2");
+                        let (o, e) = on(v3, &f, points, n);
+                        check(o, e, "AVX2");
                     }
                     if let Some(v4) = pulp::x86::V4::try_new() {
-                        check(kernel().with_simd(v4), "AVX-512");
+                        let (o, e) = on(v4, &f, points, n);
+                        check(o, e, "AVX-512");
                     }
                 }
             }
