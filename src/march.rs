@@ -217,8 +217,10 @@ struct Marcher {
     ray: Ray,
     t: Real,
     t_exit: Real,
-    /// The last point found outside the set, with its estimate.
-    outside: Option<(Real, Estimate)>,
+    /// The last point found outside the set. Only its distance along the
+    /// ray: its estimate is needed only after an overshoot (rare), and
+    /// then taken again, which is cheaper than keeping every step's.
+    outside: Option<Real>,
     omega: Real,
     previous_distance: Real,
     previous_step: Real,
@@ -305,20 +307,15 @@ impl Walk for Marcher {
             return None;
         }
         if !estimate.escaped {
-            if let Some((t_out, estimate_out)) = self.outside {
+            if let Some(t_out) = self.outside {
                 // Overshot: bisect [outside, t (inside)] down to the threshold.
                 let at = |t: Real| ray.at(t);
                 let (lo, tests) = bisect_membership(fractal, &at, t_out, t, |lo| {
                     settings.hit_threshold * ray.footprint(lo)
                 });
                 self.evaluations += tests;
-                let estimate = if lo == t_out {
-                    estimate_out
-                } else {
-                    let e = fractal.estimate(at(lo), ray.footprint(lo));
-                    self.evaluations += e.orbits;
-                    e
-                };
+                let estimate = fractal.estimate(at(lo), ray.footprint(lo));
+                self.evaluations += estimate.orbits;
                 self.closest = 0.0;
                 return Some(self.hit(lo, estimate));
             }
@@ -326,7 +323,7 @@ impl Walk for Marcher {
         if estimate.distance < settings.hit_threshold * footprint {
             return Some(self.hit(t, estimate));
         }
-        self.outside = Some((t, estimate));
+        self.outside = Some(t);
         let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;
         // The over-relaxed step is checked at the next point (or, leaving the
         // bounding sphere, by retrying the plain step); a plain step is safe.
