@@ -574,9 +574,7 @@ impl Fractal {
     #[inline]
     pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
-        Some(self.in_vectors(points, |lanes| {
-            pulp::Arch::new().dispatch(Kernel::new(self, lanes, n))
-        }))
+        Some(self.in_vectors(points, n))
     }
 
     /// Analytic estimates at `N` points at once, finished in the vector
@@ -590,31 +588,32 @@ impl Fractal {
     ) -> [Estimate; N] {
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
             if let Some(n) = whole_power(self.power) {
-                return self.in_vectors(points, |lanes| {
-                    pulp::Arch::new().dispatch(Kernel::new(self, lanes, n))
-                });
+                return self.in_vectors(points, n);
             }
         }
         std::array::from_fn(|k| self.estimate(points[k], scales[k]))
     }
 
-    /// `points` run through `kernel` one vector at a time (lanes past the
+    /// `points` run through the vector kernel for whole power `n`, one
+    /// vector at a time, each writing its results in place (lanes past the
     /// points start outside the bailout ball and cost no iterations), with
     /// the iterations counted for this thread.
     #[inline(always)]
-    fn in_vectors<const N: usize, Out: Finished>(
-        &self,
-        points: [DVec3; N],
-        kernel: impl Fn([DVec3; VECTOR]) -> [Out; VECTOR],
-    ) -> [Out; N] {
+    fn in_vectors<const N: usize, Out: Finished>(&self, points: [DVec3; N], n: u32) -> [Out; N] {
+        let arch = pulp::Arch::new();
         let mut out = [Out::IDLE; N];
         for (chunk, out) in points.chunks(VECTOR).zip(out.chunks_mut(VECTOR)) {
-            let lanes: [DVec3; VECTOR] = match <[DVec3; VECTOR]>::try_from(chunk) {
-                Ok(full) => full,
-                Err(_) => std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT)),
-            };
-            let done = kernel(lanes);
-            out.copy_from_slice(&done[..out.len()]);
+            // Chunks of points and of results have the same lengths.
+            if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
+                let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
+                arch.dispatch(Kernel(self, lanes, n, full));
+            } else {
+                let lanes: [DVec3; VECTOR] =
+                    std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
+                let mut full = [Out::IDLE; VECTOR];
+                arch.dispatch(Kernel(self, &lanes, n, &mut full));
+                out.copy_from_slice(&full[..out.len()]);
+            }
         }
         let iterations: u64 = out.iter().map(|o| o.iterations() as u64).sum();
         ITERATIONS.with(|count| count.set(count.get() + iterations));
@@ -772,27 +771,15 @@ pub const VECTOR: usize = 16;
 /// unasked, so every version rounds exactly as the scalar `orbit` does.
 /// `Kernel<Orbit<f64>>` hands back the orbits, `Kernel<Estimate>` the
 /// analytic estimates, finished in the registers.
-struct Kernel<'a, Out>(
-    &'a Fractal,
-    [DVec3; VECTOR],
-    u32,
-    std::marker::PhantomData<Out>,
-);
-
-impl<'a, Out: Finished> Kernel<'a, Out> {
-    /// The kernel on `points` for a fractal of whole power `n`.
-    fn new(fractal: &'a Fractal, points: [DVec3; VECTOR], n: u32) -> Self {
-        Kernel(fractal, points, n, std::marker::PhantomData)
-    }
-}
+struct Kernel<'a, Out>(&'a Fractal, &'a [DVec3; VECTOR], u32, &'a mut [Out; VECTOR]);
 
 impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
-    type Output = [Out; VECTOR];
+    type Output = ();
 
     #[inline(always)]
-    fn with_simd<S: pulp::Simd>(self, simd: S) -> Self::Output {
-        let Self(fractal, points, n, _) = self;
-        run_vector(simd, fractal, &points, n)
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let Self(fractal, points, n, out) = self;
+        run_vector(simd, fractal, points, n, out)
     }
 }
 
@@ -850,8 +837,8 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
     fractal: &Fractal,
     points: &[DVec3; VECTOR],
     n: u32,
-) -> [Out; VECTOR] {
-    let mut out = [Out::IDLE; VECTOR];
+    out: &mut [Out; VECTOR],
+) {
     let lanes = S::F64_LANES.clamp(1, VECTOR / 2);
     // Two registers at a time: their dependency chains are independent,
     // so the processor overlaps one's square roots and division with
@@ -872,7 +859,6 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
         Out::write(&a, f, &points[..lanes], first);
         Out::write(&b, f, &points[lanes..], second);
     }
-    out
 }
 
 /// Two registers of orbits iterated in one loop (see `Register`).
@@ -1508,23 +1494,22 @@ mod tests {
                         }
                     };
                 // What rendering runs (the widest set found), then each set.
-                let arch = pulp::Arch::new();
-                check(
-                    arch.dispatch(Kernel::new(&f, points, n)),
-                    arch.dispatch(Kernel::new(&f, points, n)),
-                    "dispatched",
-                );
                 fn on<S: pulp::Simd>(
                     simd: S,
                     f: &Fractal,
                     points: [DVec3; VECTOR],
                     n: u32,
                 ) -> ([Orbit<f64>; VECTOR], [Estimate; VECTOR]) {
-                    (
-                        Kernel::new(f, points, n).with_simd(simd),
-                        Kernel::new(f, points, n).with_simd(simd),
-                    )
+                    let mut out = ([Orbit::IDLE; VECTOR], [Estimate::IDLE; VECTOR]);
+                    Kernel(f, &points, n, &mut out.0).with_simd(simd);
+                    Kernel(f, &points, n, &mut out.1).with_simd(simd);
+                    out
                 }
+                check(
+                    f.orbit_lanes(points).expect("a whole power"),
+                    f.estimate_lanes(points, [1e-4; VECTOR]),
+                    "dispatched",
+                );
                 let (o, e) = on(pulp::Scalar::new(), &f, points, n);
                 check(o, e, "scalar");
                 #[cfg(target_arch = "x86_64")]
