@@ -137,7 +137,7 @@ pub trait Walk: Copy {
     /// Takes the estimate at `next_point`; the output once the walk ends.
     fn advance(
         &mut self,
-        estimate: Estimate,
+        estimate: &Estimate,
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<Self::Output>;
@@ -155,7 +155,7 @@ pub fn walk_one<W: Walk>(
     };
     loop {
         let (point, footprint) = walk.next_point();
-        if let Some(done) = walk.advance(fractal.estimate(point, footprint), fractal, settings) {
+        if let Some(done) = walk.advance(&fractal.estimate(point, footprint), fractal, settings) {
             return done;
         }
     }
@@ -198,7 +198,7 @@ pub fn walk_many<W: Walk>(
             }
         }
         let estimates = fractal.estimate_lanes(points, footprints);
-        for (lane, estimate) in lanes.iter_mut().zip(estimates) {
+        for (lane, estimate) in lanes.iter_mut().zip(&estimates) {
             if let Some((i, walk)) = lane {
                 if let Some(output) = walk.advance(estimate, fractal, settings) {
                     done(*i, output);
@@ -280,7 +280,7 @@ impl Walk for Marcher {
 
     fn advance(
         &mut self,
-        estimate: Estimate,
+        estimate: &Estimate,
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<MarchResult> {
@@ -292,7 +292,7 @@ impl Walk for Marcher {
             // along a surface it keeps almost touching (a grazing ray).
             // Calling that a miss punches background-coloured speckles into
             // the surface; call it a hit.
-            return Some(self.hit(t, estimate));
+            return Some(self.hit(t, *estimate));
         }
         self.steps += 1;
         self.closest = self.closest.min(estimate.distance / footprint);
@@ -321,7 +321,7 @@ impl Walk for Marcher {
             }
         }
         if estimate.distance < settings.hit_threshold * footprint {
-            return Some(self.hit(t, estimate));
+            return Some(self.hit(t, *estimate));
         }
         self.outside = Some(t);
         let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;

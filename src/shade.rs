@@ -357,7 +357,7 @@ impl crate::march::Walk for ShadowWalk {
 
     fn advance(
         &mut self,
-        e: crate::fractal::Estimate,
+        e: &crate::fractal::Estimate,
         _: &Fractal,
         settings: &MarchSettings,
     ) -> Option<(f32, u64)> {
