@@ -164,7 +164,7 @@ pub struct Estimate {
 
 impl Estimate {
     /// A placeholder, overwritten before use.
-    const IDLE: Estimate = Estimate {
+    pub const IDLE: Estimate = Estimate {
         distance: 0.0,
         traps: OrbitTraps {
             origin: 0.0,
@@ -574,7 +574,9 @@ impl Fractal {
     #[inline]
     pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
-        Some(self.in_vectors(points, n))
+        let mut out = [Orbit::IDLE; N];
+        self.in_vectors(&points, n, &mut out);
+        Some(out)
     }
 
     /// Analytic estimates at `N` points at once, finished in the vector
@@ -586,22 +588,41 @@ impl Fractal {
         points: [DVec3; N],
         scales: [Real; N],
     ) -> [Estimate; N] {
+        let mut out = [Estimate::IDLE; N];
+        self.estimate_lanes_into(&points, &scales, &mut out);
+        out
+    }
+
+    /// `estimate_lanes` into `out`, for callers that keep one array of
+    /// estimates from step to step.
+    pub fn estimate_lanes_into<const N: usize>(
+        &self,
+        points: &[DVec3; N],
+        scales: &[Real; N],
+        out: &mut [Estimate; N],
+    ) {
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
             if let Some(n) = whole_power(self.power) {
-                return self.in_vectors(points, n);
+                return self.in_vectors(points, n, out);
             }
         }
-        std::array::from_fn(|k| self.estimate(points[k], scales[k]))
+        for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
+            *out = self.estimate(p, scale);
+        }
     }
 
     /// `points` run through the vector kernel for whole power `n`, one
-    /// vector at a time, each writing its results in place (lanes past the
-    /// points start outside the bailout ball and cost no iterations), with
-    /// the iterations counted for this thread.
+    /// vector at a time, each writing its results in place into `out`
+    /// (lanes past the points start outside the bailout ball and cost no
+    /// iterations), with the iterations counted for this thread.
     #[inline(always)]
-    fn in_vectors<const N: usize, Out: Finished>(&self, points: [DVec3; N], n: u32) -> [Out; N] {
+    fn in_vectors<const N: usize, Out: Finished>(
+        &self,
+        points: &[DVec3; N],
+        n: u32,
+        out: &mut [Out; N],
+    ) {
         let arch = pulp::Arch::new();
-        let mut out = [Out::IDLE; N];
         for (chunk, out) in points.chunks(VECTOR).zip(out.chunks_mut(VECTOR)) {
             // Chunks of points and of results have the same lengths.
             if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
@@ -617,7 +638,6 @@ impl Fractal {
         }
         let iterations: u64 = out.iter().map(|o| o.iterations() as u64).sum();
         ITERATIONS.with(|count| count.set(count.get() + iterations));
-        out
     }
 
     /// Whether `p` belongs to the set at this iteration count: its orbit never
@@ -761,6 +781,12 @@ pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
 /// Orbits the lane kernel takes per call: two AVX-512 registers of eight
 /// f64 in flight at once (with AVX2, two registers of four at a time, twice).
 pub const VECTOR: usize = 16;
+
+/// The most f64 lanes one register has (AVX-512's eight).
+const REGISTER: usize = VECTOR / 2;
+
+/// One register's lanes in memory (the first `S::F64_LANES` used).
+type Lanes = [f64; REGISTER];
 
 /// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
 /// each instruction set and picked at run time by the processor (pulp's
@@ -923,14 +949,14 @@ impl<S: pulp::Simd> Register<S> {
     }
 
     #[inline(always)]
-    fn store(v: Vector<S>) -> [f64; VECTOR] {
-        let mut a = [0.0; VECTOR];
+    fn store(v: Vector<S>) -> Lanes {
+        let mut a = [0.0; REGISTER];
         S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
         a
     }
 
     #[inline(always)]
-    fn load(simd: S, a: &[f64; VECTOR]) -> Vector<S> {
+    fn load(simd: S, a: &Lanes) -> Vector<S> {
         Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
     }
 
@@ -938,7 +964,7 @@ impl<S: pulp::Simd> Register<S> {
     #[inline(always)]
     fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
         debug_assert_eq!(points.len(), S::F64_LANES);
-        let mut xyz = [[0.0; VECTOR]; 3];
+        let mut xyz = [[0.0; REGISTER]; 3];
         for (k, p) in points.iter().enumerate() {
             (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
         }
@@ -1108,13 +1134,13 @@ impl<S: pulp::Simd> Register<S> {
 #[inline(never)]
 fn near_axis_powers(
     formula: Formula,
-    z: [[f64; VECTOR]; 3],
-    r: [f64; VECTOR],
+    z: [Lanes; 3],
+    r: Lanes,
     n: u32,
-    which: &[f64; VECTOR],
-) -> [[f64; VECTOR]; 3] {
-    let mut out = [[0.0; VECTOR]; 3];
-    for k in (0..VECTOR).filter(|&k| which[k] != 0.0) {
+    which: &Lanes,
+) -> [Lanes; 3] {
+    let mut out = [[0.0; REGISTER]; 3];
+    for k in (0..REGISTER).filter(|&k| which[k] != 0.0) {
         let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
         for axis in 0..3 {
             out[axis][k] = exact[axis];

@@ -174,6 +174,7 @@ pub fn walk_many<W: Walk>(
 ) {
     let mut walks = walks.into_iter().enumerate();
     let mut lanes: [Option<(usize, W)>; VECTOR] = [None; VECTOR];
+    let mut estimates = [Estimate::IDLE; VECTOR];
     loop {
         for lane in lanes.iter_mut().filter(|lane| lane.is_none()) {
             for (i, walk) in walks.by_ref() {
@@ -197,7 +198,7 @@ pub fn walk_many<W: Walk>(
                 (*point, *footprint) = walk.next_point();
             }
         }
-        let estimates = fractal.estimate_lanes(points, footprints);
+        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
         for (lane, estimate) in lanes.iter_mut().zip(&estimates) {
             if let Some((i, walk)) = lane {
                 if let Some(output) = walk.advance(estimate, fractal, settings) {
