@@ -84,9 +84,9 @@ pub trait Lanes: Arith {
     fn if_at_least(self, bound: f64, then: Self, otherwise: Self) -> Self;
     /// Lane by lane: `then` where `self < bound`, else `otherwise`.
     fn if_below(self, bound: f64, then: Self, otherwise: Self) -> Self;
-    /// For a positive normal x = m·2ᵉ with m in [1, 2): (m, 2ᵉ), from the
-    /// bits (the sign is dropped).
-    fn mantissa_and_power(self) -> (Self, Self);
+    /// For a positive normal x = m·2ᵉ with m in [1, 2): (m, e), exactly
+    /// (the sign is dropped).
+    fn mantissa_and_exponent(self) -> (Self, Self);
 }
 
 /// The bits of an f64's exponent and of its mantissa, and 1.0's.
@@ -100,11 +100,12 @@ impl Lanes for f64 {
         v
     }
     #[inline(always)]
-    fn mantissa_and_power(self) -> (Self, Self) {
+    fn mantissa_and_exponent(self) -> (Self, Self) {
         let bits = self.to_bits();
+        let biased = (bits & EXPONENT_BITS) >> 52;
         (
             f64::from_bits(bits & MANTISSA_BITS | ONE_BITS),
-            f64::from_bits(bits & EXPONENT_BITS),
+            biased as f64 - 1023.0,
         )
     }
     #[inline(always)]
@@ -131,16 +132,40 @@ impl<S: pulp::Simd> Lanes for Vector<S> {
         Vector::splat(self.0, v)
     }
     #[inline(always)]
-    fn mantissa_and_power(self) -> (Self, Self) {
+    fn mantissa_and_exponent(self) -> (Self, Self) {
+        /// 2ᵏ for k = 512, 256, …, 1: (k, 2ᵏ, 2⁻ᵏ), all exact.
+        const LADDER: [(f64, f64, f64); 10] = {
+            let mut ladder = [(0.0, 0.0, 0.0); 10];
+            let mut i = 0;
+            while i < 10 {
+                let k = 512 >> i;
+                ladder[i] = (
+                    k as f64,
+                    f64::from_bits((1023 + k as u64) << 52),
+                    f64::from_bits((1023 - k as u64) << 52),
+                );
+                i += 1;
+            }
+            ladder
+        };
         let simd = self.0;
         let bits = simd.transmute_u64s_f64s(self.1);
         let mantissa = simd.and_u64s(bits, simd.splat_u64s(MANTISSA_BITS));
         let mantissa = simd.or_u64s(mantissa, simd.splat_u64s(ONE_BITS));
         let power = simd.and_u64s(bits, simd.splat_u64s(EXPONENT_BITS));
-        (
-            Vector(simd, simd.transmute_f64s_u64s(mantissa)),
-            Vector(simd, simd.transmute_f64s_u64s(power)),
-        )
+        let mut power = Vector(simd, simd.transmute_f64s_u64s(power));
+        // pulp has no shift of 64-bit lanes nor integer conversion for
+        // every instruction set, so e comes from 2ᵉ by exact steps: the
+        // same whole number the scalar version reads from the bits. For
+        // 2ᵉ ≥ 2⁻¹ (x ≥ ½); below, e is meaningless, as x is out of range.
+        let mut e = self.constant(0.0);
+        for (k, at_least, inverse) in LADDER {
+            let (scaled, raised) = (power * power.constant(inverse), e + e.constant(k));
+            e = power.if_at_least(at_least, raised, e);
+            power = power.if_at_least(at_least, scaled, power);
+        }
+        e = power.if_below(1.0, e - e.constant(1.0), e);
+        (Vector(simd, simd.transmute_f64s_u64s(mantissa)), e)
     }
     #[inline(always)]
     fn if_at_least(self, bound: f64, then: Self, otherwise: Self) -> Self {
@@ -162,29 +187,14 @@ impl<S: pulp::Simd> Lanes for Vector<S> {
 /// get the same bits; within 2 ulp of the true value there (tested against
 /// `f64::ln`). Outside that range the result is meaningless: `ln` checks it.
 ///
-/// x = m·2ᵉ: the mantissa m in [1, 2) and the power 2ᵉ come from x's bits;
-/// e from 2ᵉ by exact multiplications by powers of two, beside the rest
-/// (nothing else waits on it). With m moved into [√½, √2), ln m = 2·atanh(s)
+/// x = m·2ᵉ: m in [1, 2) and e come from x's bits (`mantissa_and_exponent`;
+/// in vectors e takes a few steps beside the rest, which does not wait on
+/// it). With m moved into [√½, √2), ln m = 2·atanh(s)
 /// with s = (m−1)/(m+1), |s| ≤ 0.172, whose odd series s·Σ s²ᵏ/(2k+1) is
 /// below f64's resolution after 12 terms, summed by Estrin's scheme (a tree
 /// of depth 4 rather than Horner's chain of 12).
 #[inline(always)]
 pub fn ln_in_range<T: Lanes>(x: T) -> T {
-    /// 2ᵏ for k = 512, 256, …, 1: (k, 2ᵏ, 2⁻ᵏ), all exact.
-    const LADDER: [(f64, f64, f64); 10] = {
-        let mut ladder = [(0.0, 0.0, 0.0); 10];
-        let mut i = 0;
-        while i < 10 {
-            let k = 512 >> i;
-            ladder[i] = (
-                k as f64,
-                f64::from_bits((1023 + k as u64) << 52),
-                f64::from_bits((1023 - k as u64) << 52),
-            );
-            i += 1;
-        }
-        ladder
-    };
     /// 1/(2k+3) for k = 0..12: the series after its leading 1.
     const C: [f64; 12] = {
         let mut c = [0.0; 12];
@@ -195,15 +205,7 @@ pub fn ln_in_range<T: Lanes>(x: T) -> T {
         }
         c
     };
-    let (mut m, mut power) = x.mantissa_and_power();
-    // e from 2ᵉ (≥ ½ here).
-    let mut e = x.constant(0.0);
-    for (k, at_least, inverse) in LADDER {
-        let (scaled, raised) = (power * power.constant(inverse), e + e.constant(k));
-        e = power.if_at_least(at_least, raised, e);
-        power = power.if_at_least(at_least, scaled, power);
-    }
-    e = power.if_below(1.0, e - e.constant(1.0), e);
+    let (mut m, mut e) = x.mantissa_and_exponent();
     // Centre m on 1.
     let (halved, raised) = (m * m.constant(0.5), e + e.constant(1.0));
     e = m.if_at_least(std::f64::consts::SQRT_2, raised, e);
