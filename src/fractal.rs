@@ -409,8 +409,9 @@ impl Orbit<f64> {
 }
 
 /// An orbit being iterated: the loop body of `orbit`. The vector kernel
-/// (`Register::step`) repeats it operation for operation on registers, and
-/// shares `finish`; tests hold the two to the bit.
+/// (`Register::step`) repeats it operation for operation on registers and
+/// ends the same way (`Orbit::ended`, `OrbitTraps::ended`); tests hold the
+/// two to the bit.
 #[derive(Clone, Copy)]
 struct OrbitState<T> {
     z: Triplex<T>,
@@ -571,6 +572,8 @@ impl Fractal {
     /// side by side in f64, each lane of a vector register holding one
     /// orbit. Each lane does exactly the operations of `orbit`, so its
     /// result is bit-identical. For whole powers; `None` otherwise.
+    /// Rendering takes `estimate_lanes`, which finishes the estimates in the
+    /// registers; this is what the tests hold the vector orbit to.
     #[inline]
     pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
@@ -786,7 +789,7 @@ pub const VECTOR: usize = 16;
 const REGISTER: usize = VECTOR / 2;
 
 /// One register's lanes in memory (the first `S::F64_LANES` used).
-type Lanes = [f64; REGISTER];
+type Stored = [f64; REGISTER];
 
 /// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
 /// each instruction set and picked at run time by the processor (pulp's
@@ -795,8 +798,8 @@ type Lanes = [f64; REGISTER];
 /// written out as the vector instruction it is, so the speed does not rest
 /// on the compiler vectorising; Rust never fuses a multiply and an add
 /// unasked, so every version rounds exactly as the scalar `orbit` does.
-/// `Kernel<Orbit<f64>>` hands back the orbits, `Kernel<Estimate>` the
-/// analytic estimates, finished in the registers.
+/// `Kernel<Orbit<f64>>` writes the orbits into its output, `Kernel<Estimate>`
+/// the analytic estimates, finished in the registers.
 struct Kernel<'a, Out>(&'a Fractal, &'a [DVec3; VECTOR], u32, &'a mut [Out; VECTOR]);
 
 impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
@@ -865,7 +868,9 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
     n: u32,
     out: &mut [Out; VECTOR],
 ) {
-    let lanes = S::F64_LANES.clamp(1, VECTOR / 2);
+    // Registers are stored in `Stored` arrays of `REGISTER` lanes.
+    const { assert!(S::F64_LANES >= 1 && S::F64_LANES <= REGISTER) };
+    let lanes = S::F64_LANES;
     // Two registers at a time: their dependency chains are independent,
     // so the processor overlaps one's square roots and division with
     // the other's multiplications instead of waiting.
@@ -949,14 +954,14 @@ impl<S: pulp::Simd> Register<S> {
     }
 
     #[inline(always)]
-    fn store(v: Vector<S>) -> Lanes {
+    fn store(v: Vector<S>) -> Stored {
         let mut a = [0.0; REGISTER];
         S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
         a
     }
 
     #[inline(always)]
-    fn load(simd: S, a: &Lanes) -> Vector<S> {
+    fn load(simd: S, a: &Stored) -> Vector<S> {
         Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
     }
 
@@ -1088,6 +1093,9 @@ impl<S: pulp::Simd> Register<S> {
     /// and division taken in the registers.
     #[inline(always)]
     fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
+        // The analytic estimator in f64 is the only one finished here
+        // (`estimate_lanes_into` sends the others one point at a time).
+        debug_assert!(fractal.de == DeMethod::Analytic && fractal.precision == Precision::F64);
         let store = Self::store;
         let (r, dr) = (self.r, self.dr);
         // `half_r_ln_r_over`, operation for operation.
@@ -1134,11 +1142,11 @@ impl<S: pulp::Simd> Register<S> {
 #[inline(never)]
 fn near_axis_powers(
     formula: Formula,
-    z: [Lanes; 3],
-    r: Lanes,
+    z: [Stored; 3],
+    r: Stored,
     n: u32,
-    which: &Lanes,
-) -> [Lanes; 3] {
+    which: &Stored,
+) -> [Stored; 3] {
     let mut out = [[0.0; REGISTER]; 3];
     for k in (0..REGISTER).filter(|&k| which[k] != 0.0) {
         let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
@@ -1465,6 +1473,7 @@ mod tests {
         // scalar always, AVX2 and AVX-512 where this processor has them),
         // against `orbit` one point at a time: every field, to the bit.
         use pulp::WithSimd;
+        let mut outside_ln_range = 0;
         let mut pts = points(96, 0.0..2.5, 9);
         pts.extend([
             DVec3::new(0.0, 0.0, 0.7),
@@ -1497,14 +1506,30 @@ mod tests {
                 julia: Some(DVec3::new(0.3, -0.5, 0.2)),
                 ..Fractal::default()
             },
+            // Escaped radii below the logarithm's range and past f64's
+            // (timelines allow neither bailout; the kernel must still agree).
+            Fractal {
+                bailout: 0.45,
+                julia: Some(DVec3::new(0.47, 0.01, 0.0)),
+                ..Fractal::default()
+            },
+            Fractal {
+                bailout: 1e150,
+                ..Fractal::default()
+            },
         ] {
             let n = whole_power(f.power).unwrap();
             for chunk in pts.chunks_exact(VECTOR) {
                 let points: [DVec3; VECTOR] = chunk.try_into().unwrap();
-                let expected: Vec<String> = points
+                let orbits: Vec<Orbit<f64>> = points
                     .iter()
-                    .map(|p| format!("{:?}", f.orbit([p.x, p.y, p.z], f.iterations, true)))
+                    .map(|p| f.orbit([p.x, p.y, p.z], f.iterations, true))
                     .collect();
+                outside_ln_range += orbits
+                    .iter()
+                    .filter(|o| o.escaped && o.iterations > 0 && !crate::math::in_ln_range(o.r))
+                    .count();
+                let expected: Vec<String> = orbits.iter().map(|o| format!("{o:?}")).collect();
                 // Estimates too: their logarithm and division run in the registers.
                 let estimated: Vec<String> = points
                     .iter()
@@ -1551,6 +1576,8 @@ mod tests {
                 }
             }
         }
+        // The lanes whose logarithm the kernel leaves to `f64::ln` were met.
+        assert!(outside_ln_range > 0);
     }
 
     #[test]
