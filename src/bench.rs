@@ -494,49 +494,54 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
         loaded.push((timeline, work));
     }
 
-    // Thread scaling on the first scene, counts alternating low/high.
+    // Thread scaling on every scene (the zoom is a whole sequence, where
+    // start-up is shared by its frames), counts alternating low/high.
+    for (scene, (_, work)) in scenes.iter().zip(&loaded) {
+        let mut by_threads: Vec<(usize, Vec<Measurement>)> =
+            options.threads.iter().map(|&t| (t, Vec::new())).collect();
+        for run in 0..options.runs {
+            log(
+                options.quiet,
+                &format!("scaling {}: run {}/{}", scene.name, run + 1, options.runs),
+            );
+            let order: Vec<usize> = if run % 2 == 0 {
+                (0..by_threads.len()).collect()
+            } else {
+                (0..by_threads.len()).rev().collect()
+            };
+            for i in order {
+                let threads = by_threads[i].0;
+                let out = scratch
+                    .path()
+                    .join(format!("scaling-{}-{threads}", scene.name));
+                let args = render_args(&scene.timeline, &out, threads, &[]);
+                by_threads[i].1.push(timed(&exe, &args)?);
+            }
+        }
+        let one = by_threads
+            .iter()
+            .find(|(t, _)| *t == 1)
+            .map(|(_, m)| median(m.iter().map(|m| m.wall_s).collect()));
+        for (threads, runs) in by_threads {
+            let mut row = timing_row(
+                Row {
+                    scene: format!("{} (scaling)", scene.name),
+                    renderer: "mandelreel".into(),
+                    threads,
+                    ..base()
+                },
+                &runs,
+                Some(work),
+                peak,
+            );
+            if let Some(one) = one {
+                row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
+            }
+            rows.push(row);
+        }
+    }
     let first = &scenes[0];
-    let (timeline, work) = loaded.swap_remove(0);
-    let mut by_threads: Vec<(usize, Vec<Measurement>)> =
-        options.threads.iter().map(|&t| (t, Vec::new())).collect();
-    for run in 0..options.runs {
-        log(
-            options.quiet,
-            &format!("scaling: run {}/{}", run + 1, options.runs),
-        );
-        let order: Vec<usize> = if run % 2 == 0 {
-            (0..by_threads.len()).collect()
-        } else {
-            (0..by_threads.len()).rev().collect()
-        };
-        for i in order {
-            let threads = by_threads[i].0;
-            let out = scratch.path().join(format!("scaling-{threads}"));
-            let args = render_args(&first.timeline, &out, threads, &[]);
-            by_threads[i].1.push(timed(&exe, &args)?);
-        }
-    }
-    let one = by_threads
-        .iter()
-        .find(|(t, _)| *t == 1)
-        .map(|(_, m)| median(m.iter().map(|m| m.wall_s).collect()));
-    for (threads, runs) in by_threads {
-        let mut row = timing_row(
-            Row {
-                scene: format!("{} (scaling)", first.name),
-                renderer: "mandelreel".into(),
-                threads,
-                ..base()
-            },
-            &runs,
-            Some(&work),
-            peak,
-        );
-        if let Some(one) = one {
-            row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
-        }
-        rows.push(row);
-    }
+    let (timeline, _) = loaded.swap_remove(0);
 
     // The same frame rendered in this process on pools of each size: the
     // renderer's own scaling, without start-up and file writing.
@@ -962,19 +967,21 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         );
     }
     md.push_str(
-        "\n| threads | median | speed-up over 1 thread | render only (in-process) | DE iterations/s | share of FMA peak |\n",
+        "\n| scene | threads | median | speed-up over 1 thread | render only (in-process) | DE iterations/s | share of FMA peak |\n",
     );
-    md.push_str("| ---: | ---: | ---: | ---: | ---: | ---: |\n");
-    for r in rows.iter().filter(|r| r.scene.ends_with("(scaling)")) {
+    md.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: |\n");
+    for r in rows.iter().filter(|r| r.scene.ends_with(" (scaling)")) {
+        let scene = r.scene.trim_end_matches(" (scaling)");
         let render_only = rows
             .iter()
-            .find(|o| o.scene.ends_with("(render only)") && o.threads == r.threads)
+            .find(|o| o.scene == format!("{scene} (render only)") && o.threads == r.threads)
             .map_or("–".into(), |o| {
                 format!("{:.3} s, {:.2}×", o.median_s, o.scaling_vs_one_thread)
             });
         let _ = writeln!(
             md,
-            "| {} | {:.3} s | {:.2}× | {} | {:.3e} | {:.1}% |",
+            "| {} | {} | {:.3} s | {:.2}× | {} | {:.3e} | {:.1}% |",
+            scene,
             r.threads,
             r.median_s,
             r.scaling_vs_one_thread,

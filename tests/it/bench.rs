@@ -10,6 +10,9 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     std::fs::create_dir_all(d.path().join("fract")).unwrap();
     d.write("scenes/tiny.ron", &tiny_timeline(2, 7.0));
     d.write("fract/tiny.fract", "[main_parameters]\n");
+    // A second scene: scaling is measured on every scene, in-process on the first.
+    d.write("scenes/tiny_zoom.ron", &tiny_timeline(3, 8.0));
+    d.write("fract/tiny_zoom.fract", "[main_parameters]\n");
     // A z-buffer as Mandelbulber2 writes one (16-bit grey, log-scaled, 65535
     // where its ray missed), for the depth comparison.
     let zbuffer = d.path().join("zbuffer.png");
@@ -123,6 +126,21 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
         "{csv}"
     );
+    // The second scene has its own scaling rows, its own work counted.
+    let zoom_one = row("tiny_zoom (scaling)", "mandelreel", "1");
+    let zoom_two = row("tiny_zoom (scaling)", "mandelreel", "2");
+    assert_eq!(num(zoom_one, "scaling_vs_one_thread"), 1.0);
+    let expected = num(zoom_one, "median_s") / num(zoom_two, "median_s");
+    assert!((num(zoom_two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02);
+    assert_eq!(num(zoom_two, "pixels"), (48 * 27 * 3) as f64);
+    // In the table: a row per scene and count; in-process timings only for
+    // the first scene.
+    assert!(md.contains("| tiny | 2 | "), "{md}");
+    let zoom_line = md
+        .lines()
+        .find(|l| l.starts_with("| tiny_zoom | 2 | "))
+        .unwrap_or_else(|| panic!("no scaling line for tiny_zoom in\n{md}"));
+    assert!(zoom_line.contains("| – |"), "{zoom_line}");
     // The same frame rendered in-process on pools of 1 and 2 threads.
     let one = row("tiny (render only)", "mandelreel", "1");
     let two = row("tiny (render only)", "mandelreel", "2");
