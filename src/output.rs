@@ -274,14 +274,22 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
     // per cent more bytes; encoding is the one serial stage of a frame.
     encoder.set_compression(png::Compression::Fast);
     let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    // The sRGB curve (a powf per channel) runs on every thread.
+    // The sRGB curve (a powf per channel) runs on every thread, a row at a
+    // time straight into place (a flattening collect gathered per-thread
+    // lists and then copied them).
     use rayon::prelude::*;
-    let bytes: Vec<u8> = film
-        .colour
-        .par_iter()
-        .flat_map_iter(|c| [c.x, c.y, c.z])
-        .map(|v| (linear_to_srgb(v) * 255.0 + 0.5) as u8)
-        .collect();
+    let row = (film.width as usize).max(1);
+    let mut bytes = vec![0u8; film.colour.len() * 3];
+    bytes
+        .par_chunks_mut(3 * row)
+        .zip(film.colour.par_chunks(row))
+        .for_each(|(bytes, colour)| {
+            for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
+                for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
+                    *byte = (linear_to_srgb(v) * 255.0 + 0.5) as u8;
+                }
+            }
+        });
     writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
     writer.finish().map_err(|e| e.to_string())
 }
