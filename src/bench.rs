@@ -307,6 +307,27 @@ pub struct Row {
     pub hit_mismatch: Option<f64>,
 }
 
+/// Times `contenders` candidates `runs` times each, in alternating order
+/// (forwards on even runs, backwards on odd ones) so a machine that drifts
+/// favours none of them: `each_run(n)` before run n (from 1), `time(i)` for
+/// candidate i. Each candidate's timings, in the order of the candidates.
+fn alternate<T>(
+    runs: usize,
+    contenders: usize,
+    mut each_run: impl FnMut(usize),
+    mut time: impl FnMut(usize) -> Result<T>,
+) -> Result<Vec<Vec<T>>> {
+    let mut timings: Vec<Vec<T>> = (0..contenders).map(|_| Vec::new()).collect();
+    for run in 0..runs {
+        each_run(run + 1);
+        for k in 0..contenders {
+            let i = if run % 2 == 0 { k } else { contenders - 1 - k };
+            timings[i].push(time(i)?);
+        }
+    }
+    Ok(timings)
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
@@ -438,27 +459,32 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
             }
             _ => None,
         };
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        for run in 0..options.runs {
-            log(
-                options.quiet,
-                &format!("{}: run {}/{}", scene.name, run + 1, options.runs),
-            );
-            // Alternate the order so a drifting machine favours neither side.
-            let first_ours = run % 2 == 0;
-            if first_ours {
-                a.push(timed(&exe, &ours)?);
-            }
-            if let Some((program, args)) = &theirs {
-                // Mandelbulber2 skips animation frames that already exist: start empty.
-                let _ = std::fs::remove_dir_all(&out_b);
-                std::fs::create_dir_all(&out_b).map_err(|e| Error::io(&out_b, e))?;
-                b.push(timed(program, args)?);
-            }
-            if !first_ours {
-                a.push(timed(&exe, &ours)?);
-            }
-        }
+        let contenders = 1 + theirs.is_some() as usize;
+        let mut timings = alternate(
+            options.runs,
+            contenders,
+            |run| {
+                log(
+                    options.quiet,
+                    &format!("{}: run {run}/{}", scene.name, options.runs),
+                )
+            },
+            |i| match (i, &theirs) {
+                (1, Some((program, args))) => {
+                    // Mandelbulber2 skips animation frames that already exist: start empty.
+                    let _ = std::fs::remove_dir_all(&out_b);
+                    std::fs::create_dir_all(&out_b).map_err(|e| Error::io(&out_b, e))?;
+                    timed(program, args)
+                }
+                _ => timed(&exe, &ours),
+            },
+        )?;
+        let b = if contenders > 1 {
+            timings.pop().unwrap_or_default()
+        } else {
+            Vec::new()
+        };
+        let a = timings.pop().unwrap_or_default();
         let mut ours_row = timing_row(
             Row {
                 scene: scene.name.clone(),
@@ -497,27 +523,23 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     // Thread scaling on every scene (the zoom is a whole sequence, where
     // start-up is shared by its frames), counts alternating low/high.
     for (scene, (_, work)) in scenes.iter().zip(&loaded) {
-        let mut by_threads: Vec<(usize, Vec<Measurement>)> =
-            options.threads.iter().map(|&t| (t, Vec::new())).collect();
-        for run in 0..options.runs {
-            log(
-                options.quiet,
-                &format!("scaling {}: run {}/{}", scene.name, run + 1, options.runs),
-            );
-            let order: Vec<usize> = if run % 2 == 0 {
-                (0..by_threads.len()).collect()
-            } else {
-                (0..by_threads.len()).rev().collect()
-            };
-            for i in order {
-                let threads = by_threads[i].0;
+        let timings = alternate(
+            options.runs,
+            options.threads.len(),
+            |run| {
+                let line = format!("scaling {}: run {run}/{}", scene.name, options.runs);
+                log(options.quiet, &line)
+            },
+            |i| {
+                let threads = options.threads[i];
                 let out = scratch
                     .path()
                     .join(format!("scaling-{}-{threads}", scene.name));
-                let args = render_args(&scene.timeline, &out, threads, &[]);
-                by_threads[i].1.push(timed(&exe, &args)?);
-            }
-        }
+                timed(&exe, &render_args(&scene.timeline, &out, threads, &[]))
+            },
+        )?;
+        let by_threads: Vec<(usize, Vec<Measurement>)> =
+            options.threads.iter().copied().zip(timings).collect();
         let one = by_threads
             .iter()
             .find(|(t, _)| *t == 1)
@@ -614,23 +636,21 @@ fn render_only_rows(
             Some((t, pool))
         })
         .collect();
-    let mut walls: Vec<Vec<f64>> = vec![Vec::new(); pools.len()];
     let mut counts = FrameStats::default();
-    for run in 0..options.runs {
-        let order: Vec<usize> = if run % 2 == 0 {
-            (0..pools.len()).collect()
-        } else {
-            (0..pools.len()).rev().collect()
-        };
-        for i in order {
+    let walls = alternate(
+        options.runs,
+        pools.len(),
+        |_| {},
+        |i| -> Result<f64> {
             let start = Instant::now();
             let film = pools[i]
                 .1
                 .install(|| crate::render::render_frame(&frame, 0, w, h, &|| {}));
-            walls[i].push(start.elapsed().as_secs_f64());
             counts = film.stats;
-        }
-    }
+            Ok(start.elapsed().as_secs_f64())
+        },
+    )
+    .expect("an in-process timing has no error to return");
     let medians: Vec<f64> = walls.iter().map(|w| median(w.clone())).collect();
     let one = pools.iter().position(|(t, _)| *t == 1).map(|i| medians[i]);
     let frames = Work {
@@ -1087,6 +1107,37 @@ pub fn default_machine_name(peak: &Peak) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn alternate_reverses_the_order_every_other_run() {
+        let (mut calls, mut runs) = (Vec::new(), Vec::new());
+        let timings = alternate(
+            3,
+            3,
+            |run| runs.push(run),
+            |i| {
+                calls.push(i);
+                Ok(calls.len())
+            },
+        )
+        .unwrap();
+        assert_eq!(runs, [1, 2, 3]);
+        assert_eq!(calls, [0, 1, 2, 2, 1, 0, 0, 1, 2]);
+        // Each candidate's timings, in call order: 0 was called 1st, 6th, 7th.
+        assert_eq!(timings, [vec![1, 6, 7], vec![2, 5, 8], vec![3, 4, 9]]);
+        // An error stops the timing.
+        assert!(alternate(
+            2,
+            2,
+            |_| {},
+            |i| if i == 1 {
+                Err(Error::usage("x", "y"))
+            } else {
+                Ok(i)
+            }
+        )
+        .is_err());
+    }
 
     #[test]
     fn a_mandelbulber_zbuffer_fits_back_to_its_depths() {
