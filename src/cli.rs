@@ -200,8 +200,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub claim: bool,
     /// Seconds without a heartbeat after which another worker takes a claimed frame over.
-    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
-    pub claim_timeout: f64,
+    #[arg(long, default_value = "300", value_name = "SECONDS", value_parser = positive_seconds)]
+    pub claim_timeout: std::time::Duration,
     /// Frames of several sample waves save their progress this often, so a killed
     /// render resumes them mid-frame (0 = after every wave).
     #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
@@ -216,8 +216,8 @@ pub struct StatusArgs {
     #[command(flatten)]
     pub sequence: SequenceArgs,
     /// Seconds without a heartbeat after which a claim counts as abandoned.
-    #[arg(long, default_value_t = 300.0, value_name = "SECONDS")]
-    pub claim_timeout: f64,
+    #[arg(long, default_value = "300", value_name = "SECONDS", value_parser = positive_seconds)]
+    pub claim_timeout: std::time::Duration,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
@@ -575,6 +575,16 @@ impl Plan {
     }
 }
 
+/// A positive, finite number of seconds (`--claim-timeout`).
+fn positive_seconds(text: &str) -> std::result::Result<std::time::Duration, String> {
+    match text.trim().parse::<f64>() {
+        Ok(s) if s.is_finite() && s > 0.0 && s < 1e12 => Ok(std::time::Duration::from_secs_f64(s)),
+        _ => Err(format!(
+            "must be a positive number of seconds, got {text:?}"
+        )),
+    }
+}
+
 /// Samples per pixel in one wave: about 16 waves a frame, so a long frame
 /// can be checkpointed between them.
 fn wave_size(samples_per_pixel: u32) -> u32 {
@@ -639,10 +649,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|s| parse_shard(s, &|k| std::env::var(k).ok()))
         .transpose()?;
-    if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {
-        return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());
-    }
-    let claim_timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
+    let claim_timeout = args.claim_timeout;
     if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds >= 0.0) {
         return Err(Error::usage(
             "--checkpoint-seconds",
@@ -894,10 +901,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     } else {
         Plan::new(&args.target, &args.sequence)?
     };
-    if !(args.claim_timeout.is_finite() && args.claim_timeout > 0.0) {
-        return Err(Error::usage("--claim-timeout", "must be a positive number of seconds").into());
-    }
-    let timeout = std::time::Duration::from_secs_f64(args.claim_timeout);
+    let timeout = args.claim_timeout;
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<&str, Vec<u32>> = Default::default();

@@ -124,6 +124,15 @@ fn bad_flags_exit_with_usage_code_and_write_nothing() {
     );
     rejected(&tiny_timeline(2, 6.0), &["--size", "0x10"], 2, &["--size"]);
     rejected(&tiny_timeline(2, 6.0), &["--format", "jpg"], 2, &["jpg"]);
+    for bad in ["0", "-1", "inf", "soon"] {
+        let flag = format!("--claim-timeout={bad}");
+        rejected(
+            &tiny_timeline(2, 6.0),
+            &[&flag],
+            2,
+            &["--claim-timeout", "positive"],
+        );
+    }
 }
 
 #[test]
