@@ -862,8 +862,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 }
 
 /// The state of one frame in an output folder.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum FrameState {
     /// Every format exists and carries the current hash.
     Complete,
@@ -874,6 +873,28 @@ pub enum FrameState {
     /// A checkpoint holds part of its samples: a render will continue it.
     Resumable,
     Missing,
+}
+
+impl FrameState {
+    /// Every state, in the order `status` lists them.
+    const ALL: [FrameState; 5] = [
+        FrameState::Complete,
+        FrameState::InProgress,
+        FrameState::Resumable,
+        FrameState::Stale,
+        FrameState::Missing,
+    ];
+
+    /// The state's name in `status --json` (`in progress` in the text).
+    pub fn name(self) -> &'static str {
+        match self {
+            FrameState::Complete => "complete",
+            FrameState::Stale => "stale",
+            FrameState::InProgress => "in_progress",
+            FrameState::Resumable => "resumable",
+            FrameState::Missing => "missing",
+        }
+    }
 }
 
 /// `0-3, 7, 9-12` for sorted frame numbers.
@@ -904,7 +925,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     let timeout = args.claim_timeout;
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
-    let mut by_state: std::collections::BTreeMap<&str, Vec<u32>> = Default::default();
+    let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
     let mut workers = std::collections::BTreeSet::new();
     for frame in plan.range.clone() {
         let (_, hash) = plan.frame(frame);
@@ -925,17 +946,10 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         } else {
             FrameState::Missing
         };
-        let key = match state {
-            FrameState::Complete => "complete",
-            FrameState::Stale => "stale",
-            FrameState::InProgress => "in_progress",
-            FrameState::Resumable => "resumable",
-            FrameState::Missing => "missing",
-        };
-        by_state.entry(key).or_default().push(frame);
+        by_state.entry(state).or_default().push(frame);
     }
     let total = plan.range.len();
-    let complete = by_state.get("complete").map_or(0, Vec::len);
+    let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
     let changed = std::fs::read_to_string(&plan.timeline.source)
         .ok()
         .zip(output::JobRecord::read(&plan.out_dir).ok())
@@ -948,7 +962,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             frames: (u32, u32),
             total: usize,
             complete: usize,
-            states: &'a std::collections::BTreeMap<&'a str, Vec<u32>>,
+            states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
             workers: Vec<String>,
             timeline_changed_since_render: bool,
         }
@@ -960,7 +974,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 frames: (plan.range.start, plan.range.end),
                 total,
                 complete,
-                states: &by_state,
+                states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
                 workers: workers.iter().cloned().collect(),
                 timeline_changed_since_render: changed,
             })?
@@ -975,11 +989,11 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             plan.width,
             plan.height
         );
-        for key in ["complete", "in_progress", "resumable", "stale", "missing"] {
-            if let Some(frames) = by_state.get(key) {
+        for state in FrameState::ALL {
+            if let Some(frames) = by_state.get(&state) {
                 println!(
                     "  {:<12} {:>6}  {}",
-                    key.replace('_', " "),
+                    state.name().replace('_', " "),
                     frames.len(),
                     ranges(frames)
                 );
