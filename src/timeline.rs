@@ -619,6 +619,30 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             Err((field.to_string(), message()))
         }
     }
+    // The three checks most fields need, each with one wording.
+    fn positive<T: Into<f64> + Copy + std::fmt::Display>(
+        v: T,
+        field: &str,
+    ) -> Result<(), (String, String)> {
+        let x: f64 = v.into();
+        check(x.is_finite() && x > 0.0, field, || {
+            format!("must be positive, got {v}")
+        })
+    }
+    fn non_negative<T: Into<f64> + Copy + std::fmt::Display>(
+        v: T,
+        field: &str,
+    ) -> Result<(), (String, String)> {
+        let x: f64 = v.into();
+        check(x.is_finite() && x >= 0.0, field, || {
+            format!("must be non-negative, got {v}")
+        })
+    }
+    fn colour(c: Vec3, field: &str) -> Result<(), (String, String)> {
+        check(c.is_finite() && c.min_element() >= 0.0, field, || {
+            format!("colours must be finite and non-negative, got {c}")
+        })
+    }
     let finite3 = |v: DVec3| v.is_finite();
     let c = &s.camera;
     for (field, v) in [
@@ -647,9 +671,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         },
     )?;
     if let Some(f) = c.focus_distance {
-        check(f.is_finite() && f > 0.0, "camera.focus_distance", || {
-            format!("must be positive, got {f}")
-        })?;
+        positive(f, "camera.focus_distance")?;
     }
     let view = c.target - c.position;
     // Below a few ulps of the coordinates the view direction is noise.
@@ -713,9 +735,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         ("quality.normal_step", q.normal_step),
         ("quality.bounding_radius", q.bounding_radius),
     ] {
-        check(v.is_finite() && v > 0.0, field, || {
-            format!("must be a positive number, got {v}")
-        })?;
+        positive(v, field)?;
     }
     check(
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
@@ -758,9 +778,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         ("look.background_top", l.background_top),
         ("look.background_bottom", l.background_bottom),
     ] {
-        check(v.is_finite() && v.min_element() >= 0.0, field, || {
-            format!("colours must be finite and non-negative, got {v}")
-        })?;
+        colour(v, field)?;
     }
     check(
         l.trap_occlusion.is_finite() && (0.0..=1.0).contains(&l.trap_occlusion),
@@ -817,11 +835,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             "effects.ambient_occlusion.samples",
             || format!("must be 1..=64, got {}", ao.samples),
         )?;
-        check(
-            ao.radius.is_finite() && ao.radius > 0.0,
-            "effects.ambient_occlusion.radius",
-            || format!("must be positive, got {}", ao.radius),
-        )?;
+        positive(ao.radius, "effects.ambient_occlusion.radius")?;
         check(
             ao.strength.is_finite() && (0.0..=1.0).contains(&ao.strength),
             "effects.ambient_occlusion.strength",
@@ -829,33 +843,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         )?;
     }
     if let Some(sp) = &e.specular {
-        check(
-            sp.strength.is_finite() && sp.strength >= 0.0,
-            "effects.specular.strength",
-            || format!("must be non-negative, got {}", sp.strength),
-        )?;
-        check(
-            sp.shininess.is_finite() && sp.shininess > 0.0,
-            "effects.specular.shininess",
-            || format!("must be positive, got {}", sp.shininess),
-        )?;
+        non_negative(sp.strength, "effects.specular.strength")?;
+        positive(sp.shininess, "effects.specular.shininess")?;
     }
     if let Some(fog) = &e.fog {
-        check(
-            fog.density.is_finite() && fog.density >= 0.0,
-            "effects.fog.density",
-            || format!("must be non-negative, got {}", fog.density),
-        )?;
-        check(
-            fog.colour.is_finite() && fog.colour.min_element() >= 0.0,
-            "effects.fog.colour",
-            || {
-                format!(
-                    "colours must be finite and non-negative, got {}",
-                    fog.colour
-                )
-            },
-        )?;
+        non_negative(fog.density, "effects.fog.density")?;
+        colour(fog.colour, "effects.fog.colour")?;
     }
     if let Some(pt) = &e.path_tracing {
         check(
@@ -875,11 +868,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             "effects.path_tracing.sun_angle_degrees",
             || format!("must be 0..=30, got {}", pt.sun_angle_degrees),
         )?;
-        check(
-            pt.sky_intensity.is_finite() && pt.sky_intensity >= 0.0,
-            "effects.path_tracing.sky_intensity",
-            || format!("must be non-negative, got {}", pt.sky_intensity),
-        )?;
+        non_negative(pt.sky_intensity, "effects.path_tracing.sky_intensity")?;
         match pt.sky {
             crate::shade::Sky::Constant(c) => check(
                 c.is_finite() && c.min_element() >= 0.0,
@@ -902,21 +891,9 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         )?;
     }
     if let Some(g) = &e.glow {
-        check(
-            g.strength.is_finite() && g.strength >= 0.0,
-            "effects.glow.strength",
-            || format!("must be non-negative, got {}", g.strength),
-        )?;
-        check(
-            g.width.is_finite() && g.width > 0.0,
-            "effects.glow.width",
-            || format!("must be positive, got {}", g.width),
-        )?;
-        check(
-            g.colour.is_finite() && g.colour.min_element() >= 0.0,
-            "effects.glow.colour",
-            || format!("colours must be finite and non-negative, got {}", g.colour),
-        )?;
+        non_negative(g.strength, "effects.glow.strength")?;
+        positive(g.width, "effects.glow.width")?;
+        colour(g.colour, "effects.glow.colour")?;
     }
     Ok(())
 }
@@ -1086,6 +1063,55 @@ mod tests {
         );
         let e = error_of("(fps: inf, frames: 3, size: (8, 6))");
         assert!(e.contains("fps"), "{e}");
+    }
+
+    #[test]
+    fn out_of_range_values_name_their_field_and_the_rule() {
+        for (scene, field, rule) in [
+            (
+                "quality: (hit_threshold: 0)",
+                "quality.hit_threshold",
+                "must be positive",
+            ),
+            (
+                "camera: (focus_distance: Some(-2))",
+                "camera.focus_distance",
+                "must be positive",
+            ),
+            (
+                "effects: (fog: (density: -1))",
+                "effects.fog.density",
+                "must be non-negative",
+            ),
+            (
+                "effects: (specular: (shininess: 0))",
+                "effects.specular.shininess",
+                "must be positive",
+            ),
+            (
+                "effects: (glow: (width: inf))",
+                "effects.glow.width",
+                "must be positive",
+            ),
+            (
+                "effects: (glow: (colour: (1, -0.5, 0)))",
+                "effects.glow.colour",
+                "colours must be finite and non-negative",
+            ),
+            (
+                "look: (ambient: (0, NaN, 0))",
+                "look.ambient",
+                "colours must be finite",
+            ),
+        ] {
+            let e = error_of(&format!(
+                "(fps: 24, frames: 3, size: (8, 6), scene: ({scene}))"
+            ));
+            assert!(
+                e.contains(&format!("scene.{field}")) && e.contains(rule),
+                "{scene}: {e}"
+            );
+        }
     }
 
     #[test]
