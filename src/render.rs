@@ -8,7 +8,7 @@
 use crate::march::{march_many, normal, walk_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
-use crate::shade::{fogged, glow, trace_path, StageCounts, SurfacePoint};
+use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
 use rayon::prelude::*;
 
 /// Depth written for pixels that see only background.
@@ -523,6 +523,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         walks,
         shadows,
         first_shadow,
+        paths,
     } = &mut scratch;
     marched.resize(w, MarchResult::default());
     for s in frame.samples.clone() {
@@ -566,15 +567,35 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             });
         }
         first_shadow.push(shadows.len());
+        // The row's path-traced samples, a bounce at a time side by side.
+        let traced = match &scene.effects.path_tracing {
+            Some(pt) => {
+                let starts: Vec<Option<SurfacePoint>> =
+                    surfaces.iter().map(|(at, _)| *at).collect();
+                let random =
+                    |x: usize, d: u32| sample_1d(scene.seed, frame_index, (y * w + x) as u64, s, d);
+                crate::shade::trace_paths(
+                    &scene.look,
+                    pt,
+                    &scene.fractal,
+                    &scene.quality,
+                    &starts,
+                    camera.up,
+                    frame.environment.as_deref(),
+                    &random,
+                    paths,
+                );
+                &paths.out[..]
+            }
+            None => &[][..],
+        };
         for (x, ((ray, result), (at, surface_cost))) in rays
             .iter()
             .zip(marched.iter())
             .zip(surfaces.iter())
             .enumerate()
         {
-            let pixel = (y * w + x) as u64;
             let before = stats.stage_total();
-            let random = |d: u32| sample_1d(scene.seed, frame_index, pixel, s, d);
             let mut outcomes = first_shadow
                 .get(x..x + 2)
                 .map_or(&[][..], |range| &shadows[range[0]..range[1]])
@@ -586,10 +607,10 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 result,
                 at.as_ref(),
                 &mut outcomes,
+                traced.get(x).copied(),
                 camera.up,
                 scale,
                 frame.environment.as_deref(),
-                &random,
                 &mut stats,
             );
             if let Some(&SurfacePoint {
@@ -648,6 +669,8 @@ struct RowScratch {
     walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     shadows: Vec<(f32, u64)>,
     first_shadow: Vec<usize>,
+    /// The row's path-traced samples, traced together.
+    paths: crate::shade::PathScratch,
 }
 
 thread_local! {
@@ -696,8 +719,9 @@ fn surface(
 
 /// The radiance of one camera sample, which met the surface at `at` or
 /// nothing. Shadow rays' outcomes come from `shadows` (see
-/// `Look::shade_with`). Only the stages of the scene's enabled effects run;
-/// `stats` counts each.
+/// `Look::shade_with`); a path-traced sample's light and counts from
+/// `traced` (see `trace_paths`). Only the stages of the scene's enabled
+/// effects run; `stats` counts each.
 #[allow(clippy::too_many_arguments)]
 fn trace(
     scene: &Scene,
@@ -705,10 +729,10 @@ fn trace(
     result: &MarchResult,
     at: Option<&SurfacePoint>,
     shadows: &mut dyn Iterator<Item = (f32, u64)>,
+    traced: Option<(Vec3, StageCounts)>,
     up: crate::math::DVec3,
     scale: Real,
     environment: Option<&crate::environment::EnvironmentMap>,
-    random: &dyn Fn(u32) -> Real,
     stats: &mut FrameStats,
 ) -> Vec3 {
     let Some(at) = at else {
@@ -724,17 +748,11 @@ fn trace(
     };
     let mut stages = StageCounts::default();
     let lit = match &scene.effects.path_tracing {
-        Some(pt) => trace_path(
-            &scene.look,
-            pt,
-            &scene.fractal,
-            &scene.quality,
-            at,
-            up,
-            environment,
-            random,
-            &mut stages,
-        ),
+        Some(_) => {
+            let (radiance, counts) = traced.expect("a path-traced row traces every hit");
+            stages = counts;
+            radiance
+        }
         None => scene
             .look
             .shade_with(&scene.effects, &scene.fractal, at, &mut stages, shadows),

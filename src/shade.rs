@@ -712,6 +712,7 @@ pub fn preetham(dir: DVec3, to_sun: DVec3, turbidity: Real) -> Vec3 {
 
 /// Radiance of a path-traced camera sample that hit `at`. `random(d)` is the
 /// sample's d-th uniform number (deterministic per pixel and sample).
+/// `trace_paths` for one path.
 #[allow(clippy::too_many_arguments)] // the sample's whole context, passed plainly
 pub fn trace_path(
     look: &Look,
@@ -724,104 +725,216 @@ pub fn trace_path(
     random: &dyn Fn(u32) -> Real,
     counts: &mut StageCounts,
 ) -> Vec3 {
-    use crate::march::{march, normal, Ray};
+    let mut traced = PathScratch::default();
+    trace_paths(
+        look,
+        pt,
+        fractal,
+        settings,
+        &[Some(*at)],
+        up,
+        environment,
+        &|_, d| random(d),
+        &mut traced,
+    );
+    let (radiance, stages) = traced.out[0];
+    counts.bounces += stages.bounces;
+    counts.sun_rays += stages.sun_rays;
+    radiance
+}
+
+/// Buffers of `trace_paths`, kept by the caller from row to row: the
+/// result per path (radiance and the estimates it took) in `out`.
+#[derive(Default)]
+pub struct PathScratch {
+    pub out: Vec<(Vec3, StageCounts)>,
+    paths: Vec<Path>,
+    rays: Vec<crate::march::Ray>,
+    /// What each shadow ray brings if it gets through, and to which path.
+    gains: Vec<(usize, Vec3)>,
+    marched: Vec<crate::march::MarchResult>,
+}
+
+/// One path between bounces.
+#[derive(Clone, Copy)]
+struct Path {
+    here: SurfacePoint,
+    throughput: Vec3,
+    alive: bool,
+}
+
+/// Path-traced radiance of every camera sample of `starts` that hit (`None`
+/// gives black and no work), into `scratch.out` in the same order. The
+/// paths advance together a bounce at a time, so each bounce's shadow and
+/// bounce rays march side by side (`march_many`); every path takes exactly
+/// the steps, random numbers (`random(path, d)`) and additions it would
+/// alone, so its radiance and counts are the same to the bit.
+#[allow(clippy::too_many_arguments)] // the samples' whole context, passed plainly
+pub fn trace_paths(
+    look: &Look,
+    pt: &PathTracing,
+    fractal: &Fractal,
+    settings: &MarchSettings,
+    starts: &[Option<SurfacePoint>],
+    up: DVec3,
+    environment: Option<&crate::environment::EnvironmentMap>,
+    random: &dyn Fn(usize, u32) -> Real,
+    scratch: &mut PathScratch,
+) {
+    use crate::march::{march_many, normal, MarchResult, Ray};
     let rotation = pt.sky.rotation();
     // Multiple importance sampling (power heuristic) between the map's own
     // sampling and the cosine-weighted bounce, when the sky is a map.
     let power = |a: Real, b: Real| a * a / (a * a + b * b);
     let sun_half_angle = 0.5 * pt.sun_angle_degrees.to_radians();
     let sky_scale = pt.sky_intensity;
-    let mut radiance = Vec3::ZERO;
-    let mut throughput = Vec3::ONE;
-    let mut here = *at;
+    let PathScratch {
+        out,
+        paths,
+        rays,
+        gains,
+        marched,
+    } = scratch;
+    out.clear();
+    out.resize(starts.len(), (Vec3::ZERO, StageCounts::default()));
+    paths.clear();
+    paths.extend(starts.iter().map(|at| Path {
+        here: at.unwrap_or(SurfacePoint {
+            point: DVec3::ZERO,
+            normal: DVec3::Y,
+            view_dir: DVec3::Y,
+            t: 0.0,
+            footprint: 0.0,
+            traps: crate::fractal::Estimate::IDLE.traps,
+        }),
+        throughput: Vec3::ONE,
+        alive: at.is_some(),
+    }));
+    let leave = |here: &SurfacePoint, dir: DVec3| Ray {
+        origin: here.point + here.normal * (2.0 * here.footprint),
+        dir,
+        pixel_angle: 0.0,
+        start_footprint: here.footprint,
+    };
+    let march_all = |rays: &[Ray], marched: &mut Vec<MarchResult>| {
+        marched.clear();
+        marched.resize(rays.len(), MarchResult::default());
+        march_many(rays, fractal, settings, marched);
+    };
     let bounces = pt.max_bounces.max(1);
     for bounce in 0..bounces {
+        if !paths.iter().any(|p| p.alive) {
+            break;
+        }
         // Dimensions 0–3 belong to the pixel and lens; 32 per bounce after that:
         // 0–2 the bounce and roulette, then two per light.
-        let dim = |k: u32| random(4 + 32 * bounce + k);
-        let albedo = look.albedo(&here.traps);
-        let leave = |dir: DVec3| Ray {
-            origin: here.point + here.normal * (2.0 * here.footprint),
-            dir,
-            pixel_angle: 0.0,
-            start_footprint: here.footprint,
-        };
-        // Next-event estimation: one ray towards a point on each light's disc.
-        for (i, (to_light, brightness)) in look.lights().enumerate() {
-            let k = 3 + 2 * i as u32;
-            let dir = if sun_half_angle > 0.0 {
-                cone_direction(to_light, sun_half_angle, dim(k), dim(k + 1))
-            } else {
-                to_light
-            };
-            let cos_light = here.normal.dot(dir);
-            if cos_light > 0.0 {
-                let shadow = march(&leave(dir), fractal, settings);
-                counts.sun_rays += shadow.evaluations as u64;
-                if shadow.hit.is_none() {
+        let dim = |path: usize, k: u32| random(path, 4 + 32 * bounce + k);
+        // Next-event estimation: one ray towards a point on each light's disc,
+        // then the map's light, sampled where it is bright; each adds what it
+        // brings where nothing blocks it, in that order.
+        rays.clear();
+        gains.clear();
+        for (i, path) in paths.iter().enumerate().filter(|(_, p)| p.alive) {
+            let here = &path.here;
+            let albedo = look.albedo(&here.traps);
+            for (l, (to_light, brightness)) in look.lights().enumerate() {
+                let k = 3 + 2 * l as u32;
+                let dir = if sun_half_angle > 0.0 {
+                    cone_direction(to_light, sun_half_angle, dim(i, k), dim(i, k + 1))
+                } else {
+                    to_light
+                };
+                let cos_light = here.normal.dot(dir);
+                if cos_light > 0.0 {
                     // Lambert: albedo/π × irradiance × cos θ, with the irradiance
                     // spread over π so an albedo-1 plane facing the light returns it.
-                    radiance += throughput * albedo * brightness * cos_light as f32;
+                    rays.push(leave(here, dir));
+                    gains.push((i, path.throughput * albedo * brightness * cos_light as f32));
+                }
+            }
+            if let Some(map) = environment {
+                let k = 3 + 2 * MAX_LIGHTS as u32;
+                let (dir, pdf) = map.sample(
+                    dim(i, k),
+                    dim(i, k + 1),
+                    (dim(i, k + 2), dim(i, k + 3)),
+                    rotation,
+                );
+                let cos = here.normal.dot(dir);
+                if cos > 0.0 && pdf > 0.0 {
+                    let weight = power(pdf, cos / std::f64::consts::PI);
+                    let scale = (cos / std::f64::consts::PI / pdf * weight) as f32;
+                    rays.push(leave(here, dir));
+                    gains.push((
+                        i,
+                        path.throughput
+                            * albedo
+                            * map.radiance(dir, rotation)
+                            * (sky_scale * scale),
+                    ));
                 }
             }
         }
-        // The map's light, sampled where it is bright.
-        if let Some(map) = environment {
-            let k = 3 + 2 * MAX_LIGHTS as u32;
-            let (dir, pdf) = map.sample(dim(k), dim(k + 1), (dim(k + 2), dim(k + 3)), rotation);
-            let cos = here.normal.dot(dir);
-            if cos > 0.0 && pdf > 0.0 {
-                let shadow = march(&leave(dir), fractal, settings);
-                counts.sun_rays += shadow.evaluations as u64;
-                if shadow.hit.is_none() {
-                    let weight = power(pdf, cos / std::f64::consts::PI);
-                    let scale = (cos / std::f64::consts::PI / pdf * weight) as f32;
-                    radiance +=
-                        throughput * albedo * map.radiance(dir, rotation) * (sky_scale * scale);
-                }
+        march_all(rays, marched);
+        for (&(i, gain), shadow) in gains.iter().zip(marched.iter()) {
+            out[i].1.sun_rays += shadow.evaluations as u64;
+            if shadow.hit.is_none() {
+                out[i].0 += gain;
             }
         }
         // Bounce: cosine-weighted, so the throughput only takes the albedo.
-        let dir = cosine_direction(here.normal, dim(0), dim(1));
-        throughput *= albedo;
-        let ray = leave(dir);
-        let result = march(&ray, fractal, settings);
-        counts.bounces += result.evaluations as u64;
-        let Some(hit) = result.hit else {
-            let sky = match environment {
-                Some(map) => {
-                    let cos_pdf = here.normal.dot(dir).max(0.0) / std::f64::consts::PI;
-                    map.radiance(dir, rotation) * power(cos_pdf, map.pdf(dir, rotation)) as f32
-                }
-                None => pt.sky.radiance(look, dir, up, None),
+        rays.clear();
+        gains.clear();
+        for (i, path) in paths.iter_mut().enumerate().filter(|(_, p)| p.alive) {
+            let dir = cosine_direction(path.here.normal, dim(i, 0), dim(i, 1));
+            path.throughput *= look.albedo(&path.here.traps);
+            rays.push(leave(&path.here, dir));
+            gains.push((i, Vec3::ZERO));
+        }
+        march_all(rays, marched);
+        for ((&(i, _), ray), result) in gains.iter().zip(rays.iter()).zip(marched.iter()) {
+            let path = &mut paths[i];
+            let (radiance, counts) = &mut out[i];
+            counts.bounces += result.evaluations as u64;
+            let Some(hit) = result.hit else {
+                let dir = ray.dir;
+                let sky = match environment {
+                    Some(map) => {
+                        let cos_pdf = path.here.normal.dot(dir).max(0.0) / std::f64::consts::PI;
+                        map.radiance(dir, rotation) * power(cos_pdf, map.pdf(dir, rotation)) as f32
+                    }
+                    None => pt.sky.radiance(look, dir, up, None),
+                };
+                *radiance += path.throughput * sky * sky_scale;
+                path.alive = false;
+                continue;
             };
-            radiance += throughput * sky * sky_scale;
-            break;
-        };
-        if bounce + 1 == bounces {
-            break; // the path ends here: its hit needs no normal
-        }
-        // Russian roulette from the third bounce: unbiased, and paths that
-        // carry little light end early.
-        if bounce >= 2 {
-            let survive = throughput.max_element().clamp(0.05, 0.95);
-            if dim(2) as f32 >= survive {
-                break;
+            if bounce + 1 == bounces {
+                path.alive = false; // the path ends here: its hit needs no normal
+                continue;
             }
-            throughput /= survive;
+            // Russian roulette from the third bounce: unbiased, and paths that
+            // carry little light end early.
+            if bounce >= 2 {
+                let survive = path.throughput.max_element().clamp(0.05, 0.95);
+                if dim(i, 2) as f32 >= survive {
+                    path.alive = false;
+                    continue;
+                }
+                path.throughput /= survive;
+            }
+            let (nrm, spent) = normal(ray, &hit, fractal, settings);
+            counts.bounces += spent as u64;
+            path.here = SurfacePoint {
+                point: hit.point,
+                normal: nrm,
+                view_dir: ray.dir,
+                t: path.here.t + hit.t,
+                footprint: ray.footprint(hit.t),
+                traps: hit.estimate.traps,
+            };
         }
-        let (nrm, spent) = normal(&ray, &hit, fractal, settings);
-        counts.bounces += spent as u64;
-        here = SurfacePoint {
-            point: hit.point,
-            normal: nrm,
-            view_dir: dir,
-            t: here.t + hit.t,
-            footprint: ray.footprint(hit.t),
-            traps: hit.estimate.traps,
-        };
     }
-    radiance
 }
 
 /// Fog over a hit `distance` away, with `scale` the camera–target distance.
@@ -841,6 +954,24 @@ pub fn glow(glow: &Glow, closest: Real) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Where `ray` meets the surface, as shading takes it.
+    fn surface_at(
+        ray: &crate::march::Ray,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<SurfacePoint> {
+        let hit = crate::march::march(ray, fractal, settings).hit?;
+        let (normal, _) = crate::march::normal(ray, &hit, fractal, settings);
+        Some(SurfacePoint {
+            point: hit.point,
+            normal,
+            view_dir: ray.dir,
+            t: hit.t,
+            footprint: ray.footprint(hit.t),
+            traps: hit.estimate.traps,
+        })
+    }
 
     fn unit_ball() -> Fractal {
         Fractal::unit_ball()
@@ -878,16 +1009,7 @@ mod tests {
                     pixel_angle: 1e-3,
                     start_footprint: 0.0,
                 };
-                let hit = crate::march::march(&ray, &fractal, &settings).hit?;
-                let (normal, _) = crate::march::normal(&ray, &hit, &fractal, &settings);
-                Some(SurfacePoint {
-                    point: hit.point,
-                    normal,
-                    view_dir: ray.dir,
-                    t: hit.t,
-                    footprint: ray.footprint(hit.t),
-                    traps: hit.estimate.traps,
-                })
+                surface_at(&ray, &fractal, &settings)
             })
             .collect();
         let walks: Vec<_> = points
@@ -1067,17 +1189,8 @@ mod tests {
                 pixel_angle: 1e-3,
                 start_footprint: 0.0,
             };
-            let Some(hit) = crate::march::march(&ray, fractal, &settings).hit else {
+            let Some(at) = surface_at(&ray, fractal, &settings) else {
                 continue;
-            };
-            let (n, _) = crate::march::normal(&ray, &hit, fractal, &settings);
-            let at = SurfacePoint {
-                point: hit.point,
-                normal: n,
-                view_dir: ray.dir,
-                t: hit.t,
-                footprint: ray.footprint(hit.t),
-                traps: hit.estimate.traps,
             };
             let random = |d: u32| crate::math::sample_1d(5, 2, i, 0, d);
             total += trace_path(
@@ -1096,6 +1209,95 @@ mod tests {
         }
         assert!(taken > samples / 2);
         total / taken as f64
+    }
+
+    #[test]
+    fn paths_traced_together_match_paths_traced_alone() {
+        // A row of camera samples on the bulb (misses among them), traced side
+        // by side and one at a time: every radiance and count to the bit, with
+        // a sun and an extra light, and with an uneven environment map too.
+        let fractal = Fractal::default();
+        let settings = MarchSettings::default();
+        let look = Look {
+            extra_lights: vec![Light {
+                direction: DVec3::new(-1.0, 0.3, 0.2),
+                colour: Vec3::new(0.4, 0.5, 0.9),
+                intensity: 0.7,
+            }],
+            ..Look::default()
+        };
+        let starts: Vec<Option<SurfacePoint>> = (0..48)
+            .map(|i| {
+                let x = i as Real / 48.0 * 2.4 - 1.2;
+                let ray = crate::march::Ray {
+                    origin: DVec3::new(x, 0.3, 2.6),
+                    dir: DVec3::new(0.0, -0.1, -1.0).normalize(),
+                    pixel_angle: 2e-3,
+                    start_footprint: 0.0,
+                };
+                surface_at(&ray, &fractal, &settings)
+            })
+            .collect();
+        assert!(
+            starts.iter().any(Option::is_none)
+                && starts.iter().filter(|s| s.is_some()).count() > 20
+        );
+        let pixels: Vec<Vec3> = (0..128)
+            .map(|i| Vec3::new(0.2 + (i % 7) as f32, 0.5, 0.1 * (i / 16) as f32))
+            .collect();
+        let map = crate::environment::EnvironmentMap::from_pixels(16, 8, pixels);
+        for environment in [None, Some(&map)] {
+            let pt = PathTracing {
+                max_bounces: 6,
+                ..PathTracing::default()
+            };
+            let random = |path: usize, d: u32| crate::math::sample_1d(3, 7, path as u64, 0, d);
+            let mut together = PathScratch::default();
+            trace_paths(
+                &look,
+                &pt,
+                &fractal,
+                &settings,
+                &starts,
+                DVec3::Y,
+                environment,
+                &random,
+                &mut together,
+            );
+            let mut bounced = 0;
+            for (i, start) in starts.iter().enumerate() {
+                let (radiance, counts) = together.out[i];
+                let Some(at) = start else {
+                    assert_eq!(radiance, Vec3::ZERO);
+                    assert_eq!(counts.bounces + counts.sun_rays, 0);
+                    continue;
+                };
+                let mut alone = StageCounts::default();
+                let single = trace_path(
+                    &look,
+                    &pt,
+                    &fractal,
+                    &settings,
+                    at,
+                    DVec3::Y,
+                    environment,
+                    &|d| random(i, d),
+                    &mut alone,
+                );
+                assert_eq!(
+                    radiance.to_array().map(f32::to_bits),
+                    single.to_array().map(f32::to_bits),
+                    "path {i}"
+                );
+                assert_eq!(
+                    (counts.bounces, counts.sun_rays),
+                    (alone.bounces, alone.sun_rays),
+                    "path {i}"
+                );
+                bounced += (counts.bounces > 0) as usize;
+            }
+            assert!(bounced > 20);
+        }
     }
 
     #[test]
