@@ -488,26 +488,39 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
         ],
         stats: acc.stats,
     };
-    let mut bytes = CHECKPOINT_MAGIC.to_vec();
-    bytes.extend(serde_json::to_vec(&header).expect("a header serialises"));
-    bytes.push(b'\n');
-    // Raw little-endian arrays: exact bits, so a resumed frame ends identical.
-    for c in &acc.colour {
-        c.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
-    }
-    acc.hits.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
-    acc.depth.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
-    acc.spent.iter().for_each(|v| bytes.extend(v.to_le_bytes()));
-    for v in acc.normal.iter().chain(&acc.albedo) {
-        v.to_array()
-            .iter()
-            .for_each(|x| bytes.extend(x.to_le_bytes()));
-    }
-    for v in &acc.traps {
-        v.iter().for_each(|x| bytes.extend(x.to_le_bytes()));
-    }
+    // Streamed through the file's buffer, not assembled first: the
+    // accumulation of a large frame is hundreds of megabytes.
     write_atomic(path, |w, temp| {
-        w.write_all(&bytes).map_err(|e| Error::io(temp, e))
+        let mut put = |bytes: &[u8]| w.write_all(bytes).map_err(|e| Error::io(temp, e));
+        put(CHECKPOINT_MAGIC)?;
+        put(&serde_json::to_vec(&header).expect("a header serialises"))?;
+        put(b"\n")?;
+        // Raw little-endian arrays: exact bits, so a resumed frame ends identical.
+        for c in &acc.colour {
+            for v in c {
+                put(&v.to_le_bytes())?;
+            }
+        }
+        for v in &acc.hits {
+            put(&v.to_le_bytes())?;
+        }
+        for v in &acc.depth {
+            put(&v.to_le_bytes())?;
+        }
+        for v in &acc.spent {
+            put(&v.to_le_bytes())?;
+        }
+        for v in acc.normal.iter().chain(&acc.albedo) {
+            for x in v.to_array() {
+                put(&x.to_le_bytes())?;
+            }
+        }
+        for v in &acc.traps {
+            for x in v {
+                put(&x.to_le_bytes())?;
+            }
+        }
+        Ok(())
     })
 }
 
@@ -520,10 +533,18 @@ pub fn read_checkpoint(
     height: u32,
     layers: crate::render::Layers,
 ) -> Option<crate::render::Accumulation> {
-    let bytes = std::fs::read(path).ok()?;
-    let rest = bytes.strip_prefix(CHECKPOINT_MAGIC)?;
-    let newline = rest.iter().position(|&b| b == b'\n')?;
-    let header: CheckpointHeader = serde_json::from_slice(&rest[..newline]).ok()?;
+    // Read as it is parsed, so resuming holds the accumulation once, not
+    // also the file's bytes.
+    use std::io::{BufRead, Read};
+    let mut file = std::io::BufReader::new(std::fs::File::open(path).ok()?);
+    let mut magic = vec![0; CHECKPOINT_MAGIC.len()];
+    file.read_exact(&mut magic).ok()?;
+    if magic != CHECKPOINT_MAGIC {
+        return None;
+    }
+    let mut line = Vec::new();
+    file.read_until(b'\n', &mut line).ok()?;
+    let header: CheckpointHeader = serde_json::from_slice(line.strip_suffix(b"\n")?).ok()?;
     let wanted = [layers.normal, layers.albedo, layers.traps];
     if header.hash != hash
         || header.width != width
@@ -533,37 +554,37 @@ pub fn read_checkpoint(
         return None;
     }
     let mut acc = crate::render::Accumulation::new(width, height, layers);
-    let mut data = &rest[newline + 1..];
-    let mut take = |n: usize| -> Option<&[u8]> {
-        let (head, tail) = (data.get(..n)?, data.get(n..)?);
-        data = tail;
-        Some(head)
-    };
+    fn take<const N: usize>(file: &mut impl Read) -> Option<[u8; N]> {
+        let mut bytes = [0; N];
+        file.read_exact(&mut bytes).ok()?;
+        Some(bytes)
+    }
     for c in acc.colour.iter_mut() {
         for v in c.iter_mut() {
-            *v = f64::from_le_bytes(take(8)?.try_into().ok()?);
+            *v = f64::from_le_bytes(take(&mut file)?);
         }
     }
     for v in acc.hits.iter_mut() {
-        *v = u32::from_le_bytes(take(4)?.try_into().ok()?);
+        *v = u32::from_le_bytes(take(&mut file)?);
     }
     for v in acc.depth.iter_mut() {
-        *v = f32::from_le_bytes(take(4)?.try_into().ok()?);
+        *v = f32::from_le_bytes(take(&mut file)?);
     }
     for v in acc.spent.iter_mut() {
-        *v = u64::from_le_bytes(take(8)?.try_into().ok()?);
+        *v = u64::from_le_bytes(take(&mut file)?);
     }
     for v in acc.normal.iter_mut().chain(acc.albedo.iter_mut()) {
         for k in 0..3 {
-            v[k] = f32::from_le_bytes(take(4)?.try_into().ok()?);
+            v[k] = f32::from_le_bytes(take(&mut file)?);
         }
     }
     for v in acc.traps.iter_mut() {
         for x in v.iter_mut() {
-            *x = f32::from_le_bytes(take(4)?.try_into().ok()?);
+            *x = f32::from_le_bytes(take(&mut file)?);
         }
     }
-    if !data.is_empty() {
+    // Whole: nothing after the arrays.
+    if file.read(&mut [0u8; 1]).ok()? != 0 {
         return None;
     }
     acc.samples_done = header.samples_done;
@@ -947,10 +968,15 @@ mod tests {
         assert!(read_checkpoint(&path, "h2", 12, 8, layers).is_none());
         assert!(read_checkpoint(&path, "h1", 12, 9, layers).is_none());
         assert!(read_checkpoint(&path, "h1", 12, 8, Layers::default()).is_none());
-        // A cut-short file is refused, not half-read.
+        // A cut-short file is refused, not half-read, and so is one with
+        // anything after its arrays.
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 3]).unwrap();
         assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_none());
+        std::fs::write(&path, [&bytes[..], b"x"].concat()).unwrap();
+        assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_none());
+        std::fs::write(&path, &bytes).unwrap();
+        assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_some());
     }
 
     #[test]
