@@ -521,9 +521,15 @@ impl Timeline {
             tracks,
         };
         // Splines can overshoot their keys: check every scene the frames
-        // render, motion blur's instants between frames included.
+        // render, motion blur's instants between frames included, and each
+        // frame's own instant (what previews, `info`, `pick` and `accuracy`
+        // show of it).
         for frame in 0..frame_count {
-            let failure = timeline.sample_times(frame).into_iter().find_map(|time| {
+            let mut times = timeline.sample_times(frame);
+            if timeline.base.effects.motion_blur.is_some() {
+                times.insert(0, timeline.time_of(frame));
+            }
+            let failure = times.into_iter().find_map(|time| {
                 validate_scene(&timeline.scene_at_time(time))
                     .err()
                     .map(|e| (time, e))
@@ -584,11 +590,11 @@ impl Timeline {
     /// (s + ½)/n of it), so everything animated blurs as a camera would see it.
     pub fn sample_times(&self, frame_index: u32) -> Vec<Real> {
         let time = self.time_of(frame_index);
-        let scene = self.scene_at(frame_index);
-        let Some(blur) = &scene.effects.motion_blur else {
+        // No track animates the shutter or the sample count: the base has them.
+        let Some(blur) = &self.base.effects.motion_blur else {
             return vec![time];
         };
-        let n = scene.samples_per_pixel.max(1);
+        let n = self.base.samples_per_pixel.max(1);
         let open = blur.shutter / self.fps;
         (0..n)
             .map(|s| time + open * (s as Real + 0.5) / n as Real)
@@ -870,11 +876,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         )?;
         non_negative(pt.sky_intensity, "effects.path_tracing.sky_intensity")?;
         match pt.sky {
-            crate::shade::Sky::Constant(c) => check(
-                c.is_finite() && c.min_element() >= 0.0,
-                "effects.path_tracing.sky",
-                || format!("a constant sky must be finite and non-negative, got {c}"),
-            )?,
+            crate::shade::Sky::Constant(c) => colour(c, "effects.path_tracing.sky")?,
             crate::shade::Sky::Preetham { turbidity } => check(
                 turbidity.is_finite() && (1.7..=12.0).contains(&turbidity),
                 "effects.path_tracing.sky",

@@ -176,3 +176,20 @@ fn motion_blur_instants_between_frames_are_checked_too() {
     );
     d.ok(&["render", "ok.ron", "--quiet"]);
 }
+
+#[test]
+fn a_blurred_frames_own_instant_is_checked_too() {
+    // Frame 1's own instant dips below bailout 1 while every instant its open
+    // shutter samples (1.025 s to 1.175 s) is past the dip: previews, `info`
+    // and `pick` show that instant, so it is rejected as well.
+    let timeline = "(
+    fps: 1,
+    frames: 3,
+    size: (8, 6),
+    scene: (samples_per_pixel: 4, effects: (motion_blur: (shutter: 0.2))),
+    tracks: {
+        \"fractal.bailout\": (interpolation: Linear, keys: [(time: 0, value: 4), (time: 1, value: 0.9), (time: 1.01, value: 4)]),
+    },
+)";
+    rejected(timeline, &[], 3, &["frame 1 (t = 1", "fractal.bailout"]);
+}
