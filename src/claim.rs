@@ -5,8 +5,12 @@
 //! file system decides the one winner) holding its host, pid, a unique token
 //! and a heartbeat time, which a background thread refreshes while the frame
 //! renders. A claim whose heartbeat is older than the timeout belongs to a dead
-//! worker; taking it over first needs `.frame_0000N.takeover-<its token>`,
+//! worker; taking it over first needs `.frame_0000N.takeover-<its token>.0`,
 //! again created exclusively, so each dead claim is taken over exactly once.
+//! A marker older than the timeout was left by a taker that died before
+//! writing its claim; the next generation's marker (`.1`, …) decides then.
+//! Markers are never deleted while a takeover may be deciding, so no two
+//! workers can win one generation.
 //! Heartbeats compare clocks across machines: cluster nodes must keep them in
 //! step (NTP), to well within the timeout.
 
@@ -38,9 +42,9 @@ pub fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
     ))
 }
 
-fn takeover_path(dir: &Path, frame_index: u32, token: &str) -> PathBuf {
+fn takeover_path(dir: &Path, frame_index: u32, token: &str, generation: u32) -> PathBuf {
     dir.join(format!(
-        ".frame_{frame_index:0width$}.takeover-{token}",
+        ".frame_{frame_index:0width$}.takeover-{token}.{generation}",
         width = crate::output::FRAME_DIGITS
     ))
 }
@@ -84,8 +88,9 @@ pub enum Attempt {
 /// which also removes the claim file.
 pub struct Claim {
     path: PathBuf,
-    /// The takeover marker this claim created, if it took a dead claim over.
-    marker: Option<PathBuf>,
+    /// If it took a dead claim over: the marker it created, and the stale
+    /// ones of earlier generations before it.
+    markers: Vec<PathBuf>,
     token: String,
     stop: Arc<AtomicBool>,
     heartbeat: Option<std::thread::JoinHandle<()>>,
@@ -97,7 +102,7 @@ impl Claim {
         frame_index: u32,
         record: ClaimRecord,
         interval: Duration,
-        marker: Option<PathBuf>,
+        markers: Vec<PathBuf>,
     ) -> Claim {
         let path = claim_path(dir, frame_index);
         let stop = Arc::new(AtomicBool::new(false));
@@ -122,7 +127,7 @@ impl Claim {
         };
         Claim {
             path,
-            marker,
+            markers,
             token: record.token,
             stop,
             heartbeat: Some(heartbeat),
@@ -139,9 +144,9 @@ impl Drop for Claim {
         if read_claim(&self.path).is_some_and(|r| r.token == self.token) {
             let _ = std::fs::remove_file(&self.path);
         }
-        // The marker of the dead claim this one replaced has served its purpose.
-        // (Only that one: another may guard a takeover still going on.)
-        if let Some(marker) = &self.marker {
+        // The markers of the dead claim this one replaced have served their
+        // purpose. (Only those: another may guard a takeover still going on.)
+        for marker in &self.markers {
             let _ = std::fs::remove_file(marker);
         }
     }
@@ -177,7 +182,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                     frame_index,
                     record,
                     interval,
-                    None,
+                    Vec::new(),
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
@@ -213,44 +218,45 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             return Ok(Attempt::Held(held));
         }
         // A dead worker's claim: one takeover per dead claim, decided by who
-        // creates its marker first.
-        let marker = takeover_path(dir, frame_index, &held.token);
-        match OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&marker)
-        {
-            Ok(_) => {
-                if let Err(e) = write_record(&path, &record) {
-                    // A marker left behind would block this frame for good.
-                    let _ = std::fs::remove_file(&marker);
-                    return Err(e);
+        // creates its marker first; a stale marker hands the decision to the
+        // next generation's.
+        let mut generation = 0;
+        let marker = loop {
+            let marker = takeover_path(dir, frame_index, &held.token, generation);
+            match OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(&marker)
+            {
+                Ok(_) => break marker,
+                Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
+                    // Someone else is taking it over; their claim will show
+                    // up live. Unless the marker is older than the timeout:
+                    // its maker died before writing its claim.
+                    if crate::output::file_age(&marker).is_some_and(|age| age > timeout) {
+                        generation += 1;
+                        continue;
+                    }
+                    return Ok(Attempt::Held(held));
                 }
-                return Ok(Attempt::Claimed(Claim::start(
-                    dir,
-                    frame_index,
-                    record,
-                    interval,
-                    Some(marker),
-                )));
+                Err(e) => return Err(Error::io(&marker, e)),
             }
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
-                // Someone else is taking it over; their claim will show up
-                // live. Unless the marker is older than the timeout: its maker
-                // died before writing its claim, so clear it and try again.
-                let stale = std::fs::metadata(&marker)
-                    .and_then(|m| m.modified())
-                    .ok()
-                    .and_then(|t| t.elapsed().ok())
-                    .is_some_and(|age| age > timeout);
-                if stale {
-                    let _ = std::fs::remove_file(&marker);
-                    continue;
-                }
-                return Ok(Attempt::Held(held));
-            }
-            Err(e) => return Err(Error::io(&marker, e)),
+        };
+        if let Err(e) = write_record(&path, &record) {
+            // A marker left behind would block this frame for good.
+            let _ = std::fs::remove_file(&marker);
+            return Err(e);
         }
+        let markers = (0..=generation)
+            .map(|g| takeover_path(dir, frame_index, &held.token, g))
+            .collect();
+        return Ok(Attempt::Claimed(Claim::start(
+            dir,
+            frame_index,
+            record,
+            interval,
+            markers,
+        )));
     }
     // The claim kept vanishing and reappearing: treat it as held this round.
     Ok(Attempt::Held(read_claim(&path).unwrap_or(record)))
@@ -299,7 +305,7 @@ mod tests {
         let dead = write_dead_claim(dir.path(), 5);
         let timeout = Duration::from_secs(60);
         // Another worker has just begun taking the dead claim over.
-        let marker = takeover_path(dir.path(), 5, "dead-token");
+        let marker = takeover_path(dir.path(), 5, "dead-token", 0);
         let file = std::fs::File::create(&marker).unwrap();
         assert!(matches!(
             try_claim(dir.path(), 5, timeout).unwrap(),
@@ -318,7 +324,22 @@ mod tests {
             read_claim(&claim_path(dir.path(), 5)).unwrap().pid,
             std::process::id()
         );
+        // The stale marker stays (deleting it could let a second taker win
+        // it too): this takeover won the next generation's, which blocks a
+        // worker that still sees the dead claim (put back here for it).
+        let next = takeover_path(dir.path(), 5, "dead-token", 1);
+        assert!(marker.exists() && next.exists());
+        let ours_record = read_claim(&claim_path(dir.path(), 5)).unwrap();
+        let seen = write_dead_claim(dir.path(), 5);
+        assert!(matches!(
+            try_claim(dir.path(), 5, timeout).unwrap(),
+            Attempt::Held(held) if held == seen
+        ));
+        write_record(&claim_path(dir.path(), 5), &ours_record).unwrap();
+        // Done: the claim and both markers go.
         drop(ours);
+        assert!(!claim_path(dir.path(), 5).exists());
+        assert!(!marker.exists() && !next.exists());
     }
 
     #[test]
@@ -335,7 +356,7 @@ mod tests {
         // for that dead claim stands, and it is told the frame is held.
         let ours_record = read_claim(&claim_path(dir.path(), 7)).unwrap();
         let dead = write_dead_claim(dir.path(), 7);
-        assert!(takeover_path(dir.path(), 7, &dead.token).exists());
+        assert!(takeover_path(dir.path(), 7, &dead.token, 0).exists());
         assert!(matches!(
             try_claim(dir.path(), 7, timeout).unwrap(),
             Attempt::Held(held) if held == dead

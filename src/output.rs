@@ -638,6 +638,16 @@ fn writer_is_dead_here(name: &str) -> bool {
     }
 }
 
+/// How long ago `path` was last modified (`None` if that cannot be told).
+pub fn file_age(path: &Path) -> Option<std::time::Duration> {
+    std::fs::metadata(path)
+        .ok()?
+        .modified()
+        .ok()?
+        .elapsed()
+        .ok()
+}
+
 /// The temporary files in `dir` (any writer's, any version's), each with
 /// whether its writer is gone: a dead process on this machine, or older than
 /// `STALE_PARTIAL_AGE`.
@@ -647,19 +657,12 @@ fn partials(dir: &Path) -> Result<Vec<(PathBuf, String, bool)>> {
         .filter_map(|e| e.ok())
         .filter_map(|entry| {
             let name = entry.file_name().to_string_lossy().into_owned();
-            let temporary = name.ends_with(".partial")
-                && (name.starts_with(".frame_")
-                    || name.starts_with(&format!(".{JOB_FILE}."))
-                    // Names of earlier versions' temporary files.
-                    || [".claim.", ".job.", ".ckpt."].iter().any(|p| name.starts_with(p)));
-            if !temporary {
+            // Every `write_atomic` temporary (frames, job file, checkpoints,
+            // claims, sheets), and earlier versions' names too.
+            if !(name.starts_with('.') && name.ends_with(".partial")) {
                 return None;
             }
-            let age = entry
-                .metadata()
-                .and_then(|m| m.modified())
-                .ok()
-                .and_then(|t| t.elapsed().ok());
+            let age = file_age(&entry.path());
             let stale = writer_is_dead_here(&name) || age.is_some_and(|a| a >= STALE_PARTIAL_AGE);
             Some((entry.path(), name, stale))
         })
