@@ -204,8 +204,8 @@ pub struct RenderArgs {
     pub claim_timeout: std::time::Duration,
     /// Frames of several sample waves save their progress this often, so a killed
     /// render resumes them mid-frame (0 = after every wave).
-    #[arg(long, default_value_t = 60.0, value_name = "SECONDS")]
-    pub checkpoint_seconds: f64,
+    #[arg(long, default_value = "60", value_name = "SECONDS", value_parser = any_seconds)]
+    pub checkpoint_seconds: std::time::Duration,
 }
 
 #[derive(Debug, clap::Args)]
@@ -575,14 +575,21 @@ impl Plan {
     }
 }
 
-/// A positive, finite number of seconds (`--claim-timeout`).
+/// A positive number of seconds (`--claim-timeout`).
 fn positive_seconds(text: &str) -> std::result::Result<std::time::Duration, String> {
-    match text.trim().parse::<f64>() {
-        Ok(s) if s.is_finite() && s > 0.0 && s < 1e12 => Ok(std::time::Duration::from_secs_f64(s)),
-        _ => Err(format!(
-            "must be a positive number of seconds, got {text:?}"
-        )),
-    }
+    seconds(text)
+        .filter(|d| !d.is_zero())
+        .ok_or_else(|| format!("must be a positive number of seconds, got {text:?}"))
+}
+
+/// A number of seconds, 0 or more (`--checkpoint-seconds`).
+fn any_seconds(text: &str) -> std::result::Result<std::time::Duration, String> {
+    seconds(text).ok_or_else(|| format!("must be a number of seconds, 0 or more, got {text:?}"))
+}
+
+/// `text` as a duration: finite, not negative, within `Duration`'s range.
+fn seconds(text: &str) -> Option<std::time::Duration> {
+    std::time::Duration::try_from_secs_f64(text.trim().parse().ok()?).ok()
 }
 
 /// Samples per pixel in one wave: about 16 waves a frame, so a long frame
@@ -649,15 +656,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|s| parse_shard(s, &|k| std::env::var(k).ok()))
         .transpose()?;
-    let claim_timeout = args.claim_timeout;
-    if !(args.checkpoint_seconds.is_finite() && args.checkpoint_seconds >= 0.0) {
-        return Err(Error::usage(
-            "--checkpoint-seconds",
-            "must be a number of seconds, 0 or more",
-        )
-        .into());
-    }
-    let checkpoint_every = std::time::Duration::from_secs_f64(args.checkpoint_seconds);
     let record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
@@ -751,7 +749,9 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let n = scene[0].samples_per_pixel.max(1);
         current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
         let (stats, resumed) =
-            plan.render_frame(frame, scene, hash, checkpoint_every, &|| current.inc(1))?;
+            plan.render_frame(frame, scene, hash, args.checkpoint_seconds, &|| {
+                current.inc(1)
+            })?;
         if resumed > 0 && !args.quiet {
             say(format!(
                 "frame {frame}: resumed from a checkpoint at {resumed} of {n} samples per pixel"
@@ -788,7 +788,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     if args.claim {
         // Take frames one at a time; wait out frames other live workers hold,
         // so a worker that dies has its frame taken over by one that did not.
-        let poll = (claim_timeout / 4).clamp(
+        let poll = (args.claim_timeout / 4).clamp(
             std::time::Duration::from_millis(100),
             std::time::Duration::from_secs(5),
         );
@@ -797,7 +797,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 if !args.force && plan.is_complete(*frame, hash) {
                     continue;
                 }
-                match crate::claim::try_claim(&out_dir, *frame, claim_timeout)? {
+                match crate::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
                     crate::claim::Attempt::Claimed(claim) => {
                         // It may have been finished between the check and the claim.
                         if args.force || !plan.is_complete(*frame, hash) {
@@ -864,27 +864,20 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 /// The state of one frame in an output folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum FrameState {
+    // In the order `status` lists them.
     /// Every format exists and carries the current hash.
     Complete,
-    /// A file exists but was made from other inputs (the timeline changed).
-    Stale,
     /// A live claim or a fresh temporary file: some worker is on it.
     InProgress,
     /// A checkpoint holds part of its samples: a render will continue it.
     Resumable,
+    /// A file exists but was made from other inputs (the timeline changed).
+    Stale,
+    /// Nothing of it yet.
     Missing,
 }
 
 impl FrameState {
-    /// Every state, in the order `status` lists them.
-    const ALL: [FrameState; 5] = [
-        FrameState::Complete,
-        FrameState::InProgress,
-        FrameState::Resumable,
-        FrameState::Stale,
-        FrameState::Missing,
-    ];
-
     /// The state's name in `status --json` (`in progress` in the text).
     pub fn name(self) -> &'static str {
         match self {
@@ -922,7 +915,6 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     } else {
         Plan::new(&args.target, &args.sequence)?
     };
-    let timeout = args.claim_timeout;
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
@@ -933,7 +925,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             FrameState::Complete
         } else if let Some(claim) =
             crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
-                .filter(|c| crate::claim::is_live(c, timeout))
+                .filter(|c| crate::claim::is_live(c, args.claim_timeout))
         {
             workers.insert(format!("{}:{}", claim.host, claim.pid));
             FrameState::InProgress
@@ -989,15 +981,13 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             plan.width,
             plan.height
         );
-        for state in FrameState::ALL {
-            if let Some(frames) = by_state.get(&state) {
-                println!(
-                    "  {:<12} {:>6}  {}",
-                    state.name().replace('_', " "),
-                    frames.len(),
-                    ranges(frames)
-                );
-            }
+        for (state, frames) in &by_state {
+            println!(
+                "  {:<12} {:>6}  {}",
+                state.name().replace('_', " "),
+                frames.len(),
+                ranges(frames)
+            );
         }
         if !workers.is_empty() {
             println!(

@@ -124,13 +124,23 @@ fn bad_flags_exit_with_usage_code_and_write_nothing() {
     );
     rejected(&tiny_timeline(2, 6.0), &["--size", "0x10"], 2, &["--size"]);
     rejected(&tiny_timeline(2, 6.0), &["--format", "jpg"], 2, &["jpg"]);
-    for bad in ["0", "-1", "inf", "soon"] {
+    for bad in ["0", "-1", "inf", "soon", "1e30"] {
         let flag = format!("--claim-timeout={bad}");
         rejected(
             &tiny_timeline(2, 6.0),
             &[&flag],
             2,
             &["--claim-timeout", "positive"],
+        );
+    }
+    // Beyond what a duration holds (it used to panic), negative, not a number.
+    for bad in ["1e30", "-1", "NaN"] {
+        let flag = format!("--checkpoint-seconds={bad}");
+        rejected(
+            &tiny_timeline(2, 6.0),
+            &[&flag],
+            2,
+            &["--checkpoint-seconds", "0 or more"],
         );
     }
 }
