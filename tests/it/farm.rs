@@ -41,19 +41,23 @@ fn thirty_random_kills_then_resume_match_an_uninterrupted_render() {
             .spawn()
             .unwrap();
         std::thread::sleep(Duration::from_millis(next() % 60));
-        if child.try_wait().unwrap().is_none() {
+        let killed = child.try_wait().unwrap().is_none();
+        if killed {
             child.kill().unwrap(); // SIGKILL
             kills += 1;
         }
         child.wait().unwrap();
         // Whatever sits under a final name is a whole, current frame.
-        for f in frames_in(&d, "out/t") {
-            image::open(d.path().join("out/t").join(&f))
+        let kept = frames_in(&d, "out/t");
+        for f in &kept {
+            image::open(d.path().join("out/t").join(f))
                 .unwrap_or_else(|e| panic!("after kill {kills}, {f} is damaged: {e}"));
         }
         // Frames kept through a kill are what the resumes build on.
-        most_kept = most_kept.max(frames_in(&d, "out/t").len());
-        if frames_in(&d, "out/t").len() == 10 {
+        if killed {
+            most_kept = most_kept.max(kept.len());
+        }
+        if kept.len() == 10 {
             // Finished between kills: start over so every kill lands mid-sequence.
             std::fs::remove_dir_all(d.path().join("out/t")).unwrap();
         }
