@@ -106,6 +106,16 @@ impl FrameStats {
             + self.bounce_evaluations
             + self.sun_evaluations
     }
+
+    /// These counts as a finished frame (or row) reports them: the stage
+    /// total and the most any one pixel took.
+    fn finished(self, max_pixel_evaluations: u64) -> FrameStats {
+        FrameStats {
+            de_evaluations: self.stage_total(),
+            max_pixel_evaluations,
+            ..self
+        }
+    }
 }
 
 impl std::ops::Add for FrameStats {
@@ -176,12 +186,12 @@ pub fn render_frame_in_time(
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
     let n = scenes[0].samples_per_pixel.max(1);
+    let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     let mut film = Film::blank(width, height, layers);
     // Every row renders in parallel into this thread's one-row sums (the
     // running sums, f64 colour and counters, exist for a row at a time, not
     // the frame) and is finished straight into its place in the film: no
     // point where threads wait for each other.
-    let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     film.stats = film
         .rows_mut()
         .enumerate()
@@ -191,11 +201,7 @@ pub fn render_frame_in_time(
             let stats = render_row(&frame, y, sums.all_mut());
             let max_pixel = finish_pixels(&sums, n, pixels);
             ROW_SUMS.set(sums);
-            FrameStats {
-                de_evaluations: stats.stage_total(),
-                max_pixel_evaluations: max_pixel,
-                ..stats
-            }
+            stats.finished(max_pixel)
         })
         // `+` keeps the larger per-pixel maximum.
         .reduce(FrameStats::default, |a, b| a + b);
@@ -318,11 +324,7 @@ impl Accumulation {
             traps: film.traps.as_deref_mut(),
         };
         let max_pixel = finish_pixels(&self, n, all);
-        film.stats = FrameStats {
-            de_evaluations: self.stats.stage_total(),
-            max_pixel_evaluations: max_pixel,
-            ..self.stats
-        };
+        film.stats = self.stats.finished(max_pixel);
         film
     }
 }
@@ -520,9 +522,9 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         rays,
         marched,
         surfaces,
+        surface_costs,
         walks,
         shadows,
-        first_shadow,
         paths,
     } = &mut scratch;
     marched.resize(w, MarchResult::default());
@@ -544,34 +546,29 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         march_many(rays, &scene.fractal, &scene.quality, marched);
         // Where each ray met the surface, with what that cost.
         surfaces.clear();
-        surfaces.extend(rays.iter().zip(marched.iter()).map(|(ray, result)| {
+        surface_costs.clear();
+        for (ray, result) in rays.iter().zip(marched.iter()) {
             let before = stats.stage_total();
-            let at = surface(scene, ray, result, &mut stats);
-            (at, stats.stage_total() - before)
-        }));
-        // The row's shadow rays, walked side by side.
+            surfaces.push(surface(scene, ray, result, &mut stats));
+            surface_costs.push(stats.stage_total() - before);
+        }
+        // The row's shadow rays, walked side by side. Shading takes their
+        // outcomes back in the same order, pixel after pixel.
         shadows.clear();
-        first_shadow.clear();
         if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
             walks.clear();
-            for (at, _) in surfaces.iter() {
-                first_shadow.push(walks.len());
-                if let Some(at) = at {
-                    let look = &scene.look;
-                    walks.extend(look.shadow_walks(&scene.effects, &scene.quality, at));
-                }
+            for at in surfaces.iter().flatten() {
+                walks.extend(scene.look.shadow_walks(&scene.effects, &scene.quality, at));
             }
             shadows.resize(walks.len(), (1.0, 0));
             walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
                 shadows[i] = out
             });
         }
-        first_shadow.push(shadows.len());
+        let mut outcomes = shadows.iter().copied();
         // The row's path-traced samples, a bounce at a time side by side.
         let traced = match &scene.effects.path_tracing {
             Some(pt) => {
-                let starts: Vec<Option<SurfacePoint>> =
-                    surfaces.iter().map(|(at, _)| *at).collect();
                 let random =
                     |x: usize, d: u32| sample_1d(scene.seed, frame_index, (y * w + x) as u64, s, d);
                 crate::shade::trace_paths(
@@ -579,7 +576,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                     pt,
                     &scene.fractal,
                     &scene.quality,
-                    &starts,
+                    surfaces,
                     camera.up,
                     frame.environment.as_deref(),
                     &random,
@@ -589,18 +586,14 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             }
             None => &[][..],
         };
-        for (x, ((ray, result), (at, surface_cost))) in rays
+        for (x, (((ray, result), at), surface_cost)) in rays
             .iter()
             .zip(marched.iter())
             .zip(surfaces.iter())
+            .zip(surface_costs.iter())
             .enumerate()
         {
             let before = stats.stage_total();
-            let mut outcomes = first_shadow
-                .get(x..x + 2)
-                .map_or(&[][..], |range| &shadows[range[0]..range[1]])
-                .iter()
-                .copied();
             let c = trace(
                 scene,
                 ray,
@@ -653,6 +646,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             stats.samples += 1;
             spent_row[x] += surface_cost + stats.stage_total() - before;
         }
+        debug_assert!(outcomes.next().is_none(), "a shadow outcome per ray walked");
     }
     ROW_SCRATCH.set(scratch);
     stats.de_iterations += crate::fractal::iterations_on_this_thread() - iterations_before;
@@ -665,10 +659,11 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
 struct RowScratch {
     rays: Vec<crate::march::Ray>,
     marched: Vec<MarchResult>,
-    surfaces: Vec<(Option<SurfacePoint>, u64)>,
+    /// Where each camera ray met the surface, and the estimates that took.
+    surfaces: Vec<Option<SurfacePoint>>,
+    surface_costs: Vec<u64>,
     walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     shadows: Vec<(f32, u64)>,
-    first_shadow: Vec<usize>,
     /// The row's path-traced samples, traced together.
     paths: crate::shade::PathScratch,
 }
@@ -707,14 +702,7 @@ fn surface(
     let hit = result.hit?;
     let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
     stats.normal_evaluations += evals as u64;
-    Some(SurfacePoint {
-        point: hit.point,
-        normal: nrm,
-        view_dir: ray.dir,
-        t: hit.t,
-        footprint: ray.footprint(hit.t),
-        traps: hit.estimate.traps,
-    })
+    Some(SurfacePoint::from_hit(ray, &hit, nrm))
 }
 
 /// The radiance of one camera sample, which met the surface at `at` or
@@ -747,9 +735,8 @@ fn trace(
         return colour;
     };
     let mut stages = StageCounts::default();
-    let lit = match &scene.effects.path_tracing {
-        Some(_) => {
-            let (radiance, counts) = traced.expect("a path-traced row traces every hit");
+    let lit = match traced {
+        Some((radiance, counts)) => {
             stages = counts;
             radiance
         }

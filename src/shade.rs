@@ -269,6 +269,20 @@ pub struct SurfacePoint {
     pub traps: OrbitTraps,
 }
 
+impl SurfacePoint {
+    /// Where `ray` met the surface (`hit`), with the surface `normal` there.
+    pub fn from_hit(ray: &crate::march::Ray, hit: &crate::march::Hit, normal: DVec3) -> Self {
+        SurfacePoint {
+            point: hit.point,
+            normal,
+            view_dir: ray.dir,
+            t: hit.t,
+            footprint: ray.footprint(hit.t),
+            traps: hit.estimate.traps,
+        }
+    }
+}
+
 /// Light reaching `from` along `to_light`: 1 unoccluded, 0 blocked, in between
 /// in a penumbra (`softness` > 0). Returns the factor and the estimates spent.
 pub fn shadow(
@@ -748,7 +762,8 @@ pub fn trace_path(
 #[derive(Default)]
 pub struct PathScratch {
     pub out: Vec<(Vec3, StageCounts)>,
-    paths: Vec<Path>,
+    /// Each start's path while it goes on.
+    paths: Vec<Option<Path>>,
     rays: Vec<crate::march::Ray>,
     /// What each shadow ray brings if it gets through, and to which path.
     gains: Vec<(usize, Vec3)>,
@@ -760,7 +775,6 @@ pub struct PathScratch {
 struct Path {
     here: SurfacePoint,
     throughput: Vec3,
-    alive: bool,
 }
 
 /// Path-traced radiance of every camera sample of `starts` that hit (`None`
@@ -798,20 +812,14 @@ pub fn trace_paths(
     out.clear();
     out.resize(starts.len(), (Vec3::ZERO, StageCounts::default()));
     paths.clear();
-    paths.extend(starts.iter().map(|at| Path {
-        here: at.unwrap_or(SurfacePoint {
-            point: DVec3::ZERO,
-            normal: DVec3::Y,
-            view_dir: DVec3::Y,
-            t: 0.0,
-            footprint: 0.0,
-            traps: crate::fractal::Estimate::IDLE.traps,
-        }),
-        throughput: Vec3::ONE,
-        alive: at.is_some(),
+    paths.extend(starts.iter().map(|at| {
+        at.map(|here| Path {
+            here,
+            throughput: Vec3::ONE,
+        })
     }));
     let leave = |here: &SurfacePoint, dir: DVec3| Ray {
-        origin: here.point + here.normal * (2.0 * here.footprint),
+        origin: shadow_origin(here),
         dir,
         pixel_angle: 0.0,
         start_footprint: here.footprint,
@@ -823,7 +831,7 @@ pub fn trace_paths(
     };
     let bounces = pt.max_bounces.max(1);
     for bounce in 0..bounces {
-        if !paths.iter().any(|p| p.alive) {
+        if paths.iter().all(Option::is_none) {
             break;
         }
         // Dimensions 0–3 belong to the pixel and lens; 32 per bounce after that:
@@ -834,7 +842,8 @@ pub fn trace_paths(
         // brings where nothing blocks it, in that order.
         rays.clear();
         gains.clear();
-        for (i, path) in paths.iter().enumerate().filter(|(_, p)| p.alive) {
+        for (i, path) in paths.iter_mut().enumerate() {
+            let Some(path) = path else { continue };
             let here = &path.here;
             let albedo = look.albedo(&here.traps);
             for (l, (to_light, brightness)) in look.lights().enumerate() {
@@ -874,6 +883,8 @@ pub fn trace_paths(
                     ));
                 }
             }
+            // The bounce is cosine-weighted, so the throughput only takes the albedo.
+            path.throughput *= albedo;
         }
         march_all(rays, marched);
         for (&(i, gain), shadow) in gains.iter().zip(marched.iter()) {
@@ -882,20 +893,21 @@ pub fn trace_paths(
                 out[i].0 += gain;
             }
         }
-        // Bounce: cosine-weighted, so the throughput only takes the albedo.
+        // Bounce.
         rays.clear();
-        gains.clear();
-        for (i, path) in paths.iter_mut().enumerate().filter(|(_, p)| p.alive) {
-            let dir = cosine_direction(path.here.normal, dim(i, 0), dim(i, 1));
-            path.throughput *= look.albedo(&path.here.traps);
-            rays.push(leave(&path.here, dir));
-            gains.push((i, Vec3::ZERO));
-        }
+        rays.extend(paths.iter().enumerate().filter_map(|(i, path)| {
+            let here = &path.as_ref()?.here;
+            Some(leave(
+                here,
+                cosine_direction(here.normal, dim(i, 0), dim(i, 1)),
+            ))
+        }));
         march_all(rays, marched);
-        for ((&(i, _), ray), result) in gains.iter().zip(rays.iter()).zip(marched.iter()) {
-            let path = &mut paths[i];
+        let walked = paths.iter_mut().enumerate().filter(|(_, p)| p.is_some());
+        for (((i, slot), ray), result) in walked.zip(rays.iter()).zip(marched.iter()) {
             let (radiance, counts) = &mut out[i];
             counts.bounces += result.evaluations as u64;
+            let Some(path) = slot.as_mut() else { continue };
             let Some(hit) = result.hit else {
                 let dir = ray.dir;
                 let sky = match environment {
@@ -906,11 +918,11 @@ pub fn trace_paths(
                     None => pt.sky.radiance(look, dir, up, None),
                 };
                 *radiance += path.throughput * sky * sky_scale;
-                path.alive = false;
+                *slot = None;
                 continue;
             };
             if bounce + 1 == bounces {
-                path.alive = false; // the path ends here: its hit needs no normal
+                *slot = None; // the path ends here: its hit needs no normal
                 continue;
             }
             // Russian roulette from the third bounce: unbiased, and paths that
@@ -918,7 +930,7 @@ pub fn trace_paths(
             if bounce >= 2 {
                 let survive = path.throughput.max_element().clamp(0.05, 0.95);
                 if dim(i, 2) as f32 >= survive {
-                    path.alive = false;
+                    *slot = None;
                     continue;
                 }
                 path.throughput /= survive;
@@ -926,12 +938,8 @@ pub fn trace_paths(
             let (nrm, spent) = normal(ray, &hit, fractal, settings);
             counts.bounces += spent as u64;
             path.here = SurfacePoint {
-                point: hit.point,
-                normal: nrm,
-                view_dir: ray.dir,
                 t: path.here.t + hit.t,
-                footprint: ray.footprint(hit.t),
-                traps: hit.estimate.traps,
+                ..SurfacePoint::from_hit(ray, &hit, nrm)
             };
         }
     }
@@ -963,14 +971,7 @@ mod tests {
     ) -> Option<SurfacePoint> {
         let hit = crate::march::march(ray, fractal, settings).hit?;
         let (normal, _) = crate::march::normal(ray, &hit, fractal, settings);
-        Some(SurfacePoint {
-            point: hit.point,
-            normal,
-            view_dir: ray.dir,
-            t: hit.t,
-            footprint: ray.footprint(hit.t),
-            traps: hit.estimate.traps,
-        })
+        Some(SurfacePoint::from_hit(ray, &hit, normal))
     }
 
     fn unit_ball() -> Fractal {
