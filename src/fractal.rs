@@ -2,7 +2,7 @@
 //! powers by complex squaring, without trigonometry), one iteration driver
 //! (bailout, running derivative, orbit traps, Julia mode) generic over f64, f32
 //! and dual numbers, its vector twin that iterates 16 orbits in SIMD registers
-//! bit-identically (`orbit_lanes`, `estimate_lanes`), and five distance
+//! bit-identically (`estimate_lanes`), and five distance
 //! estimators built on them.
 //!
 //! Sources: the spherical power and the scalar running derivative
@@ -268,9 +268,8 @@ fn complex_powi<T: Arith>(re: T, im: T, n: u32) -> (T, T) {
 #[inline(always)]
 pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> Option<Triplex<T>> {
     let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n, T::from_real(1.0));
-    let usable = rho2.value() > 1e-12 * r2.value()
-        && r2.value().is_finite()
-        && out.iter().all(|v| v.value().is_finite());
+    // ρ² > 1e-12·r² also fails for an infinite or NaN r².
+    let usable = rho2.value() > 1e-12 * r2.value() && out.iter().all(|v| v.value().is_finite());
     usable.then_some(out)
 }
 
@@ -393,6 +392,7 @@ pub struct Orbit<T> {
     pub escaped: bool,
 }
 
+#[cfg(test)]
 impl Orbit<f64> {
     /// A placeholder, overwritten before use.
     const IDLE: Orbit<f64> = Orbit {
@@ -574,8 +574,8 @@ impl Fractal {
     /// result is bit-identical. For whole powers; `None` otherwise.
     /// Rendering takes `estimate_lanes`, which finishes the estimates in the
     /// registers; this is what the tests hold the vector orbit to.
-    #[inline]
-    pub fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
+    #[cfg(test)]
+    fn orbit_lanes<const N: usize>(&self, points: [DVec3; N]) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
         let mut out = [Orbit::IDLE; N];
         self.in_vectors(&points, n, &mut out);
@@ -762,7 +762,7 @@ impl Fractal {
                 }
             };
             if d.is_finite() {
-                analytic_distance(d)
+                d.max(0.0)
             } else {
                 guarded_distance(centre)
             }
@@ -826,6 +826,7 @@ trait Finished: Copy {
     );
 }
 
+#[cfg(test)]
 impl Finished for Orbit<f64> {
     const IDLE: Self = Orbit::IDLE;
     fn iterations(&self) -> u32 {
@@ -875,8 +876,8 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
     // so the processor overlaps one's square roots and division with
     // the other's multiplications instead of waiting.
     for (points, out) in points.chunks(2 * lanes).zip(out.chunks_mut(2 * lanes)) {
-        // One copy of the loop per convention and for power 8, so the
-        // loop has no branch on either and power 8 unrolls.
+        // For power 8, one copy of the loop per convention, so those loops
+        // have no branch on either and unroll; other powers share one copy.
         let f = fractal;
         let (a, b) = match (f.formula, n) {
             (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez),
@@ -1021,10 +1022,7 @@ impl<S: pulp::Simd> Register<S> {
         // `triplex_power_int`'s test, lane by lane.
         let finite = |v: Vector<S>| simd.less_than_f64s(simd.abs_f64s(v.1), infinity.1);
         let usable = simd.and_m64s(
-            simd.and_m64s(
-                simd.greater_than_f64s(rho2.1, (self.splat(1e-12) * power_r2).1),
-                finite(power_r2),
-            ),
+            simd.greater_than_f64s(rho2.1, (self.splat(1e-12) * power_r2).1),
             simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
         );
         let near_axis = simd.and_m64s(running, simd.not_m64s(usable));
@@ -1067,24 +1065,12 @@ impl<S: pulp::Simd> Register<S> {
     }
 
     /// The finished orbits, into `out` (one per lane).
+    #[cfg(test)]
     #[inline(always)]
     fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
-        let store = Self::store;
-        let (z0, z1, z2) = (store(self.z[0]), store(self.z[1]), store(self.z[2]));
-        let (p0, p1, p2) = (
-            store(self.planes[0]),
-            store(self.planes[1]),
-            store(self.planes[2]),
-        );
-        let (r2, r, dr) = (store(self.r2), store(self.r), store(self.dr));
-        let (origin, i) = (store(self.origin), store(self.i));
+        let ends = self.ends();
         for (k, out) in out.iter_mut().enumerate() {
-            let traps = OrbitTraps {
-                origin: origin[k],
-                planes: DVec3::new(p0[k], p1[k], p2[k]),
-            };
-            let z = [z0[k], z1[k], z2[k]];
-            *out = Orbit::ended(z, r2[k], r[k], dr[k], traps, i[k] as u32, fractal.bailout);
+            *out = ends.orbit(k, fractal.bailout);
         }
     }
 
@@ -1096,42 +1082,76 @@ impl<S: pulp::Simd> Register<S> {
         // The analytic estimator in f64 is the only one finished here
         // (`estimate_lanes_into` sends the others one point at a time).
         debug_assert!(fractal.de == DeMethod::Analytic && fractal.precision == Precision::F64);
-        let store = Self::store;
         let (r, dr) = (self.r, self.dr);
         // `half_r_ln_r_over`, operation for operation.
-        let raw = store(self.splat(0.5) * crate::math::ln_in_range(r) * r / dr);
-        let (r2, r, dr) = (store(self.r2), store(r), store(dr));
-        let (z0, z1, z2) = (store(self.z[0]), store(self.z[1]), store(self.z[2]));
-        let (p0, p1, p2) = (
-            store(self.planes[0]),
-            store(self.planes[1]),
-            store(self.planes[2]),
-        );
-        let (origin, i) = (store(self.origin), store(self.i));
+        let raw = Self::store(self.splat(0.5) * crate::math::ln_in_range(r) * r / dr);
+        let ends = self.ends();
         for (k, out) in out.iter_mut().enumerate() {
-            let traps = OrbitTraps {
-                origin: origin[k],
-                planes: DVec3::new(p0[k], p1[k], p2[k]),
-            };
-            let traps = traps.ended([z0[k], z1[k], z2[k]]);
-            let (escaped, iterations) = (r2[k] > fractal.bailout * fractal.bailout, i[k] as u32);
-            let distance = if !escaped {
+            let o = ends.orbit(k, fractal.bailout);
+            let distance = if !o.escaped {
                 0.0
-            } else if iterations == 0 {
+            } else if o.iterations == 0 {
                 distance_to_ball(points[k], fractal.bailout)
-            } else if crate::math::in_ln_range(r[k]) {
-                analytic_distance(raw[k])
+            } else if crate::math::in_ln_range(o.r) {
+                as_distance(raw[k])
             } else {
-                analytic_distance(half_r_ln_r_over(r[k], dr[k]))
+                as_distance(half_r_ln_r_over(o.r, o.dr))
             };
             *out = Estimate {
                 distance,
-                traps,
-                iterations,
-                escaped,
+                traps: o.traps,
+                iterations: o.iterations,
+                escaped: o.escaped,
                 orbits: 1,
             };
         }
+    }
+
+    /// The register's state, lane by lane in memory.
+    #[inline(always)]
+    fn ends(&self) -> Ends {
+        let store = Self::store;
+        Ends {
+            z: self.z.map(store),
+            planes: self.planes.map(store),
+            origin: store(self.origin),
+            r2: store(self.r2),
+            r: store(self.r),
+            dr: store(self.dr),
+            i: store(self.i),
+        }
+    }
+}
+
+/// A register's finished orbits, lane by lane (`Register::ends`).
+struct Ends {
+    z: [Stored; 3],
+    planes: [Stored; 3],
+    origin: Stored,
+    r2: Stored,
+    r: Stored,
+    dr: Stored,
+    i: Stored,
+}
+
+impl Ends {
+    /// Lane `k`'s orbit, ended as the scalar loop ends it (`Orbit::ended`).
+    #[inline(always)]
+    fn orbit(&self, k: usize, bailout: Real) -> Orbit<f64> {
+        let traps = OrbitTraps {
+            origin: self.origin[k],
+            planes: DVec3::new(self.planes[0][k], self.planes[1][k], self.planes[2][k]),
+        };
+        let z = [self.z[0][k], self.z[1][k], self.z[2][k]];
+        Orbit::ended(
+            z,
+            self.r2[k],
+            self.r[k],
+            self.dr[k],
+            traps,
+            self.i[k] as u32,
+            bailout,
+        )
     }
 }
 
@@ -1192,12 +1212,12 @@ pub fn spectral_norm(m: glam::DMat3) -> Real {
 /// orbit if that is finite, else 0, which the marcher treats as a hit: it may
 /// stop early but never skips surface.
 fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
-    analytic_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
+    as_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
 }
 
 /// An estimate `d` as a distance: 0 where it is negative or not finite.
 #[inline(always)]
-fn analytic_distance(d: Real) -> Real {
+fn as_distance(d: Real) -> Real {
     if d.is_finite() {
         d.max(0.0)
     } else {

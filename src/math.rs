@@ -82,10 +82,9 @@ pub trait Lanes: Arith {
     /// Lane by lane: `then` where `self ≥ bound`, else `otherwise` (also
     /// where `self` is NaN).
     fn if_at_least(self, bound: f64, then: Self, otherwise: Self) -> Self;
-    /// Lane by lane: `then` where `self < bound`, else `otherwise`.
-    fn if_below(self, bound: f64, then: Self, otherwise: Self) -> Self;
-    /// For a positive normal x = m·2ᵉ with m in [1, 2): (m, e), exactly
-    /// (the sign is dropped).
+    /// For a normal x ≥ ½ (what `ln_in_range` takes), x = m·2ᵉ with m in
+    /// [1, 2): (m, e), exactly (the sign is dropped). Below ½ the vector
+    /// version's e is wrong.
     fn mantissa_and_exponent(self) -> (Self, Self);
 }
 
@@ -111,14 +110,6 @@ impl Lanes for f64 {
     #[inline(always)]
     fn if_at_least(self, bound: f64, then: Self, otherwise: Self) -> Self {
         if self >= bound {
-            then
-        } else {
-            otherwise
-        }
-    }
-    #[inline(always)]
-    fn if_below(self, bound: f64, then: Self, otherwise: Self) -> Self {
-        if self < bound {
             then
         } else {
             otherwise
@@ -164,19 +155,13 @@ impl<S: pulp::Simd> Lanes for Vector<S> {
             e = power.if_at_least(at_least, raised, e);
             power = power.if_at_least(at_least, scaled, power);
         }
-        e = power.if_below(1.0, e - e.constant(1.0), e);
+        e = power.if_at_least(1.0, e, e - e.constant(1.0));
         (Vector(simd, simd.transmute_f64s_u64s(mantissa)), e)
     }
     #[inline(always)]
     fn if_at_least(self, bound: f64, then: Self, otherwise: Self) -> Self {
         let simd = self.0;
         let mask = simd.greater_than_or_equal_f64s(self.1, simd.splat_f64s(bound));
-        Vector(simd, simd.select_f64s(mask, then.1, otherwise.1))
-    }
-    #[inline(always)]
-    fn if_below(self, bound: f64, then: Self, otherwise: Self) -> Self {
-        let simd = self.0;
-        let mask = simd.less_than_f64s(self.1, simd.splat_f64s(bound));
         Vector(simd, simd.select_f64s(mask, then.1, otherwise.1))
     }
 }
