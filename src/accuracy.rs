@@ -622,6 +622,21 @@ pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()>
 mod tests {
     use super::*;
 
+    #[test]
+    fn depth_errors_of_known_hits() {
+        // Five pixels, footprints 0.5, 1, 2, 1, 1: pixel 0 stops 1 footprint
+        // short (0.5 before), pixel 1 3 footprints past (an overshoot),
+        // pixel 2 exactly on, pixel 3 hits where the reference misses,
+        // pixel 4 misses where the reference hits.
+        let hits = [Some(1.5), Some(5.0), Some(4.0), Some(1.0), None];
+        let reference = [Some(2.0), Some(2.0), Some(4.0), None, Some(3.0)];
+        let e = depth_errors(&hits, &reference, &[0.5, 1.0, 2.0, 1.0, 1.0]);
+        assert_eq!(e.mean_px, (1.0 + 3.0 + 0.0) / 3.0);
+        assert_eq!(e.p99_px, 3.0);
+        assert_eq!(e.hit_mismatch, 2.0 / 5.0);
+        assert_eq!(e.overshoot, 1.0 / 5.0);
+    }
+
     fn row(knob: &'static str, seconds: f64, rmse: f64) -> Measurement {
         Measurement {
             knob,

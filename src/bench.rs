@@ -43,7 +43,7 @@ pub struct Options {
     pub mandelbulber: Option<PathBuf>,
     /// A/B pairs per scene.
     pub runs: usize,
-    /// Thread counts for the scaling rows (on the first scene).
+    /// Thread counts for the scaling rows (every scene; in-process on the first).
     pub threads: Vec<usize>,
     /// Size of the peak-memory render; `None` skips it.
     pub memory_size: Option<(u32, u32)>,
@@ -843,14 +843,13 @@ fn depth_rows(
     // Its z may be distance along the ray or along the view axis: fit both,
     // keep the one that fits better.
     let camera = frame.camera.frame();
-    let forward = (frame.camera.target - frame.camera.position).normalize();
     let along_axis: Vec<Real> = (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))
         .map(|(x, y)| {
             camera
                 .ray(x as Real + 0.5, y as Real + 0.5, w, h)
                 .dir
-                .dot(forward)
+                .dot(camera.forward)
         })
         .collect();
     let along_ray = vec![1.0; along_axis.len()];
@@ -881,14 +880,20 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
             .par_chunks(1024)
             .map(|chunk| {
                 let before = crate::fractal::iterations_on_this_thread();
-                // A vector of points at a time, as marching asks.
+                // A vector of points at a time, into one array of estimates
+                // kept from call to call, as marching asks.
+                let mut estimates = [crate::fractal::Estimate::IDLE; crate::fractal::VECTOR];
                 let sum: f64 = chunk
                     .chunks_exact(crate::fractal::VECTOR)
                     .map(|v| {
-                        let v: [crate::math::DVec3; crate::fractal::VECTOR] =
+                        let v: &[crate::math::DVec3; crate::fractal::VECTOR] =
                             v.try_into().expect("whole vectors");
-                        let e = fractal.estimate_lanes(v, [1e-4; crate::fractal::VECTOR]);
-                        e.iter().map(|e| e.distance).sum::<f64>()
+                        fractal.estimate_lanes_into(
+                            v,
+                            &[1e-4; crate::fractal::VECTOR],
+                            &mut estimates,
+                        );
+                        estimates.iter().map(|e| e.distance).sum::<f64>()
                     })
                     .sum();
                 std::hint::black_box(sum);
@@ -896,10 +901,12 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
             })
             .sum::<u64>()
     };
-    // A warm-up pass, then samples of enough passes to last 0.2 s each, so
-    // thread start-up and fork/join are a small part of what is timed.
-    let start = Instant::now();
+    // A warm-up pass, then samples of enough passes to last 0.2 s each (as
+    // a second, warm pass times them), so thread start-up and fork/join are
+    // a small part of what is timed.
     let iterations_per_pass = pass();
+    let start = Instant::now();
+    pass();
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
         .ceil()
         .max(1.0) as u64;

@@ -103,16 +103,26 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     // The stand-in sleeps 50 ms, so its median cannot be below that.
     assert!(num(theirs, "median_s") >= 0.05);
     // Counts agree with what `render --stats` reports for the same frames.
-    let stats = d.ok(&["render", "scenes/tiny.ron", "--out", "check", "--stats"]);
-    let text = String::from_utf8_lossy(&stats.stderr).to_string() + &stdout(&stats);
-    let total: u64 = text
-        .lines()
-        .find_map(|l| l.strip_prefix("total DE evaluations: "))
-        .and_then(|l| l.split(',').next())
-        .expect("render --stats prints the total")
-        .parse()
-        .unwrap();
-    assert_eq!(num(ours, "de_evaluations") as u64, total);
+    let total_of = |frames: &str| -> u64 {
+        let out = format!("check{frames}");
+        let stats = d.ok(&[
+            "render",
+            "scenes/tiny.ron",
+            "--out",
+            &out,
+            "--frames",
+            frames,
+            "--stats",
+        ]);
+        let text = String::from_utf8_lossy(&stats.stderr).to_string() + &stdout(&stats);
+        text.lines()
+            .find_map(|l| l.strip_prefix("total DE evaluations: "))
+            .and_then(|l| l.split(',').next())
+            .expect("render --stats prints the total")
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(num(ours, "de_evaluations") as u64, total_of("0..2"));
     assert_eq!(num(ours, "pixels"), (48 * 27 * 2) as f64);
     assert!(num(ours, "de_iterations") > num(ours, "de_evaluations"));
     // Scaling rows for each thread count asked for, one thread as the unit.
@@ -123,7 +133,7 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     // … and each is the one-thread median over its own.
     let expected = num(one, "median_s") / num(two, "median_s");
     assert!(
-        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
+        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 1e-9,
         "{csv}"
     );
     // The second scene has its own scaling rows, its own work counted.
@@ -131,7 +141,7 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     let zoom_two = row("tiny_zoom (scaling)", "mandelreel", "2");
     assert_eq!(num(zoom_one, "scaling_vs_one_thread"), 1.0);
     let expected = num(zoom_one, "median_s") / num(zoom_two, "median_s");
-    assert!((num(zoom_two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02);
+    assert!((num(zoom_two, "scaling_vs_one_thread") / expected - 1.0).abs() < 1e-9);
     assert_eq!(num(zoom_two, "pixels"), (48 * 27 * 3) as f64);
     // In the table: a row per scene and count; in-process timings only for
     // the first scene.
@@ -147,11 +157,12 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     assert_eq!(num(one, "scaling_vs_one_thread"), 1.0);
     let expected = num(one, "median_s") / num(two, "median_s");
     assert!(
-        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 0.02,
+        (num(two, "scaling_vs_one_thread") / expected - 1.0).abs() < 1e-9,
         "{csv}"
     );
     // Frame 0 alone: the same count on either pool, part of the two frames'.
     assert_eq!(num(one, "de_evaluations"), num(two, "de_evaluations"));
+    assert_eq!(num(two, "de_evaluations") as u64, total_of("0..1"));
     assert!(num(two, "de_evaluations") > 0.0);
     assert!(num(two, "de_evaluations") < num(ours, "de_evaluations"));
     // The kernel row measures a share of the nominal peak, and the memory row
