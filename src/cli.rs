@@ -88,7 +88,7 @@ pub struct BenchArgs {
     /// Runs of each renderer per scene (alternating); medians are reported.
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
-    /// Thread counts for the scaling rows, comma-separated [default: 1, 2, 4, … up to all cores].
+    /// Thread counts for the scaling rows, comma-separated [default: 1, 2, 4, … up to every logical CPU].
     #[arg(long, value_delimiter = ',')]
     pub threads: Vec<usize>,
     /// Size of the peak-memory EXR render, or `none` to skip it.
