@@ -134,10 +134,12 @@ pub trait Walk: Copy {
     type Output;
     /// The point to estimate next and its pixel footprint.
     fn next_point(&self) -> (DVec3, Real);
-    /// Takes the estimate at `next_point`; the output once the walk ends.
+    /// Takes the estimate at `next_point` (and its footprint, as
+    /// `next_point` gave it); the output once the walk ends.
     fn advance(
         &mut self,
         estimate: &Estimate,
+        footprint: Real,
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<Self::Output>;
@@ -155,7 +157,12 @@ pub fn walk_one<W: Walk>(
     };
     loop {
         let (point, footprint) = walk.next_point();
-        if let Some(done) = walk.advance(&fractal.estimate(point, footprint), fractal, settings) {
+        if let Some(done) = walk.advance(
+            &fractal.estimate(point, footprint),
+            footprint,
+            fractal,
+            settings,
+        ) {
             return done;
         }
     }
@@ -199,9 +206,9 @@ pub fn walk_many<W: Walk>(
             }
         }
         fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
-        for (lane, estimate) in lanes.iter_mut().zip(&estimates) {
+        for ((lane, estimate), &footprint) in lanes.iter_mut().zip(&estimates).zip(&footprints) {
             if let Some((i, walk)) = lane {
-                if let Some(output) = walk.advance(estimate, fractal, settings) {
+                if let Some(output) = walk.advance(estimate, footprint, fractal, settings) {
                     done(*i, output);
                     *lane = None;
                 }
@@ -282,11 +289,11 @@ impl Walk for Marcher {
     fn advance(
         &mut self,
         estimate: &Estimate,
+        footprint: Real,
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<MarchResult> {
         let (t, ray) = (self.t, self.ray);
-        let footprint = ray.footprint(t);
         self.evaluations += estimate.orbits;
         if self.steps == settings.max_steps {
             // Out of steps inside the bounding sphere: the ray is creeping

@@ -372,6 +372,7 @@ impl crate::march::Walk for ShadowWalk {
     fn advance(
         &mut self,
         e: &crate::fractal::Estimate,
+        _: Real,
         _: &Fractal,
         settings: &MarchSettings,
     ) -> Option<(f32, u64)> {
