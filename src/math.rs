@@ -511,6 +511,78 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
+/// 8-bit sRGB codes from linear light without a `powf` per channel: equal,
+/// for every f32, to `(linear_to_srgb(x) * 255.0 + 0.5) as u8` (tested over
+/// every value in [2⁻¹³, 1]), so frames keep their bytes. Values from 2⁻¹³
+/// to 1 fall in buckets of 1/128 of an octave, keyed by the top bits of the
+/// float; a bucket spans under half a code step of the curve, so it holds the
+/// code at its start and at most one threshold where the code goes up by one.
+pub struct SrgbBytes {
+    base: [u8; SRGB_BUCKETS],
+    next: [f32; SRGB_BUCKETS],
+}
+
+/// Below this every value codes to 0 (12.92 · 2⁻¹³ · 255 < 0.5).
+const SRGB_LOWEST: f32 = 1.0 / 8192.0;
+/// Mantissa bits in the bucket key: 128 buckets per octave.
+const SRGB_KEY_SHIFT: u32 = f32::MANTISSA_DIGITS - 1 - 7;
+const SRGB_FIRST_KEY: u32 = SRGB_LOWEST.to_bits() >> SRGB_KEY_SHIFT;
+const SRGB_BUCKETS: usize = ((1.0f32.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
+
+impl SrgbBytes {
+    /// The table, built on first use (a few thousand `powf`s).
+    pub fn get() -> &'static SrgbBytes {
+        static TABLE: std::sync::OnceLock<SrgbBytes> = std::sync::OnceLock::new();
+        TABLE.get_or_init(SrgbBytes::new)
+    }
+
+    /// The code the curve gives `x`, computed the slow way.
+    fn exact(x: f32) -> u8 {
+        (linear_to_srgb(x) * 255.0 + 0.5) as u8
+    }
+
+    fn new() -> SrgbBytes {
+        let mut table = SrgbBytes {
+            base: [0; SRGB_BUCKETS],
+            next: [f32::INFINITY; SRGB_BUCKETS],
+        };
+        for i in 0..SRGB_BUCKETS {
+            let first = (SRGB_FIRST_KEY + i as u32) << SRGB_KEY_SHIFT;
+            let last = first + (1 << SRGB_KEY_SHIFT) - 1;
+            let base = Self::exact(f32::from_bits(first));
+            table.base[i] = base;
+            if Self::exact(f32::from_bits(last)) > base {
+                // The first value of the bucket whose code is above its start.
+                let (mut below, mut above) = (first, last);
+                while above - below > 1 {
+                    let mid = below + (above - below) / 2;
+                    if Self::exact(f32::from_bits(mid)) > base {
+                        above = mid;
+                    } else {
+                        below = mid;
+                    }
+                }
+                table.next[i] = f32::from_bits(above);
+            }
+        }
+        table
+    }
+
+    /// The 8-bit sRGB code of linear `x`: 0 for NaN, infinities and
+    /// anything at or below 0, 255 from 1 up.
+    #[inline]
+    pub fn byte(&self, x: f32) -> u8 {
+        if !x.is_finite() || x < SRGB_LOWEST {
+            return 0;
+        }
+        if x >= 1.0 {
+            return 255;
+        }
+        let i = ((x.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
+        self.base[i] + (x >= self.next[i]) as u8
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -673,6 +745,42 @@ mod tests {
         assert!((t1 - 2.0).abs() < 1e-12);
         assert!(sphere_interval(DVec3::new(0.0, 3.0, 5.0), -DVec3::Z, 1.0).is_none());
         assert!(sphere_interval(DVec3::new(0.0, 0.0, 5.0), DVec3::Z, 1.0).is_none());
+    }
+
+    #[test]
+    fn srgb_bytes_match_the_curve_for_every_float() {
+        let table = SrgbBytes::get();
+        // Every f32 from 2^-13 to 1, where the table does its work.
+        use rayon::prelude::*;
+        let (from, to) = (SRGB_LOWEST.to_bits(), 1.0f32.to_bits());
+        let wrong = (from..=to)
+            .into_par_iter()
+            .filter(|&bits| {
+                let x = f32::from_bits(bits);
+                table.byte(x) != SrgbBytes::exact(x)
+            })
+            .count();
+        assert_eq!(wrong, 0);
+        // Below, above and beside: a stride through the rest of the floats.
+        let rest = (0..u32::MAX / 9973)
+            .map(|k| f32::from_bits(k * 9973))
+            .chain([
+                0.0,
+                -0.0,
+                -1.0,
+                2.0,
+                f32::MAX,
+                f32::MIN_POSITIVE,
+                f32::EPSILON,
+            ])
+            .chain([f32::NAN, f32::INFINITY, f32::NEG_INFINITY]);
+        for x in rest {
+            assert_eq!(table.byte(x), SrgbBytes::exact(x), "{x:e}");
+        }
+        // The curve's own ends and mid-grey, stated independently.
+        assert_eq!(table.byte(1.0), 255);
+        assert_eq!(table.byte(0.18), 118); // 0.4613 · 255 + 0.5
+        assert_eq!(table.byte(0.0031308), 10); // 0.04045 · 255 + 0.5
     }
 
     #[test]
