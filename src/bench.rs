@@ -43,7 +43,8 @@ pub struct Options {
     pub mandelbulber: Option<PathBuf>,
     /// A/B pairs per scene.
     pub runs: usize,
-    /// Thread counts for the scaling rows (every scene; in-process on the first).
+    /// Thread counts for the scaling rows (every scene; in-process on the
+    /// first; the kernel alone).
     pub threads: Vec<usize>,
     /// Size of the peak-memory render; `None` skips it.
     pub memory_size: Option<(u32, u32)>,
@@ -538,29 +539,26 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
                 timed(&exe, &render_args(&scene.timeline, &out, threads, &[]))
             },
         )?;
-        let by_threads: Vec<(usize, Vec<Measurement>)> =
-            options.threads.iter().copied().zip(timings).collect();
-        let one = by_threads
+        let mut scaling: Vec<Row> = options
+            .threads
             .iter()
-            .find(|(t, _)| *t == 1)
-            .map(|(_, m)| median(m.iter().map(|m| m.wall_s).collect()));
-        for (threads, runs) in by_threads {
-            let mut row = timing_row(
-                Row {
-                    scene: format!("{} (scaling)", scene.name),
-                    renderer: "mandelreel".into(),
-                    threads,
-                    ..base()
-                },
-                &runs,
-                Some(work),
-                peak,
-            );
-            if let Some(one) = one {
-                row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
-            }
-            rows.push(row);
-        }
+            .zip(timings)
+            .map(|(&threads, runs)| {
+                timing_row(
+                    Row {
+                        scene: format!("{} (scaling)", scene.name),
+                        renderer: "mandelreel".into(),
+                        threads,
+                        ..base()
+                    },
+                    &runs,
+                    Some(work),
+                    peak,
+                )
+            })
+            .collect();
+        scale_to_one_thread(&mut scaling);
+        rows.extend(scaling);
     }
     let first = &scenes[0];
     let (timeline, _) = loaded.swap_remove(0);
@@ -569,8 +567,9 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     // renderer's own scaling, without start-up and file writing.
     rows.extend(render_only_rows(first, &timeline, options, base()));
 
-    // The kernel alone: analytic estimates at points where marching spends its time.
-    rows.push(kernel_row(&timeline, peak, base()));
+    // The kernel alone, on pools of each size: analytic estimates at points
+    // where marching spends its time.
+    rows.extend(kernel_rows(&timeline, options, base()));
 
     // Peak memory of a big EXR frame against its output buffers.
     if let Some((w, h)) = options.memory_size {
@@ -625,17 +624,7 @@ fn render_only_rows(
 ) -> Vec<Row> {
     let frame = timeline.scene_at(0);
     let (w, h) = (timeline.width, timeline.height);
-    let pools: Vec<(usize, rayon::ThreadPool)> = options
-        .threads
-        .iter()
-        .filter_map(|&t| {
-            let pool = rayon::ThreadPoolBuilder::new()
-                .num_threads(t)
-                .build()
-                .ok()?;
-            Some((t, pool))
-        })
-        .collect();
+    let pools = thread_pools(&options.threads);
     let mut counts = FrameStats::default();
     let walls = alternate(
         options.runs,
@@ -651,42 +640,65 @@ fn render_only_rows(
         },
     )
     .expect("an in-process timing has no error to return");
-    let medians: Vec<f64> = walls.iter().map(|w| median(w.clone())).collect();
-    let one = pools.iter().position(|(t, _)| *t == 1).map(|i| medians[i]);
     let frames = Work {
         frames: 1,
         pixels: w as u64 * h as u64,
         stats: counts,
     };
-    pools
+    let mut rows: Vec<Row> = pools
         .iter()
         .zip(walls)
         .map(|((threads, _), walls)| {
-            let runs: Vec<Measurement> = walls
-                .iter()
-                .map(|&wall_s| Measurement {
-                    wall_s,
-                    peak_rss_kib: 0,
-                    exit_code: 0,
-                })
-                .collect();
-            let mut row = timing_row(
+            timing_row(
                 Row {
                     scene: format!("{} (render only)", scene.name),
                     renderer: "mandelreel".into(),
                     threads: *threads,
                     ..base.clone()
                 },
-                &runs,
+                &in_process(&walls),
                 Some(&frames),
                 &options.peak,
-            );
-            if let Some(one) = one {
-                row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
-            }
-            row
+            )
+        })
+        .collect();
+    scale_to_one_thread(&mut rows);
+    rows
+}
+
+/// A rayon pool of each size in `threads`, in that order.
+fn thread_pools(threads: &[usize]) -> Vec<(usize, rayon::ThreadPool)> {
+    threads
+        .iter()
+        .filter_map(|&t| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(t)
+                .build()
+                .ok()?;
+            Some((t, pool))
         })
         .collect()
+}
+
+/// Wall times taken in this process, as measurements with nothing else.
+fn in_process(walls: &[f64]) -> Vec<Measurement> {
+    walls
+        .iter()
+        .map(|&wall_s| Measurement {
+            wall_s,
+            peak_rss_kib: 0,
+            exit_code: 0,
+        })
+        .collect()
+}
+
+/// Sets each row's speed-up over the one-thread row among them, if any.
+fn scale_to_one_thread(rows: &mut [Row]) {
+    if let Some(one) = rows.iter().find(|r| r.threads == 1).map(|r| r.median_s) {
+        for row in rows {
+            row.scaling_vs_one_thread = one / row.median_s.max(1e-9);
+        }
+    }
 }
 
 /// What Mandelbulber2 writes for a pixel whose ray met nothing.
@@ -867,62 +879,70 @@ fn depth_rows(
     Ok(rows)
 }
 
-/// Measures DE iterations per second of the analytic estimator on every
-/// thread, at points on a shell just outside the bulb of `timeline`'s first
-/// frame (where the marcher spends most of its estimates).
-pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
+/// Measures DE iterations per second of the analytic estimator at points on
+/// a shell just outside the bulb of `timeline`'s first frame (where the
+/// marcher spends most of its estimates), on a pool of each size in
+/// `options.threads`, alternating: the kernel's own thread scaling, with no
+/// start-up, scheduling of rows or file writing in it.
+pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row> {
     let fractal = timeline.scene_at(0).fractal;
     let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
-    let threads = rayon::current_num_threads();
-    // One pass over the points: its orbit iterations.
-    let pass = || {
-        points
-            .par_chunks(1024)
-            .map(|chunk| {
-                let before = crate::fractal::iterations_on_this_thread();
-                // A vector of points at a time, into one array of estimates
-                // kept from call to call, as marching asks.
-                let mut estimates = [crate::fractal::Estimate::IDLE; crate::fractal::VECTOR];
-                let sum: f64 = chunk
-                    .chunks_exact(crate::fractal::VECTOR)
-                    .map(|v| {
-                        let v: &[crate::math::DVec3; crate::fractal::VECTOR] =
-                            v.try_into().expect("whole vectors");
-                        fractal.estimate_lanes_into(
-                            v,
-                            &[1e-4; crate::fractal::VECTOR],
-                            &mut estimates,
-                        );
-                        estimates.iter().map(|e| e.distance).sum::<f64>()
-                    })
-                    .sum();
-                std::hint::black_box(sum);
-                crate::fractal::iterations_on_this_thread() - before
-            })
-            .sum::<u64>()
+    let pools = thread_pools(&options.threads);
+    // One pass over the points on a pool: its orbit iterations.
+    let pass = |pool: &rayon::ThreadPool| {
+        pool.install(|| {
+            points
+                .par_chunks(1024)
+                .map(|chunk| {
+                    let before = crate::fractal::iterations_on_this_thread();
+                    // A vector of points at a time, into one array of estimates
+                    // kept from call to call, as marching asks.
+                    let mut estimates = [crate::fractal::Estimate::IDLE; crate::fractal::VECTOR];
+                    let sum: f64 = chunk
+                        .chunks_exact(crate::fractal::VECTOR)
+                        .map(|v| {
+                            let v: &[crate::math::DVec3; crate::fractal::VECTOR] =
+                                v.try_into().expect("whole vectors");
+                            fractal.estimate_lanes_into(
+                                v,
+                                &[1e-4; crate::fractal::VECTOR],
+                                &mut estimates,
+                            );
+                            estimates.iter().map(|e| e.distance).sum::<f64>()
+                        })
+                        .sum();
+                    std::hint::black_box(sum);
+                    crate::fractal::iterations_on_this_thread() - before
+                })
+                .sum::<u64>()
+        })
     };
-    // A warm-up pass, then samples of enough passes to last 0.2 s each (as
-    // a second, warm pass times them), so thread start-up and fork/join are
-    // a small part of what is timed.
-    let iterations_per_pass = pass();
+    let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
+        return Vec::new();
+    };
+    // A warm-up pass, then samples of enough passes to last 0.2 s each on
+    // the widest pool (as a second, warm pass times them; longer on fewer
+    // threads), so thread start-up and fork/join are a small part of what
+    // is timed.
+    let iterations_per_pass = pass(widest);
     let start = Instant::now();
-    pass();
+    pass(widest);
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
         .ceil()
         .max(1.0) as u64;
-    let walls: Vec<Measurement> = (0..5)
-        .map(|_| {
+    let walls = alternate(
+        5,
+        pools.len(),
+        |_| {},
+        |i| -> Result<f64> {
             let start = Instant::now();
             for _ in 0..passes {
-                pass();
+                pass(&pools[i].1);
             }
-            Measurement {
-                wall_s: start.elapsed().as_secs_f64(),
-                peak_rss_kib: 0,
-                exit_code: 0,
-            }
-        })
-        .collect();
+            Ok(start.elapsed().as_secs_f64())
+        },
+    )
+    .expect("an in-process timing has no error to return");
     let work = Work {
         frames: 0,
         pixels: 0,
@@ -932,17 +952,25 @@ pub fn kernel_row(timeline: &Timeline, peak: &Peak, base: Row) -> Row {
             ..FrameStats::default()
         },
     };
-    timing_row(
-        Row {
-            scene: "kernel".into(),
-            renderer: "mandelreel".into(),
-            threads,
-            ..base
-        },
-        &walls,
-        Some(&work),
-        peak,
-    )
+    let mut rows: Vec<Row> = pools
+        .iter()
+        .zip(walls)
+        .map(|((threads, _), walls)| {
+            timing_row(
+                Row {
+                    scene: "kernel".into(),
+                    renderer: "mandelreel".into(),
+                    threads: *threads,
+                    ..base.clone()
+                },
+                &in_process(&walls),
+                Some(&work),
+                &options.peak,
+            )
+        })
+        .collect();
+    scale_to_one_thread(&mut rows);
+    rows
 }
 
 /// The rows as CSV, one header line first.
@@ -1017,8 +1045,9 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             100.0 * r.fraction_of_peak
         );
     }
-    for r in rows.iter().filter(|r| r.scene == "kernel") {
-        let _ = writeln!(
+    let kernel: Vec<&Row> = rows.iter().filter(|r| r.scene == "kernel").collect();
+    if let Some(r) = kernel.iter().max_by_key(|r| r.threads) {
+        let _ = write!(
             md,
             "\nKernel alone ({} threads, analytic estimate at points around the bulb): \
 {:.3e} DE iterations/s × {} flops = {:.1} GFLOP/s, {:.1}% of the nominal peak.",
@@ -1028,6 +1057,21 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             r.gflops,
             100.0 * r.fraction_of_peak
         );
+        if kernel.len() > 1 {
+            let scaling: Vec<String> = kernel
+                .iter()
+                .map(|k| {
+                    let noun = if k.threads == 1 { "thread" } else { "threads" };
+                    format!("{} {noun} {:.2}×", k.threads, k.scaling_vs_one_thread)
+                })
+                .collect();
+            let _ = write!(
+                md,
+                " Its speed-up over one thread, with no start-up, rows or files in it: {}.",
+                scaling.join(", ")
+            );
+        }
+        md.push('\n');
     }
     for r in rows
         .iter()
