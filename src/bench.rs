@@ -645,25 +645,14 @@ fn render_only_rows(
         pixels: w as u64 * h as u64,
         stats: counts,
     };
-    let mut rows: Vec<Row> = pools
-        .iter()
-        .zip(walls)
-        .map(|((threads, _), walls)| {
-            timing_row(
-                Row {
-                    scene: format!("{} (render only)", scene.name),
-                    renderer: "mandelreel".into(),
-                    threads: *threads,
-                    ..base.clone()
-                },
-                &in_process(&walls),
-                Some(&frames),
-                &options.peak,
-            )
-        })
-        .collect();
-    scale_to_one_thread(&mut rows);
-    rows
+    pool_rows(
+        &format!("{} (render only)", scene.name),
+        &pools,
+        walls,
+        &frames,
+        &options.peak,
+        base,
+    )
 }
 
 /// A rayon pool of each size in `threads`, in that order.
@@ -680,16 +669,43 @@ fn thread_pools(threads: &[usize]) -> Vec<(usize, rayon::ThreadPool)> {
         .collect()
 }
 
-/// Wall times taken in this process, as measurements with nothing else.
-fn in_process(walls: &[f64]) -> Vec<Measurement> {
-    walls
+/// The rows of `work` timed in this process on each pool (`walls[i]` on
+/// `pools[i]`), with their speed-ups over the one-thread pool.
+fn pool_rows(
+    scene: &str,
+    pools: &[(usize, rayon::ThreadPool)],
+    walls: Vec<Vec<f64>>,
+    work: &Work,
+    peak: &Peak,
+    base: Row,
+) -> Vec<Row> {
+    let mut rows: Vec<Row> = pools
         .iter()
-        .map(|&wall_s| Measurement {
-            wall_s,
-            peak_rss_kib: 0,
-            exit_code: 0,
+        .zip(walls)
+        .map(|((threads, _), walls)| {
+            let runs: Vec<Measurement> = walls
+                .iter()
+                .map(|&wall_s| Measurement {
+                    wall_s,
+                    peak_rss_kib: 0,
+                    exit_code: 0,
+                })
+                .collect();
+            timing_row(
+                Row {
+                    scene: scene.into(),
+                    renderer: "mandelreel".into(),
+                    threads: *threads,
+                    ..base.clone()
+                },
+                &runs,
+                Some(work),
+                peak,
+            )
         })
-        .collect()
+        .collect();
+    scale_to_one_thread(&mut rows);
+    rows
 }
 
 /// Sets each row's speed-up over the one-thread row among them, if any.
@@ -952,25 +968,7 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
             ..FrameStats::default()
         },
     };
-    let mut rows: Vec<Row> = pools
-        .iter()
-        .zip(walls)
-        .map(|((threads, _), walls)| {
-            timing_row(
-                Row {
-                    scene: "kernel".into(),
-                    renderer: "mandelreel".into(),
-                    threads: *threads,
-                    ..base.clone()
-                },
-                &in_process(&walls),
-                Some(&work),
-                &options.peak,
-            )
-        })
-        .collect();
-    scale_to_one_thread(&mut rows);
-    rows
+    pool_rows("kernel", &pools, walls, &work, &options.peak, base)
 }
 
 /// The rows as CSV, one header line first.

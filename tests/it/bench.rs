@@ -174,7 +174,10 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     let kernel = row("kernel", "mandelreel", "2");
     let fraction = num(kernel, "fraction_of_peak");
     assert!(fraction > 0.0 && fraction < 1.0, "{fraction}");
-    assert_eq!(num(kernel_one, "de_iterations"), num(kernel, "de_iterations"));
+    assert_eq!(
+        num(kernel_one, "de_iterations"),
+        num(kernel, "de_iterations")
+    );
     assert_eq!(num(kernel_one, "scaling_vs_one_thread"), 1.0);
     let expected = num(kernel_one, "median_s") / num(kernel, "median_s");
     assert!(
