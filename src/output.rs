@@ -453,6 +453,28 @@ where
     })
 }
 
+/// One line of a channel's samples into `line`, as `sample`s, native-endian.
+fn put_line(
+    line: &mut [u8],
+    values: impl Iterator<Item = f32>,
+    sample: exr::meta::attribute::SampleType,
+) {
+    use exr::meta::attribute::SampleType;
+    match sample {
+        SampleType::F16 => line.chunks_exact_mut(2).zip(values).for_each(|(out, v)| {
+            out.copy_from_slice(&exr::prelude::f16::from_f32(v).to_ne_bytes())
+        }),
+        SampleType::F32 => line
+            .chunks_exact_mut(4)
+            .zip(values)
+            .for_each(|(out, v)| out.copy_from_slice(&v.to_ne_bytes())),
+        SampleType::U32 => line
+            .chunks_exact_mut(4)
+            .zip(values)
+            .for_each(|(out, v)| out.copy_from_slice(&(v as u32).to_ne_bytes())),
+    }
+}
+
 /// Where a channel's samples live in the film.
 enum Plane<'f> {
     /// Component `k` of each vector.
@@ -511,27 +533,24 @@ fn film_block(
         .collect::<Option<Vec<_>>>()?;
     let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
     let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
-    let mut data = Vec::with_capacity(w * h * channels.bytes_per_pixel);
+    let mut data = vec![0u8; w * h * channels.bytes_per_pixel];
+    let mut lines = data.as_mut_slice();
     for y in y0..y0 + h {
         let row = y * film.width as usize + x0..y * film.width as usize + x0 + w;
-        for (plane, sample) in &planes {
-            let put = |data: &mut Vec<u8>, v: f32| match sample {
-                SampleType::F16 => {
-                    data.extend_from_slice(&exr::prelude::f16::from_f32(v).to_ne_bytes())
-                }
-                SampleType::F32 => data.extend_from_slice(&v.to_ne_bytes()),
-                SampleType::U32 => data.extend_from_slice(&(v as u32).to_ne_bytes()),
-            };
+        for &(ref plane, sample) in &planes {
+            let (line, rest) =
+                std::mem::take(&mut lines).split_at_mut(w * sample.bytes_per_sample());
+            lines = rest;
             match *plane {
-                Plane::Vectors(v, k) => v[row.clone()].iter().for_each(|p| put(&mut data, p[k])),
-                Plane::Floats(v) => v[row.clone()].iter().for_each(|&p| put(&mut data, p)),
-                Plane::Traps(v, k) => v[row.clone()].iter().for_each(|p| put(&mut data, p[k])),
-                Plane::Counts(v) => match sample {
-                    SampleType::U32 => v[row.clone()]
-                        .iter()
-                        .for_each(|p| data.extend_from_slice(&p.to_ne_bytes())),
-                    _ => return None,
-                },
+                Plane::Vectors(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
+                Plane::Floats(v) => put_line(line, v[row.clone()].iter().copied(), sample),
+                Plane::Traps(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
+                Plane::Counts(v) if sample == SampleType::U32 => {
+                    for (out, count) in line.chunks_exact_mut(4).zip(&v[row.clone()]) {
+                        out.copy_from_slice(&count.to_ne_bytes());
+                    }
+                }
+                Plane::Counts(_) => return None,
             }
         }
     }
