@@ -630,12 +630,12 @@ impl Fractal {
             // Chunks of points and of results have the same lengths.
             if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
                 let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
-                arch.dispatch(Kernel(self, lanes, n, full));
+                arch.dispatch(Kernel(self, lanes, VECTOR, n, full));
             } else {
                 let lanes: [DVec3; VECTOR] =
                     std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
                 let mut full = [Out::IDLE; VECTOR];
-                arch.dispatch(Kernel(self, &lanes, n, &mut full));
+                arch.dispatch(Kernel(self, &lanes, chunk.len(), n, &mut full));
                 out.copy_from_slice(&full[..out.len()]);
             }
         }
@@ -799,16 +799,25 @@ type Stored = [f64; REGISTER];
 /// on the compiler vectorising; Rust never fuses a multiply and an add
 /// unasked, so every version rounds exactly as the scalar `orbit` does.
 /// `Kernel<Orbit<f64>>` writes the orbits into its output, `Kernel<Estimate>`
-/// the analytic estimates, finished in the registers.
-struct Kernel<'a, Out>(&'a Fractal, &'a [DVec3; VECTOR], u32, &'a mut [Out; VECTOR]);
+/// the analytic estimates, finished in the registers. Only the first
+/// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
+/// register of nothing but padding is neither iterated nor finished, its
+/// results left as they were (`Finished::IDLE` from `in_vectors`).
+struct Kernel<'a, Out>(
+    &'a Fractal,
+    &'a [DVec3; VECTOR],
+    usize,
+    u32,
+    &'a mut [Out; VECTOR],
+);
 
 impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) {
-        let Self(fractal, points, n, out) = self;
-        run_vector(simd, fractal, points, n, out)
+        let Self(fractal, points, live, n, out) = self;
+        run_vector(simd, fractal, points, live, n, out)
     }
 }
 
@@ -859,13 +868,15 @@ impl Finished for Estimate {
     }
 }
 
-/// Runs `points` two registers at a time; each register, with its points,
-/// writes its lanes' results (`Finished::write`).
+/// Runs the first `live` of `points` two registers at a time; each
+/// register, with its points, writes its lanes' results (`Finished::write`).
+/// Registers past `live` are skipped.
 #[inline(always)]
 fn run_vector<S: pulp::Simd, Out: Finished>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3; VECTOR],
+    live: usize,
     n: u32,
     out: &mut [Out; VECTOR],
 ) {
@@ -875,7 +886,13 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
     // Two registers at a time: their dependency chains are independent,
     // so the processor overlaps one's square roots and division with
     // the other's multiplications instead of waiting.
-    for (points, out) in points.chunks(2 * lanes).zip(out.chunks_mut(2 * lanes)) {
+    let pairs = live.div_ceil(2 * lanes);
+    for (pair, (points, out)) in points
+        .chunks(2 * lanes)
+        .zip(out.chunks_mut(2 * lanes))
+        .take(pairs)
+        .enumerate()
+    {
         // For power 8, one copy of the loop per convention, so those loops
         // have no branch on either and unroll; other powers share one copy.
         let f = fractal;
@@ -889,7 +906,10 @@ fn run_vector<S: pulp::Simd, Out: Finished>(
         };
         let (first, second) = out.split_at_mut(lanes);
         Out::write(&a, f, &points[..lanes], first);
-        Out::write(&b, f, &points[lanes..], second);
+        // A second register of padding alone has stayed where it started.
+        if live > (2 * pair + 1) * lanes {
+            Out::write(&b, f, &points[lanes..], second);
+        }
     }
 }
 
@@ -1555,43 +1575,69 @@ mod tests {
                     .iter()
                     .map(|&p| format!("{:?}", f.estimate(p, 1e-4)))
                     .collect();
-                let check =
-                    |orbits: [Orbit<f64>; VECTOR], estimates: [Estimate; VECTOR], arch: &str| {
-                        for (k, o) in orbits.iter().enumerate() {
-                            assert_eq!(format!("{o:?}"), expected[k], "{arch} at {}", points[k]);
+                // The first `live` lanes as the scalar path gives them; lanes
+                // in registers (of `width` lanes) holding no wanted lane are
+                // left untouched.
+                let check = |(orbits, estimates): ([Orbit<f64>; VECTOR], [Estimate; VECTOR]),
+                             live: usize,
+                             width: usize,
+                             arch: &str| {
+                    let skipped = live.next_multiple_of(width);
+                    for (k, o) in orbits.iter().enumerate() {
+                        let o = format!("{o:?}");
+                        if k < live {
+                            assert_eq!(o, expected[k], "{arch} {live} at {}", points[k]);
+                        } else if k >= skipped {
+                            assert_eq!(o, format!("{:?}", Orbit::<f64>::IDLE), "{arch} {live}");
                         }
-                        for (k, e) in estimates.iter().enumerate() {
-                            assert_eq!(format!("{e:?}"), estimated[k], "{arch} at {}", points[k]);
+                    }
+                    for (k, e) in estimates.iter().enumerate() {
+                        let e = format!("{e:?}");
+                        if k < live {
+                            assert_eq!(e, estimated[k], "{arch} {live} at {}", points[k]);
+                        } else if k >= skipped {
+                            assert_eq!(e, format!("{:?}", Estimate::IDLE), "{arch} {live}");
                         }
-                    };
-                // What rendering runs (the widest set found), then each set.
+                    }
+                };
+                // What rendering runs (the widest set found), then each set,
+                // with every lane wanted and with the last ones padding.
                 fn on<S: pulp::Simd>(
                     simd: S,
                     f: &Fractal,
                     points: [DVec3; VECTOR],
+                    live: usize,
                     n: u32,
                 ) -> ([Orbit<f64>; VECTOR], [Estimate; VECTOR]) {
                     let mut out = ([Orbit::IDLE; VECTOR], [Estimate::IDLE; VECTOR]);
-                    Kernel(f, &points, n, &mut out.0).with_simd(simd);
-                    Kernel(f, &points, n, &mut out.1).with_simd(simd);
+                    Kernel(f, &points, live, n, &mut out.0).with_simd(simd);
+                    Kernel(f, &points, live, n, &mut out.1).with_simd(simd);
                     out
                 }
                 check(
-                    f.orbit_lanes(points).expect("a whole power"),
-                    f.estimate_lanes(points, [1e-4; VECTOR]),
+                    (
+                        f.orbit_lanes(points).expect("a whole power"),
+                        f.estimate_lanes(points, [1e-4; VECTOR]),
+                    ),
+                    VECTOR,
+                    VECTOR,
                     "dispatched",
                 );
-                let (o, e) = on(pulp::Scalar::new(), &f, points, n);
-                check(o, e, "scalar");
-                #[cfg(target_arch = "x86_64")]
-                {
-                    if let Some(v3) = pulp::x86::V3::try_new() {
-                        let (o, e) = on(v3, &f, points, n);
-                        check(o, e, "AVX2");
-                    }
-                    if let Some(v4) = pulp::x86::V4::try_new() {
-                        let (o, e) = on(v4, &f, points, n);
-                        check(o, e, "AVX-512");
+                for live in [VECTOR, 1, 4, 5, 8, 9, 12, 13] {
+                    check(
+                        on(pulp::Scalar::new(), &f, points, live, n),
+                        live,
+                        1,
+                        "scalar",
+                    );
+                    #[cfg(target_arch = "x86_64")]
+                    {
+                        if let Some(v3) = pulp::x86::V3::try_new() {
+                            check(on(v3, &f, points, live, n), live, 4, "AVX2");
+                        }
+                        if let Some(v4) = pulp::x86::V4::try_new() {
+                            check(on(v4, &f, points, live, n), live, 8, "AVX-512");
+                        }
                     }
                 }
             }
