@@ -422,16 +422,68 @@ fn bisect_membership(
 /// estimate, with a step proportional to the pixel footprint. Returns the normal
 /// and the number of orbits used; falls back to facing the ray.
 pub fn normal(ray: &Ray, hit: &Hit, fractal: &Fractal, settings: &MarchSettings) -> (DVec3, u32) {
+    // The four estimates are independent: evaluated side by side.
+    let (points, footprint) = normal_points(ray, hit, settings);
+    let estimates = fractal.estimate_lanes(points, [footprint; 4]);
+    normal_from(ray, &estimates)
+}
+
+/// `normal` for many hits, four to a call of the lane kernel (its 16
+/// estimates), so a hit does not pay for a call of its own: `out(i, …)`
+/// gets what `normal` gives for `hits[i]`, bit for bit.
+pub fn normals_many<'h>(
+    hits: impl IntoIterator<Item = (usize, &'h Ray, &'h Hit)>,
+    fractal: &Fractal,
+    settings: &MarchSettings,
+    mut out: impl FnMut(usize, (DVec3, u32)),
+) {
+    const PER_CALL: usize = VECTOR / 4;
+    let mut hits = hits.into_iter();
+    let mut estimates = [Estimate::IDLE; VECTOR];
+    loop {
+        let mut batch: [Option<(usize, &Ray, &Hit)>; PER_CALL] = [None; PER_CALL];
+        for (slot, hit) in batch.iter_mut().zip(hits.by_ref()) {
+            *slot = Some(hit);
+        }
+        let [Some(a), Some(b), Some(c), Some(d)] = batch else {
+            // The last few, one call each.
+            for (i, ray, hit) in batch.into_iter().flatten() {
+                out(i, normal(ray, hit, fractal, settings));
+            }
+            return;
+        };
+        let batch = [a, b, c, d];
+        let mut points = [DVec3::ZERO; VECTOR];
+        let mut footprints = [0.0; VECTOR];
+        for (k, &(_, ray, hit)) in batch.iter().enumerate() {
+            let (p, f) = normal_points(ray, hit, settings);
+            points[4 * k..4 * k + 4].copy_from_slice(&p);
+            footprints[4 * k..4 * k + 4].fill(f);
+        }
+        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
+        for (k, &(i, ray, _)) in batch.iter().enumerate() {
+            out(i, normal_from(ray, &estimates[4 * k..4 * k + 4]));
+        }
+    }
+}
+
+/// The four points `normal` estimates around `hit` (a tetrahedron a
+/// `normal_step` of footprints across, stepped back along the ray so that
+/// it straddles the surface rather than sits inside, where the estimate is
+/// flat zero), and the footprint there.
+fn normal_points(ray: &Ray, hit: &Hit, settings: &MarchSettings) -> ([DVec3; 4], Real) {
     let footprint = ray.footprint(hit.t);
     let h = settings.normal_step * footprint;
-    // Step back along the ray so the samples straddle the surface rather than sit inside,
-    // where the estimate is flat zero.
     let centre = hit.point - ray.dir * h;
+    (TETRAHEDRON.map(|k| centre + k * h), footprint)
+}
+
+/// The normal from the estimates at `normal_points`, and the orbits they
+/// took; facing the ray where the gradient is zero.
+fn normal_from(ray: &Ray, estimates: &[Estimate]) -> (DVec3, u32) {
     let mut gradient = DVec3::ZERO;
     let mut orbits = 0;
-    // The four estimates are independent: evaluated side by side.
-    let estimates = fractal.estimate_lanes(TETRAHEDRON.map(|k| centre + k * h), [footprint; 4]);
-    for (k, e) in TETRAHEDRON.iter().zip(&estimates) {
+    for (k, e) in TETRAHEDRON.iter().zip(estimates) {
         gradient += *k * e.distance;
         orbits += e.orbits;
     }
@@ -507,6 +559,27 @@ mod tests {
                     hits > 5 && hits < rays.len() - 5,
                     "{hits} hits: too few misses or hits"
                 );
+                // The hits' normals four to a call, as one at a time (the
+                // last ones, fewer than four, by `normal` itself).
+                let hit_rays: Vec<(usize, &Ray, &Hit)> = rays
+                    .iter()
+                    .zip(&many)
+                    .enumerate()
+                    .filter_map(|(i, (r, m))| Some((i, r, m.hit.as_ref()?)))
+                    .collect();
+                let mut normals = vec![None; rays.len()];
+                normals_many(hit_rays.iter().copied(), f, &settings, |i, n| {
+                    assert!(normals[i].replace(n).is_none(), "ray {i} twice")
+                });
+                for &(i, r, hit) in &hit_rays {
+                    let one = normal(r, hit, f, &settings);
+                    assert_eq!(
+                        format!("{:?}", Some(one)),
+                        format!("{:?}", normals[i]),
+                        "{f:?}"
+                    );
+                }
+                assert_eq!(normals.iter().flatten().count(), hit_rays.len());
             }
         }
     }

@@ -5,7 +5,7 @@
 //! Every pixel depends only on (scene, frame, pixel, sample), never on which
 //! thread ran it or in which order, so the image is identical for any thread count.
 
-use crate::march::{march_many, normal, walk_many, MarchResult};
+use crate::march::{march_many, normals_many, walk_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
@@ -544,14 +544,27 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             }
         }));
         march_many(rays, &scene.fractal, &scene.quality, marched);
-        // Where each ray met the surface, with what that cost.
+        // Where each ray met the surface, with its normal (the row's hits
+        // four to a kernel call), and what that cost.
         surfaces.clear();
         surface_costs.clear();
-        for (ray, result) in rays.iter().zip(marched.iter()) {
-            let before = stats.stage_total();
-            surfaces.push(surface(scene, ray, result, &mut stats));
-            surface_costs.push(stats.stage_total() - before);
+        for result in marched.iter() {
+            stats.primary_evaluations += result.evaluations as u64;
+            surfaces.push(None);
+            surface_costs.push(result.evaluations as u64);
         }
+        let hits = rays
+            .iter()
+            .zip(marched.iter())
+            .enumerate()
+            .filter_map(|(x, (ray, result))| Some((x, ray, result.hit.as_ref()?)));
+        normals_many(hits, &scene.fractal, &scene.quality, |x, (nrm, evals)| {
+            stats.normal_evaluations += evals as u64;
+            surface_costs[x] += evals as u64;
+            if let Some(hit) = &marched[x].hit {
+                surfaces[x] = Some(SurfacePoint::from_hit(&rays[x], hit, nrm));
+            }
+        });
         // The row's shadow rays, walked side by side. Shading takes their
         // outcomes back in the same order, pixel after pixel.
         shadows.clear();
@@ -687,22 +700,6 @@ fn optional_rows<T: Send>(
         layer.chunks_mut(width).map(Some).collect()
     };
     rows.into_par_iter()
-}
-
-/// Where a camera ray's march met the surface, with its normal: the
-/// surface point shading needs, or `None` for a miss. Counts the march's
-/// and the normal's estimates.
-fn surface(
-    scene: &Scene,
-    ray: &crate::march::Ray,
-    result: &MarchResult,
-    stats: &mut FrameStats,
-) -> Option<SurfacePoint> {
-    stats.primary_evaluations += result.evaluations as u64;
-    let hit = result.hit?;
-    let (nrm, evals) = normal(ray, &hit, &scene.fractal, &scene.quality);
-    stats.normal_evaluations += evals as u64;
-    Some(SurfacePoint::from_hit(ray, &hit, nrm))
 }
 
 /// The radiance of one camera sample, which met the surface at `at` or
