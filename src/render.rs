@@ -525,6 +525,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         surface_costs,
         walks,
         shadows,
+        occluded,
         paths,
     } = &mut scratch;
     marched.resize(w, MarchResult::default());
@@ -579,6 +580,19 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             });
         }
         let mut outcomes = shadows.iter().copied();
+        // The row's ambient occlusion, its samples packed across the hits.
+        occluded.clear();
+        occluded.resize(w, None);
+        if let (None, Some(ao)) = (
+            &scene.effects.path_tracing,
+            &scene.effects.ambient_occlusion,
+        ) {
+            let hits = surfaces.iter().enumerate().filter_map(|(x, at)| {
+                let at = at.as_ref()?;
+                Some((x, at.point, at.normal, at.t, at.footprint))
+            });
+            crate::shade::occlusions(&scene.fractal, ao, hits, |x, out| occluded[x] = Some(out));
+        }
         // The row's path-traced samples, a bounce at a time side by side.
         let traced = match &scene.effects.path_tracing {
             Some(pt) => {
@@ -613,6 +627,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 result,
                 at.as_ref(),
                 &mut outcomes,
+                occluded[x],
                 traced.get(x).copied(),
                 camera.up,
                 scale,
@@ -677,6 +692,8 @@ struct RowScratch {
     surface_costs: Vec<u64>,
     walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     shadows: Vec<(f32, u64)>,
+    /// Each pixel's ambient occlusion and its cost, where it hit.
+    occluded: Vec<Option<(f32, u64)>>,
     /// The row's path-traced samples, traced together.
     paths: crate::shade::PathScratch,
 }
@@ -703,8 +720,8 @@ fn optional_rows<T: Send>(
 }
 
 /// The radiance of one camera sample, which met the surface at `at` or
-/// nothing. Shadow rays' outcomes come from `shadows` (see
-/// `Look::shade_with`); a path-traced sample's light and counts from
+/// nothing. Shadow rays' outcomes come from `shadows` and its ambient
+/// occlusion from `occluded` (see `Look::shade_with`); a path-traced sample's light and counts from
 /// `traced` (see `trace_paths`). Only the stages of the scene's enabled
 /// effects run; `stats` counts each.
 #[allow(clippy::too_many_arguments)]
@@ -714,6 +731,7 @@ fn trace(
     result: &MarchResult,
     at: Option<&SurfacePoint>,
     shadows: &mut dyn Iterator<Item = (f32, u64)>,
+    occluded: Option<(f32, u64)>,
     traced: Option<(Vec3, StageCounts)>,
     up: crate::math::DVec3,
     scale: Real,
@@ -739,7 +757,7 @@ fn trace(
         }
         None => scene
             .look
-            .shade_with(&scene.effects, &scene.fractal, at, &mut stages, shadows),
+            .shade_with(&scene.effects, at, &mut stages, shadows, occluded),
     };
     stats.shadow_evaluations += stages.shadows;
     stats.occlusion_evaluations += stages.occlusion;

@@ -398,24 +398,49 @@ pub fn occlusion(
     t: Real,
     footprint: Real,
 ) -> (f32, u64) {
-    let mut blocked = 0.0;
-    let mut weights = 0.0;
-    let mut weight = 1.0;
-    let mut spent = 0;
+    let mut found = (f32::NAN, 0);
+    occlusions(fractal, ao, [(0, point, normal, t, footprint)], |_, out| {
+        found = out
+    });
+    found
+}
+
+/// `occlusion` at many surface points (index, point, normal, distance from
+/// the camera, footprint), their samples packed side by side across the
+/// points, `VECTOR` to a call of the lane kernel, so a point's few samples
+/// do not pay for a call of their own. `out(i, …)` gets point `i`'s, bit
+/// for bit what it would get alone: each point sums its samples in order.
+pub fn occlusions(
+    fractal: &Fractal,
+    ao: &AmbientOcclusion,
+    points: impl IntoIterator<Item = (usize, DVec3, DVec3, Real, Real)>,
+    mut out: impl FnMut(usize, (f32, u64)),
+) {
     let n = ao.samples.max(1);
-    let step = |i: u32| ao.radius * t * i as Real / n as Real;
-    // The samples are independent: estimated a vector at a time, summed in order.
-    let mut first = 1;
-    while first <= n {
-        let count = (n + 1 - first).min(VECTOR as u32) as usize;
-        let ds: [Real; VECTOR] = std::array::from_fn(|k| step(first + k as u32));
+    // Sample k of n at each point: its distance along the normal.
+    let mut samples = points
+        .into_iter()
+        .flat_map(|(i, point, normal, t, footprint)| {
+            (1..=n).map(move |k| {
+                let d = ao.radius * t * k as Real / n as Real;
+                (i, k, d, point + normal * d, footprint)
+            })
+        })
+        .peekable();
+    let (mut blocked, mut weights, mut weight, mut spent) = (0.0, 0.0, 1.0, 0);
+    while samples.peek().is_some() {
+        let mut lanes = [None; VECTOR];
+        for (lane, sample) in lanes.iter_mut().zip(samples.by_ref()) {
+            *lane = Some(sample);
+        }
         // Lanes past the last sample idle outside the bailout ball.
-        let points = std::array::from_fn(|k| match k < count {
-            true => point + normal * ds[k],
-            false => crate::fractal::IDLE_POINT,
-        });
-        let estimates = fractal.estimate_lanes(points, [footprint; VECTOR]);
-        for (&d, e) in ds.iter().zip(&estimates).take(count) {
+        let points = lanes.map(|l| l.map_or(crate::fractal::IDLE_POINT, |(.., p, _)| p));
+        let footprints = lanes.map(|l| l.map_or(1.0, |(.., f)| f));
+        let estimates = fractal.estimate_lanes(points, footprints);
+        for (&(i, k, d, ..), e) in lanes.iter().flatten().zip(&estimates) {
+            if k == 1 {
+                (blocked, weights, weight, spent) = (0.0, 0.0, 1.0, 0);
+            }
             spent += e.orbits as u64;
             // Where the field is nearer than the distance stepped, geometry crowds
             // in. The estimate is about half the true distance near the surface
@@ -423,11 +448,12 @@ pub fn occlusion(
             blocked += weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
             weights += weight;
             weight *= 0.6;
+            if k == n {
+                let ambient = 1.0 - ao.strength as Real * blocked / weights;
+                out(i, (ambient.clamp(0.0, 1.0) as f32, spent));
+            }
         }
-        first += VECTOR as u32;
     }
-    let ambient = 1.0 - ao.strength as Real * blocked / weights;
-    (ambient.clamp(0.0, 1.0) as f32, spent)
 }
 
 /// Colours and light of a scene. Colours are linear RGB.
@@ -512,7 +538,11 @@ impl Look {
         let mut shadows = self
             .shadow_walks(effects, settings, at)
             .map(|walk| crate::march::walk_one(walk, fractal, settings));
-        self.shade_with(effects, fractal, at, counts, &mut shadows)
+        let occluded = effects
+            .ambient_occlusion
+            .as_ref()
+            .map(|ao| occlusion(fractal, ao, at.point, at.normal, at.t, at.footprint));
+        self.shade_with(effects, at, counts, &mut shadows, occluded)
     }
 
     /// The lights that face the surface at `at`: (direction towards the
@@ -541,18 +571,19 @@ impl Look {
 
     /// `shade` with the shadow rays' outcomes (factor, estimates spent)
     /// taken from `shadows`, one per ray `shadow_walks` lists, in its order
-    /// (asked only with shadows on).
+    /// (asked only with shadows on), and the ambient occlusion `occlusion`
+    /// gives at `at` (needed only with it on).
     pub fn shade_with(
         &self,
         effects: &Effects,
-        fractal: &Fractal,
         at: &SurfacePoint,
         counts: &mut StageCounts,
         shadows: &mut dyn Iterator<Item = (f32, u64)>,
+        occluded: Option<(f32, u64)>,
     ) -> Vec3 {
         let mut ambient = 1.0f32;
-        if let Some(ao) = &effects.ambient_occlusion {
-            let (a, spent) = occlusion(fractal, ao, at.point, at.normal, at.t, at.footprint);
+        if effects.ambient_occlusion.is_some() {
+            let (a, spent) = occluded.expect("the occlusion at a point, with occlusion on");
             ambient = a;
             counts.occlusion += spent;
         }
@@ -975,8 +1006,67 @@ mod tests {
         Some(SurfacePoint::from_hit(ray, &hit, normal))
     }
 
+    /// Where `count` rays from around the bulb (`seed` picks them) meet it.
+    fn bulb_points(
+        count: usize,
+        seed: u64,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Vec<SurfacePoint> {
+        crate::math::shell_points(count, 2.5..2.6, seed)
+            .into_iter()
+            .filter_map(|origin| {
+                let ray = crate::march::Ray {
+                    origin,
+                    dir: (DVec3::new(0.1, -0.2, 0.15) - origin).normalize(),
+                    pixel_angle: 1e-3,
+                    start_footprint: 0.0,
+                };
+                surface_at(&ray, fractal, settings)
+            })
+            .collect()
+    }
+
     fn unit_ball() -> Fractal {
         Fractal::unit_ball()
+    }
+
+    #[test]
+    fn occlusion_packed_across_points_is_each_points_own() {
+        // Real surface points, their samples packed across points (a call
+        // holding the end of one point's samples and the start of the
+        // next's), against each point alone, bit for bit.
+        let fractal = Fractal::default();
+        let settings = MarchSettings::default();
+        let points = bulb_points(40, 5, &fractal, &settings);
+        assert!(points.len() > 10, "{} surface points", points.len());
+        for samples in [1, 3, 5, 16, 21] {
+            let ao = AmbientOcclusion {
+                samples,
+                radius: 0.2,
+                ..AmbientOcclusion::default()
+            };
+            let mut packed = vec![None; points.len()];
+            let sites = points
+                .iter()
+                .enumerate()
+                .map(|(i, at)| (i, at.point, at.normal, at.t, at.footprint));
+            occlusions(&fractal, &ao, sites, |i, out| {
+                assert!(packed[i].replace(out).is_none(), "point {i} twice")
+            });
+            let mut occluded = 0;
+            for (at, packed) in points.iter().zip(&packed) {
+                let (a, spent) = occlusion(&fractal, &ao, at.point, at.normal, at.t, at.footprint);
+                let (b, packed_spent) = packed.expect("every point");
+                assert_eq!(
+                    (a.to_bits(), spent),
+                    (b.to_bits(), packed_spent),
+                    "{samples}"
+                );
+                occluded += (a < 0.99) as usize;
+            }
+            assert!(occluded > 2, "{occluded} occluded with {samples} samples");
+        }
     }
 
     #[test]
@@ -1002,18 +1092,7 @@ mod tests {
             ..Effects::default()
         };
         // Real surface points: where rays from around the bulb meet it.
-        let points: Vec<SurfacePoint> = crate::math::shell_points(80, 2.5..2.6, 3)
-            .into_iter()
-            .filter_map(|origin| {
-                let ray = crate::march::Ray {
-                    origin,
-                    dir: (DVec3::new(0.1, -0.2, 0.15) - origin).normalize(),
-                    pixel_angle: 1e-3,
-                    start_footprint: 0.0,
-                };
-                surface_at(&ray, &fractal, &settings)
-            })
-            .collect();
+        let points = bulb_points(80, 3, &fractal, &settings);
         let walks: Vec<_> = points
             .iter()
             .flat_map(|at| look.shadow_walks(&effects, &settings, at))
@@ -1031,7 +1110,7 @@ mod tests {
                 partly += (out.0 > 0.0 && out.0 < 1.0) as u32;
                 Some(out)
             });
-            let batched = look.shade_with(&effects, &fractal, at, &mut many, &mut next);
+            let batched = look.shade_with(&effects, at, &mut many, &mut next, None);
             assert_eq!(
                 alone.to_array().map(f32::to_bits),
                 batched.to_array().map(f32::to_bits)
