@@ -800,6 +800,8 @@ pub struct PathScratch {
     /// What each shadow ray brings if it gets through, and to which path.
     gains: Vec<(usize, Vec3)>,
     marched: Vec<crate::march::MarchResult>,
+    /// The paths that go on from a bounce's hit, and which ray found it.
+    going_on: Vec<(usize, usize)>,
 }
 
 /// One path between bounces.
@@ -827,7 +829,7 @@ pub fn trace_paths(
     random: &dyn Fn(usize, u32) -> Real,
     scratch: &mut PathScratch,
 ) {
-    use crate::march::{march_many, normal, MarchResult, Ray};
+    use crate::march::{march_many, normals_many, MarchResult, Ray};
     let rotation = pt.sky.rotation();
     // Multiple importance sampling (power heuristic) between the map's own
     // sampling and the cosine-weighted bounce, when the sky is a map.
@@ -840,6 +842,7 @@ pub fn trace_paths(
         rays,
         gains,
         marched,
+        going_on,
     } = scratch;
     out.clear();
     out.resize(starts.len(), (Vec3::ZERO, StageCounts::default()));
@@ -935,12 +938,15 @@ pub fn trace_paths(
             ))
         }));
         march_all(rays, marched);
+        going_on.clear();
         let walked = paths.iter_mut().enumerate().filter(|(_, p)| p.is_some());
-        for (((i, slot), ray), result) in walked.zip(rays.iter()).zip(marched.iter()) {
+        for (r, ((i, slot), (ray, result))) in
+            walked.zip(rays.iter().zip(marched.iter())).enumerate()
+        {
             let (radiance, counts) = &mut out[i];
             counts.bounces += result.evaluations as u64;
             let Some(path) = slot.as_mut() else { continue };
-            let Some(hit) = result.hit else {
+            if result.hit.is_none() {
                 let dir = ray.dir;
                 let sky = match environment {
                     Some(map) => {
@@ -952,7 +958,7 @@ pub fn trace_paths(
                 *radiance += path.throughput * sky * sky_scale;
                 *slot = None;
                 continue;
-            };
+            }
             if bounce + 1 == bounces {
                 *slot = None; // the path ends here: its hit needs no normal
                 continue;
@@ -967,13 +973,23 @@ pub fn trace_paths(
                 }
                 path.throughput /= survive;
             }
-            let (nrm, spent) = normal(ray, &hit, fractal, settings);
-            counts.bounces += spent as u64;
-            path.here = SurfacePoint {
-                t: path.here.t + hit.t,
-                ..SurfacePoint::from_hit(ray, &hit, nrm)
-            };
+            going_on.push((i, r));
         }
+        // The hits the paths go on from, their normals four to a kernel call.
+        let hits = going_on
+            .iter()
+            .enumerate()
+            .filter_map(|(k, &(_, r))| Some((k, &rays[r], marched[r].hit.as_ref()?)));
+        normals_many(hits, fractal, settings, |k, (nrm, spent)| {
+            let (i, r) = going_on[k];
+            out[i].1.bounces += spent as u64;
+            if let (Some(path), Some(hit)) = (paths[i].as_mut(), &marched[r].hit) {
+                path.here = SurfacePoint {
+                    t: path.here.t + hit.t,
+                    ..SurfacePoint::from_hit(&rays[r], hit, nrm)
+                };
+            }
+        });
     }
 }
 
