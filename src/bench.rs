@@ -936,10 +936,13 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
     let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
         return Vec::new();
     };
-    // A warm-up pass, then samples of enough passes to last 0.2 s each on
-    // the widest pool (as a second, warm pass times them; longer on fewer
-    // threads), so thread start-up and fork/join are a small part of what
-    // is timed.
+    // Every pool warmed once (its threads started, the points in cache);
+    // then samples of enough passes to last 0.2 s each on the widest pool
+    // (as a warm pass times them; longer on fewer threads), so fork/join is
+    // a small part of what is timed.
+    for (_, pool) in &pools {
+        pass(pool);
+    }
     let iterations_per_pass = pass(widest);
     let start = Instant::now();
     pass(widest);
@@ -1055,7 +1058,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             r.gflops,
             100.0 * r.fraction_of_peak
         );
-        if kernel.len() > 1 {
+        if kernel.len() > 1 && kernel.iter().any(|k| k.threads == 1) {
             let scaling: Vec<String> = kernel
                 .iter()
                 .map(|k| {

@@ -630,12 +630,24 @@ impl Fractal {
             // Chunks of points and of results have the same lengths.
             if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
                 let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
-                arch.dispatch(Kernel(self, lanes, VECTOR, n, full));
+                arch.dispatch(Kernel {
+                    fractal: self,
+                    points: lanes,
+                    live: VECTOR,
+                    n,
+                    out: full,
+                });
             } else {
                 let lanes: [DVec3; VECTOR] =
                     std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
                 let mut full = [Out::IDLE; VECTOR];
-                arch.dispatch(Kernel(self, &lanes, chunk.len(), n, &mut full));
+                arch.dispatch(Kernel {
+                    fractal: self,
+                    points: &lanes,
+                    live: chunk.len(),
+                    n,
+                    out: &mut full,
+                });
                 out.copy_from_slice(&full[..out.len()]);
             }
         }
@@ -803,20 +815,27 @@ type Stored = [f64; REGISTER];
 /// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
 /// register of nothing but padding is neither iterated nor finished, its
 /// results left as they were (`Finished::IDLE` from `in_vectors`).
-struct Kernel<'a, Out>(
-    &'a Fractal,
-    &'a [DVec3; VECTOR],
-    usize,
-    u32,
-    &'a mut [Out; VECTOR],
-);
+struct Kernel<'a, Out> {
+    fractal: &'a Fractal,
+    points: &'a [DVec3; VECTOR],
+    live: usize,
+    /// The whole power.
+    n: u32,
+    out: &'a mut [Out; VECTOR],
+}
 
 impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
     type Output = ();
 
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) {
-        let Self(fractal, points, live, n, out) = self;
+        let Self {
+            fractal,
+            points,
+            live,
+            n,
+            out,
+        } = self;
         run_vector(simd, fractal, points, live, n, out)
     }
 }
@@ -1610,8 +1629,24 @@ mod tests {
                     n: u32,
                 ) -> ([Orbit<f64>; VECTOR], [Estimate; VECTOR]) {
                     let mut out = ([Orbit::IDLE; VECTOR], [Estimate::IDLE; VECTOR]);
-                    Kernel(f, &points, live, n, &mut out.0).with_simd(simd);
-                    Kernel(f, &points, live, n, &mut out.1).with_simd(simd);
+                    let fractal = f;
+                    let points = &points;
+                    Kernel {
+                        fractal,
+                        points,
+                        live,
+                        n,
+                        out: &mut out.0,
+                    }
+                    .with_simd(simd);
+                    Kernel {
+                        fractal,
+                        points,
+                        live,
+                        n,
+                        out: &mut out.1,
+                    }
+                    .with_simd(simd);
                     out
                 }
                 check(

@@ -429,15 +429,18 @@ pub fn normal(ray: &Ray, hit: &Hit, fractal: &Fractal, settings: &MarchSettings)
 }
 
 /// `normal` for many hits, four to a call of the lane kernel (its 16
-/// estimates), so a hit does not pay for a call of its own: `out(i, …)`
-/// gets what `normal` gives for `hits[i]`, bit for bit.
+/// estimates), so a hit does not pay for a call of its own: `out(i, ray,
+/// hit, …)` gets what `normal` gives for each hit (`i` as given with it),
+/// bit for bit.
 pub fn normals_many<'h>(
     hits: impl IntoIterator<Item = (usize, &'h Ray, &'h Hit)>,
     fractal: &Fractal,
     settings: &MarchSettings,
-    mut out: impl FnMut(usize, (DVec3, u32)),
+    mut out: impl FnMut(usize, &'h Ray, &'h Hit, (DVec3, u32)),
 ) {
+    // Four tetrahedra fill a call (the batch below is spelt out as four).
     const PER_CALL: usize = VECTOR / 4;
+    const { assert!(PER_CALL == 4) };
     let mut hits = hits.into_iter();
     let mut estimates = [Estimate::IDLE; VECTOR];
     loop {
@@ -448,7 +451,7 @@ pub fn normals_many<'h>(
         let [Some(a), Some(b), Some(c), Some(d)] = batch else {
             // The last few, one call each.
             for (i, ray, hit) in batch.into_iter().flatten() {
-                out(i, normal(ray, hit, fractal, settings));
+                out(i, ray, hit, normal(ray, hit, fractal, settings));
             }
             return;
         };
@@ -461,8 +464,8 @@ pub fn normals_many<'h>(
             footprints[4 * k..4 * k + 4].fill(f);
         }
         fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
-        for (k, &(i, ray, _)) in batch.iter().enumerate() {
-            out(i, normal_from(ray, &estimates[4 * k..4 * k + 4]));
+        for (k, &(i, ray, hit)) in batch.iter().enumerate() {
+            out(i, ray, hit, normal_from(ray, &estimates[4 * k..4 * k + 4]));
         }
     }
 }
@@ -568,7 +571,10 @@ mod tests {
                     .filter_map(|(i, (r, m))| Some((i, r, m.hit.as_ref()?)))
                     .collect();
                 let mut normals = vec![None; rays.len()];
-                normals_many(hit_rays.iter().copied(), f, &settings, |i, n| {
+                normals_many(hit_rays.iter().copied(), f, &settings, |i, ray, hit, n| {
+                    // Handed back with the ray and hit it was given with.
+                    assert!(std::ptr::eq(ray, &rays[i]));
+                    assert!(std::ptr::eq(hit, many[i].hit.as_ref().expect("a hit")));
                     assert!(normals[i].replace(n).is_none(), "ray {i} twice")
                 });
                 for &(i, r, hit) in &hit_rays {

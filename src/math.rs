@@ -515,8 +515,9 @@ pub fn linear_to_srgb(x: f32) -> f32 {
 /// for every f32, to `(linear_to_srgb(x) * 255.0 + 0.5) as u8` (tested over
 /// every value in [2⁻¹³, 1]), so frames keep their bytes. Values from 2⁻¹³
 /// to 1 fall in buckets of 1/128 of an octave, keyed by the top bits of the
-/// float; a bucket spans under half a code step of the curve, so it holds the
-/// code at its start and at most one threshold where the code goes up by one.
+/// float; a bucket spans under one code step of the curve (at most about
+/// two thirds, just below 1), so it holds the code at its start and at most
+/// one threshold where the code goes up by one (checked as the table is built).
 pub struct SrgbBytes {
     base: [u8; SRGB_BUCKETS],
     next: [f32; SRGB_BUCKETS],
@@ -551,7 +552,12 @@ impl SrgbBytes {
             let last = first + (1 << SRGB_KEY_SHIFT) - 1;
             let base = Self::exact(f32::from_bits(first));
             table.base[i] = base;
-            if Self::exact(f32::from_bits(last)) > base {
+            let end = Self::exact(f32::from_bits(last));
+            assert!(
+                end <= base.saturating_add(1),
+                "an sRGB bucket spans two steps"
+            );
+            if end > base {
                 // The first value of the bucket whose code is above its start.
                 let (mut below, mut above) = (first, last);
                 while above - below > 1 {

@@ -302,8 +302,10 @@ fn encode_exr(
 ) -> std::result::Result<(), String> {
     use exr::image::recursive::{NoneMore, Recursive};
     use exr::prelude::*;
-    // The file's channels are described here and each pixel's values read
-    // from the film while exr encodes its blocks: no per-channel copy of the
+    // The file's channels are described here, with the value of each pixel
+    // in each (the closure below): exrs infers the headers from this, and
+    // its own writer, which the block writer (`write_exr_blocks`) is tested
+    // against, reads the pixels through it. No per-channel copy of the
     // frame, so a 4K frame costs little beyond the film itself. Layers not
     // asked for are `None` and not written; their tuple slots are ignored.
     let channel = |name: &str, sample: SampleType| ChannelDescription::named(name, sample);
@@ -410,7 +412,8 @@ fn encode_exr(
 /// took about 90 ms, most of a core, while the pool waited), and compresses
 /// on a pool of its own as wide as the machine, whatever `--threads` says.
 /// Here each line of a channel is copied from the film in one loop
-/// (`film_block`); a channel it does not know goes through exrs' closure.
+/// (`film_block`, whose channel names must match `encode_exr`'s); a block
+/// with a channel it does not know is filled whole through exrs' closure.
 /// The bytes are the same as exrs' writer's (tested).
 fn write_exr_blocks<'i, L>(
     out: &mut (impl Write + std::io::Seek),
@@ -949,12 +952,16 @@ mod tests {
 
     #[test]
     fn exr_blocks_are_the_bytes_of_exrs_own_writer() {
-        // An odd size, every layer and values that differ per pixel and
+        // A size of 3×2 of exrs' 64-pixel tiles, cut short at the right and
+        // the bottom; every layer and values that differ per pixel and
         // channel (some negative, some past f16's range), with and without
         // the extra layers.
-        let (w, h) = (37u32, 23u32);
+        let (w, h) = (150u32, 70u32);
         let n = (w * h) as usize;
-        let v = |i: usize, k: usize| ((i * 7 + k * 3) % 41) as f32 * 0.37 - 3.0;
+        let v = |i: usize, k: usize| match (i * 7 + k * 3) % 41 {
+            40 => 1e5,
+            j => j as f32 * 0.37 - 3.0,
+        };
         let vectors = |k: usize| {
             (0..n)
                 .map(|i| Vec3::new(v(i, k), v(i, k + 1), v(i, k + 2)))

@@ -559,13 +559,16 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             .zip(marched.iter())
             .enumerate()
             .filter_map(|(x, (ray, result))| Some((x, ray, result.hit.as_ref()?)));
-        normals_many(hits, &scene.fractal, &scene.quality, |x, (nrm, evals)| {
-            stats.normal_evaluations += evals as u64;
-            surface_costs[x] += evals as u64;
-            if let Some(hit) = &marched[x].hit {
-                surfaces[x] = Some(SurfacePoint::from_hit(&rays[x], hit, nrm));
-            }
-        });
+        normals_many(
+            hits,
+            &scene.fractal,
+            &scene.quality,
+            |x, ray, hit, (nrm, evals)| {
+                stats.normal_evaluations += evals as u64;
+                surface_costs[x] += evals as u64;
+                surfaces[x] = Some(SurfacePoint::from_hit(ray, hit, nrm));
+            },
+        );
         // The row's shadow rays, walked side by side. Shading takes their
         // outcomes back in the same order, pixel after pixel.
         shadows.clear();

@@ -978,15 +978,13 @@ pub fn trace_paths(
         // The hits the paths go on from, their normals four to a kernel call.
         let hits = going_on
             .iter()
-            .enumerate()
-            .filter_map(|(k, &(_, r))| Some((k, &rays[r], marched[r].hit.as_ref()?)));
-        normals_many(hits, fractal, settings, |k, (nrm, spent)| {
-            let (i, r) = going_on[k];
+            .filter_map(|&(i, r)| Some((i, &rays[r], marched[r].hit.as_ref()?)));
+        normals_many(hits, fractal, settings, |i, ray, hit, (nrm, spent)| {
             out[i].1.bounces += spent as u64;
-            if let (Some(path), Some(hit)) = (paths[i].as_mut(), &marched[r].hit) {
+            if let Some(path) = paths[i].as_mut() {
                 path.here = SurfacePoint {
                     t: path.here.t + hit.t,
-                    ..SurfacePoint::from_hit(&rays[r], hit, nrm)
+                    ..SurfacePoint::from_hit(ray, hit, nrm)
                 };
             }
         });
@@ -1070,6 +1068,20 @@ mod tests {
             occlusions(&fractal, &ao, sites, |i, out| {
                 assert!(packed[i].replace(out).is_none(), "point {i} twice")
             });
+            // The documented sum, one scalar estimate at a time.
+            let by_hand = |at: &SurfacePoint| {
+                let (mut blocked, mut weights, mut weight, mut spent) = (0.0, 0.0, 1.0, 0);
+                for k in 1..=samples {
+                    let d = ao.radius * at.t * k as Real / samples as Real;
+                    let e = fractal.estimate(at.point + at.normal * d, at.footprint);
+                    spent += e.orbits as u64;
+                    blocked += weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
+                    weights += weight;
+                    weight *= 0.6;
+                }
+                let ambient = 1.0 - ao.strength as Real * blocked / weights;
+                (ambient.clamp(0.0, 1.0) as f32, spent)
+            };
             let mut occluded = 0;
             for (at, packed) in points.iter().zip(&packed) {
                 let (a, spent) = occlusion(&fractal, &ao, at.point, at.normal, at.t, at.footprint);
@@ -1079,6 +1091,8 @@ mod tests {
                     (b.to_bits(), packed_spent),
                     "{samples}"
                 );
+                let (c, hand_spent) = by_hand(at);
+                assert_eq!((a.to_bits(), spent), (c.to_bits(), hand_spent), "{samples}");
                 occluded += (a < 0.99) as usize;
             }
             assert!(occluded > 2, "{occluded} occluded with {samples} samples");
