@@ -59,8 +59,9 @@ pub struct Measurement {
 
 /// The scene with every knob set high: the reference. Twice the iterations
 /// (at least 8 more), a bailout of at least 16, the analytic estimator in
-/// f64, hit threshold ÷ 8, fudge ≤ 0.5, no over-relaxation, 8× the steps,
-/// normal step ÷ 4 and at least 16 samples per pixel.
+/// f64, hit threshold ÷ 8, fudge ≤ 0.5, no over-relaxation, every ray
+/// marched alone (no cones), 8× the steps, normal step ÷ 4 and at least 16
+/// samples per pixel.
 pub fn reference_scene(scene: &Scene) -> Scene {
     let mut r = scene.clone();
     let f = &scene.fractal;
@@ -75,6 +76,7 @@ pub fn reference_scene(scene: &Scene) -> Scene {
     r.quality.max_steps = scene.quality.max_steps.saturating_mul(8);
     r.quality.normal_step = scene.quality.normal_step / 4.0;
     r.quality.over_relaxation = 1.0;
+    r.quality.cone_rays = 1;
     r.samples_per_pixel = scene.samples_per_pixel.max(16);
     r
 }
@@ -150,6 +152,9 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
         add("over_relaxation", format!("{v}"), &|s| {
             s.quality.over_relaxation = v
         });
+    }
+    for v in [1, 4, 16, 64] {
+        add("cone_rays", v.to_string(), &|s| s.quality.cone_rays = v);
     }
     for k in [0.25, 0.5, 2.0] {
         let v = scaled(q.max_steps, k);

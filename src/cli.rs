@@ -1101,7 +1101,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
     );
     // The render plan: which stages run per camera sample, and their cost in
     // distance estimates relative to marching (about 20 per ray at this size).
-    println!("plan:     per sample: primary march; per hit: normal (4 estimates)");
+    let cones = match (base.quality.cone_rays, effects.glow.is_some()) {
+        (1, _) => "each camera ray alone".to_string(),
+        (_, true) => "each camera ray alone, for glow".to_string(),
+        (n, false) => format!("runs of {n} camera rays share a cone first"),
+    };
+    println!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
     if let Some(sh) = &effects.shadows {
         println!(
             "          + shadow march towards the light, up to {} estimates per lit hit ({})",
@@ -1126,7 +1131,7 @@ fn info(path: &Path) -> anyhow::Result<()> {
         println!("          + fog over hit distance (no estimates)");
     }
     if effects.glow.is_some() {
-        println!("          + glow from the march's nearest approach (no estimates)");
+        println!("          + glow from each ray's nearest approach (no estimates; its rays march without cones)");
     }
     if let Some(pt) = &effects.path_tracing {
         println!(

@@ -526,6 +526,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         walks,
         shadows,
         occluded,
+        cone_free,
         paths,
     } = &mut scratch;
     marched.resize(w, MarchResult::default());
@@ -544,7 +545,13 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 camera.ray(x as Real + ox, y as Real + oy, width, height)
             }
         }));
-        march_many(rays, &scene.fractal, &scene.quality, marched);
+        if scene.effects.glow.is_some() {
+            // Glow needs every ray's own nearest approach.
+            march_many(rays, &scene.fractal, &scene.quality, marched);
+        } else {
+            let (f, q) = (&scene.fractal, &scene.quality);
+            crate::march::march_camera_rays(rays, f, q, marched, cone_free);
+        }
         // Where each ray met the surface, with its normal (the row's hits
         // four to a kernel call), and what that cost.
         surfaces.clear();
@@ -697,6 +704,8 @@ struct RowScratch {
     shadows: Vec<(f32, u64)>,
     /// Each pixel's ambient occlusion and its cost, where it hit.
     occluded: Vec<Option<(f32, u64)>>,
+    /// Where each run of camera rays may start, and what its cone cost.
+    cone_free: Vec<(crate::math::Real, u32)>,
     /// The row's path-traced samples, traced together.
     paths: crate::shade::PathScratch,
 }
@@ -889,7 +898,17 @@ mod tests {
                 [false, false, false, false, true, true],
             ),
         ];
+        // Glow needs each camera ray's own nearest approach, so its rays march
+        // alone, without cones: against the plain frame marched that way.
+        let mut alone_scene = Scene::default();
+        alone_scene.quality.cone_rays = 1;
+        let alone = counters(&render_frame(&alone_scene, 0, 40, 30, &|| {}).stats);
+        assert!(
+            alone[0] > p[0],
+            "cones save primary estimates: {alone:?} {p:?}"
+        );
         for (name, effects, moves) in cases {
+            let p = if effects.glow.is_some() { alone } else { p };
             let scene = Scene {
                 effects,
                 ..Scene::default()

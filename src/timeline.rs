@@ -759,6 +759,11 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         || format!("must be 1..=1000000, got {}", q.max_steps),
     )?;
     check(
+        (1..=4096).contains(&q.cone_rays),
+        "quality.cone_rays",
+        || format!("must be 1..=4096, got {}", q.cone_rays),
+    )?;
+    check(
         (1..=4096).contains(&s.samples_per_pixel),
         "samples_per_pixel",
         || format!("must be 1..=4096, got {}", s.samples_per_pixel),
@@ -1134,6 +1139,11 @@ mod tests {
         assert!(error_of("(fps: 24, frames: 0, size: (8, 6))").contains("frames"));
         let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (camera: (fov_degrees: 0)))");
         assert!(e.contains("scene.camera.fov_degrees"), "{e}");
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (quality: (cone_rays: 0)))");
+        assert!(
+            e.contains("quality.cone_rays") && e.contains("1..=4096"),
+            "{e}"
+        );
         let e = error_of(&with_track(
             "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: -3)])",
         ));
