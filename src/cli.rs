@@ -1101,10 +1101,11 @@ fn info(path: &Path) -> anyhow::Result<()> {
     );
     // The render plan: which stages run per camera sample, and their cost in
     // distance estimates relative to marching (about 20 per ray at this size).
-    let cones = match (base.quality.cone_rays, effects.glow.is_some()) {
-        (1, _) => "each camera ray alone".to_string(),
-        (_, true) => "each camera ray alone, for glow".to_string(),
-        (n, false) => format!("runs of {n} camera rays share a cone first"),
+    let cones = match (base.cone_rays(), base.quality.cone_rays) {
+        (1, 1) => "each camera ray alone".to_string(),
+        (1, _) if effects.glow.is_some() => "each camera ray alone, for glow".to_string(),
+        (1, _) => format!("each camera ray alone, for the {} estimator", f.de.name()),
+        (n, _) => format!("runs of {n} camera rays share a cone first"),
     };
     println!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
     if let Some(sh) = &effects.shadows {

@@ -34,7 +34,8 @@ pub struct MarchSettings {
     /// Camera rays, neighbours along a row, that first march together along
     /// one cone holding them all, until the surface is within a pixel of the
     /// cone, and then go on alone (`march_camera_rays`); 1 marches every ray
-    /// alone. Not used with glow, which needs each ray's nearest approach.
+    /// alone. Not used with glow, which needs each ray's nearest approach,
+    /// nor with estimators other than the analytic one (`Scene::cone_rays`).
     pub cone_rays: u32,
 }
 
@@ -134,19 +135,21 @@ pub fn march_many(
 }
 
 /// Camera rays of a row, marched as `march_many` does, but each run of
-/// `settings.cone_rays` neighbours first shares one march along a cone that
-/// holds them all (`ConeWalk`): the stretch where the surface is still far
-/// off compared with the run's width is walked once for the run, and each
-/// ray starts where the cone stopped. The cone's estimates are counted on
-/// the run's first ray. `free` is scratch space, kept by the caller.
+/// `run` neighbours first shares one march along a cone that holds them
+/// all (`ConeWalk`): the stretch where the surface is still far off
+/// compared with the run's width is walked once for the run, and each ray
+/// starts where the cone stopped. The cone's estimates are shared out over
+/// the run's rays. `free` is scratch space, kept by the caller. `run` is
+/// `Scene::cone_rays` (1: every ray alone).
 pub fn march_camera_rays(
     rays: &[Ray],
     fractal: &Fractal,
     settings: &MarchSettings,
+    run: u32,
     results: &mut [MarchResult],
     free: &mut Vec<(Real, u32)>,
 ) {
-    let run = settings.cone_rays.max(1) as usize;
+    let run = run.max(1) as usize;
     if run == 1 {
         return march_many(rays, fractal, settings, results);
     }
@@ -160,8 +163,14 @@ pub fn march_camera_rays(
         .enumerate()
         .map(|(k, ray)| Marcher::start_from(ray, settings, free[k / run].0));
     walk_many(walks, fractal, settings, |i, result| results[i] = result);
-    for (k, &(_, evaluations)) in free.iter().enumerate() {
-        results[k * run].evaluations += evaluations;
+    // Each ray of a run takes its share of the cone's estimates (the first
+    // ones one more while there is a remainder), so the frame's total and
+    // the per-pixel cost map both hold them.
+    for (results, &(_, evaluations)) in results.chunks_mut(run).zip(free.iter()) {
+        let n = results.len() as u32;
+        for (k, r) in results.iter_mut().enumerate() {
+            r.evaluations += evaluations / n + u32::from((k as u32) < evaluations % n);
+        }
     }
 }
 
@@ -169,8 +178,8 @@ pub fn march_camera_rays(
 /// is the estimate less how far the farthest ray can be from the axis
 /// point there, so every ray's own path to the next point stays inside
 /// the ball the estimate clears. It stops where that shared step falls
-/// below a pixel footprint (the rays must go on alone), at a point inside
-/// the set, or where every ray has left the bounding sphere.
+/// below a pixel footprint (the rays must go on alone), where every ray has
+/// left the bounding sphere, or, a step back, at a point inside the set.
 #[derive(Clone, Copy)]
 struct ConeWalk {
     origin: DVec3,
@@ -181,6 +190,8 @@ struct ConeWalk {
     start_footprint: Real,
     pixel_angle: Real,
     t: Real,
+    /// Where the walk was before its last step.
+    previous: Real,
     t_end: Real,
     steps: u32,
     evaluations: u32,
@@ -217,6 +228,7 @@ impl ConeWalk {
             start_footprint: first.start_footprint,
             pixel_angle: first.pixel_angle,
             t: t_start,
+            previous: t_start,
             t_end,
             steps: 0,
             evaluations: 0,
@@ -241,11 +253,17 @@ impl Walk for ConeWalk {
     ) -> Option<(Real, u32)> {
         self.evaluations += estimate.orbits;
         self.steps += 1;
+        if !estimate.escaped {
+            // Inside the set: an estimate overshot. The rays start from the
+            // last point the cone stepped from, and find the crossing alone.
+            return Some((self.previous, self.evaluations));
+        }
         let reach = self.spread.0 + self.t * self.spread.1;
         let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge - reach;
-        if !estimate.escaped || step < footprint || self.steps >= settings.max_steps {
+        if step < footprint || self.steps >= settings.max_steps {
             return Some((self.t, self.evaluations));
         }
+        self.previous = self.t;
         self.t += step;
         if self.t >= self.t_end {
             return Some((self.t_end, self.evaluations));
@@ -776,37 +794,66 @@ mod tests {
     #[test]
     fn a_cone_never_starts_a_ray_past_the_surface() {
         // Each run's cone against every one of its rays' first crossing,
-        // found by membership steps (no distance estimate trusted).
+        // found by membership steps (no distance estimate trusted): runs of
+        // the default 8 rays and of 16, pinhole rays and rays whose origins
+        // spread over a lens, as depth of field gives them.
         let settings = MarchSettings::default();
         let (mut advanced, mut crossings) = (0, 0);
         for f in &cone_test_fractals() {
-            for rays in camera_rows(DVec3::new(0.3, -2.6, 0.4), 6, 32, 2e-3) {
-                for run in rays.chunks(16) {
-                    let (t_free, _) = walk_one(ConeWalk::start(run, &settings), f, &settings);
-                    for ray in run {
-                        let (crossing, _) =
-                            march_by_membership(ray, f, &settings, 0.25, 1e-9, 100_000);
-                        let enter = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-                            .map_or(Real::INFINITY, |(enter, _)| enter);
-                        advanced += (t_free > enter + 20.0 * ray.footprint(enter)) as usize;
-                        if let Some(t) = crossing {
-                            crossings += 1;
-                            assert!(t_free <= t, "{f:?}: cone to {t_free}, surface at {t}");
+            for aperture in [0.0, 0.01] {
+                for rays in camera_rows(DVec3::new(0.3, -2.6, 0.4), 6, 32, 2e-3) {
+                    let rays: Vec<Ray> = rays
+                        .into_iter()
+                        .enumerate()
+                        .map(|(k, ray)| {
+                            let (a, r) = (k as Real * 2.4, (k % 5) as Real / 4.0);
+                            let lens = DVec3::new(a.cos(), 0.0, a.sin()) * (aperture * r);
+                            Ray {
+                                origin: ray.origin + lens,
+                                ..ray
+                            }
+                        })
+                        .collect();
+                    let first_crossings: Vec<Option<Real>> = rays
+                        .iter()
+                        .map(|ray| march_by_membership(ray, f, &settings, 0.25, 1e-9, 100_000).0)
+                        .collect();
+                    for run_length in [8, 16] {
+                        let runs = rays
+                            .chunks(run_length)
+                            .zip(first_crossings.chunks(run_length));
+                        for (run, first_crossings) in runs {
+                            let (t_free, _) =
+                                walk_one(ConeWalk::start(run, &settings), f, &settings);
+                            for (ray, crossing) in run.iter().zip(first_crossings) {
+                                let enter =
+                                    sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
+                                        .map_or(Real::INFINITY, |(enter, _)| enter);
+                                if aperture == 0.0 {
+                                    advanced +=
+                                        (t_free > enter + 20.0 * ray.footprint(enter)) as usize;
+                                }
+                                if let Some(t) = *crossing {
+                                    crossings += 1;
+                                    assert!(t_free <= t, "{f:?}: cone to {t_free}, surface at {t}");
+                                }
+                            }
                         }
                     }
                 }
             }
         }
-        // The cones did go ahead of most rays, and most rays meet the surface.
+        // The pinhole cones did go ahead of most rays, and most rays meet
+        // the surface (3 fractals × 2 lenses × 2 run lengths × 192 rays).
         assert!(
-            advanced > 400 && crossings > 150,
+            advanced > 1000 && crossings > 1500,
             "{advanced} advanced, {crossings} crossings"
         );
     }
 
     #[test]
     fn rays_after_a_cone_find_the_surface_they_find_alone() {
-        let mut settings = MarchSettings::default();
+        let settings = MarchSettings::default();
         for f in &cone_test_fractals() {
             let (mut both, mut near, mut differ, mut evaluations) = (0, 0, 0, [0u64; 2]);
             for rays in camera_rows(DVec3::new(-2.2, -1.1, 0.9), 6, 64, 1.5e-3) {
@@ -818,8 +865,8 @@ mod tests {
                     .into_iter()
                     .enumerate()
                 {
-                    settings.cone_rays = cone_rays;
-                    march_camera_rays(&rays, f, &settings, &mut marched[k], &mut Vec::new());
+                    let (results, free) = (&mut marched[k], &mut Vec::new());
+                    march_camera_rays(&rays, f, &settings, cone_rays, results, free);
                     evaluations[k] += marched[k].iter().map(|m| m.evaluations as u64).sum::<u64>();
                 }
                 let mut alone = vec![MarchResult::default(); rays.len()];

@@ -5,7 +5,7 @@
 //! Every pixel depends only on (scene, frame, pixel, sample), never on which
 //! thread ran it or in which order, so the image is identical for any thread count.
 
-use crate::march::{march_many, normals_many, walk_many, MarchResult};
+use crate::march::{normals_many, walk_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
@@ -545,13 +545,8 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 camera.ray(x as Real + ox, y as Real + oy, width, height)
             }
         }));
-        if scene.effects.glow.is_some() {
-            // Glow needs every ray's own nearest approach.
-            march_many(rays, &scene.fractal, &scene.quality, marched);
-        } else {
-            let (f, q) = (&scene.fractal, &scene.quality);
-            crate::march::march_camera_rays(rays, f, q, marched, cone_free);
-        }
+        let (f, q, run) = (&scene.fractal, &scene.quality, scene.cone_rays());
+        crate::march::march_camera_rays(rays, f, q, run, marched, cone_free);
         // Where each ray met the surface, with its normal (the row's hits
         // four to a kernel call), and what that cost.
         surfaces.clear();
@@ -902,13 +897,17 @@ mod tests {
         // alone, without cones: against the plain frame marched that way.
         let mut alone_scene = Scene::default();
         alone_scene.quality.cone_rays = 1;
-        let alone = counters(&render_frame(&alone_scene, 0, 40, 30, &|| {}).stats);
+        let alone_film = render_frame(&alone_scene, 0, 40, 30, &|| {});
+        let alone = counters(&alone_film.stats);
         assert!(
             alone[0] > p[0],
             "cones save primary estimates: {alone:?} {p:?}"
         );
         for (name, effects, moves) in cases {
-            let p = if effects.glow.is_some() { alone } else { p };
+            let (p, plain) = match effects.glow {
+                Some(_) => (alone, &alone_film),
+                None => (p, &plain),
+            };
             let scene = Scene {
                 effects,
                 ..Scene::default()

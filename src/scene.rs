@@ -154,6 +154,23 @@ impl Default for Scene {
     }
 }
 
+impl Scene {
+    /// Camera rays that march one cone together (`quality.cone_rays`), or 1
+    /// where cones do not apply: with glow, which needs each ray's own
+    /// nearest approach, and with estimators other than the analytic one,
+    /// whose finite differences can overestimate a step that a cone would
+    /// trust for all its rays.
+    pub fn cone_rays(&self) -> u32 {
+        let alone =
+            self.effects.glow.is_some() || self.fractal.de != crate::fractal::DeMethod::Analytic;
+        if alone {
+            1
+        } else {
+            self.quality.cone_rays
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
