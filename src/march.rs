@@ -807,9 +807,13 @@ mod tests {
                         .enumerate()
                         .map(|(k, ray)| {
                             let (a, r) = (k as Real * 2.4, (k % 5) as Real / 4.0);
+                            // Through a point of the lens towards where the
+                            // pinhole ray is 2.5 along: focused there.
                             let lens = DVec3::new(a.cos(), 0.0, a.sin()) * (aperture * r);
+                            let focus = ray.at(2.5);
                             Ray {
                                 origin: ray.origin + lens,
+                                dir: (focus - ray.origin - lens).normalize(),
                                 ..ray
                             }
                         })
@@ -849,6 +853,27 @@ mod tests {
             advanced > 1000 && crossings > 1500,
             "{advanced} advanced, {crossings} crossings"
         );
+    }
+
+    #[test]
+    fn a_cone_that_lands_inside_starts_its_rays_a_step_back() {
+        // A fudge of 3 trusts the unit ball's exact distance three times
+        // over, so the cone's step lands inside the ball: its rays must
+        // start from the point before, in front of the surface (t = 2 on
+        // the axis, a little more off it).
+        let settings = MarchSettings {
+            fudge: 3.0,
+            ..MarchSettings::default()
+        };
+        let origin = DVec3::new(0.0, 0.0, 3.0);
+        let run: Vec<Ray> = (0..8)
+            .map(|k| ray(origin, DVec3::new(1e-3 * k as Real, 0.0, -1.0)))
+            .collect();
+        let (t_free, evaluations) =
+            walk_one(ConeWalk::start(&run, &settings), &unit_ball(), &settings);
+        // From the sphere (t = 1.5) it stepped to the centre, inside: back.
+        assert_eq!(evaluations, 2);
+        assert!((1.5..2.0).contains(&t_free), "cone stopped at {t_free}");
     }
 
     #[test]

@@ -512,7 +512,8 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
     // count of orbit iterations measures exactly the row's.
     let iterations_before = crate::fractal::iterations_on_this_thread();
     // Each sample index at a time over the whole row, so the
-    // row's camera rays march side by side (`march_many`); each
+    // row's camera rays march side by side, in cones
+    // (`march_camera_rays`); each
     // pixel still takes its samples in order.
     // This thread's buffers, kept from row to row: allocating
     // and freeing them per row made the allocator hand pages

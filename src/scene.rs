@@ -175,6 +175,26 @@ impl Scene {
 mod tests {
     use super::*;
 
+    #[test]
+    fn cones_only_with_the_analytic_estimator_and_without_glow() {
+        let mut s = Scene::default();
+        assert_eq!(s.cone_rays(), s.quality.cone_rays);
+        s.quality.cone_rays = 4;
+        assert_eq!(s.cone_rays(), 4);
+        for de in crate::fractal::DeMethod::ALL {
+            s.fractal.de = de;
+            let expected = if de == crate::fractal::DeMethod::Analytic {
+                4
+            } else {
+                1
+            };
+            assert_eq!(s.cone_rays(), expected, "{de:?}");
+        }
+        s.fractal.de = crate::fractal::DeMethod::Analytic;
+        s.effects.glow = Some(crate::shade::Glow::default());
+        assert_eq!(s.cone_rays(), 1);
+    }
+
     fn camera() -> Camera {
         Camera {
             position: DVec3::new(0.0, 0.0, 5.0),
