@@ -1101,10 +1101,9 @@ fn info(path: &Path) -> anyhow::Result<()> {
     );
     // The render plan: which stages run per camera sample, and their cost in
     // distance estimates relative to marching (about 20 per ray at this size).
-    let cones = match (base.cone_rays(), base.quality.cone_rays) {
-        (1, 1) => "each camera ray alone".to_string(),
-        (1, _) if effects.glow.is_some() => "each camera ray alone, for glow".to_string(),
-        (1, _) => format!("each camera ray alone, for the {} estimator", f.de.name()),
+    let cones = match (base.cone_rays(), base.march_alone_reason()) {
+        (1, Some(why)) => format!("each camera ray alone, {why}"),
+        (1, None) => "each camera ray alone".to_string(),
         (n, _) => format!("runs of {n} camera rays share a cone first"),
     };
     println!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");

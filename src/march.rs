@@ -39,6 +39,15 @@ pub struct MarchSettings {
     pub cone_rays: u32,
 }
 
+impl MarchSettings {
+    /// The plain step an estimate allows: `fudge` times the estimate, no
+    /// longer than the bounding sphere is wide.
+    #[inline]
+    pub fn step(&self, distance: Real) -> Real {
+        distance.min(self.bounding_radius * 2.0) * self.fudge
+    }
+}
+
 impl Default for MarchSettings {
     fn default() -> Self {
         MarchSettings {
@@ -182,13 +191,11 @@ pub fn march_camera_rays(
 /// left the bounding sphere, or, a step back, at a point inside the set.
 #[derive(Clone, Copy)]
 struct ConeWalk {
-    origin: DVec3,
-    dir: DVec3,
+    /// The cone's axis, with the run's first ray's footprint.
+    axis: Ray,
     /// A ray of the run is at most `spread.0 + t · spread.1` from the axis
     /// point at the same `t`.
     spread: (Real, Real),
-    start_footprint: Real,
-    pixel_angle: Real,
     t: Real,
     /// Where the walk was before its last step.
     previous: Real,
@@ -222,11 +229,12 @@ impl ConeWalk {
             return Err((0.0, 0)); // every ray of the run misses the sphere
         }
         Ok(ConeWalk {
-            origin,
-            dir,
+            axis: Ray {
+                origin,
+                dir,
+                ..first
+            },
             spread,
-            start_footprint: first.start_footprint,
-            pixel_angle: first.pixel_angle,
             t: t_start,
             previous: t_start,
             t_end,
@@ -240,8 +248,7 @@ impl Walk for ConeWalk {
     type Output = (Real, u32);
 
     fn next_point(&self) -> (DVec3, Real) {
-        let footprint = (self.start_footprint + self.t * self.pixel_angle).max(1e-15);
-        (self.origin + self.dir * self.t, footprint)
+        (self.axis.at(self.t), self.axis.footprint(self.t))
     }
 
     fn advance(
@@ -259,7 +266,7 @@ impl Walk for ConeWalk {
             return Some((self.previous, self.evaluations));
         }
         let reach = self.spread.0 + self.t * self.spread.1;
-        let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge - reach;
+        let step = settings.step(estimate.distance) - reach;
         if step < footprint || self.steps >= settings.max_steps {
             return Some((self.t, self.evaluations));
         }
@@ -491,7 +498,7 @@ impl Walk for Marcher {
             return Some(self.hit(t, *estimate));
         }
         self.outside = Some(t);
-        let step = estimate.distance.min(settings.bounding_radius * 2.0) * settings.fudge;
+        let step = settings.step(estimate.distance);
         // The over-relaxed step is checked at the next point (or, leaving the
         // bounding sphere, by retrying the plain step); a plain step is safe.
         self.previous_distance = step;

@@ -156,17 +156,25 @@ impl Default for Scene {
 
 impl Scene {
     /// Camera rays that march one cone together (`quality.cone_rays`), or 1
-    /// where cones do not apply: with glow, which needs each ray's own
-    /// nearest approach, and with estimators other than the analytic one,
-    /// whose finite differences can overestimate a step that a cone would
-    /// trust for all its rays.
+    /// where cones do not apply (`march_alone_reason`).
     pub fn cone_rays(&self) -> u32 {
-        let alone =
-            self.effects.glow.is_some() || self.fractal.de != crate::fractal::DeMethod::Analytic;
-        if alone {
-            1
+        match self.march_alone_reason() {
+            Some(_) => 1,
+            None => self.quality.cone_rays,
+        }
+    }
+
+    /// Why camera rays must march alone whatever `quality.cone_rays` says:
+    /// glow needs each ray's own nearest approach, and estimators other
+    /// than the analytic one have finite differences that can overestimate
+    /// a step a cone would trust for all its rays.
+    pub fn march_alone_reason(&self) -> Option<String> {
+        if self.effects.glow.is_some() {
+            Some("for glow".into())
+        } else if self.fractal.de != crate::fractal::DeMethod::Analytic {
+            Some(format!("for the {} estimator", self.fractal.de.name()))
         } else {
-            self.quality.cone_rays
+            None
         }
     }
 }
