@@ -597,40 +597,28 @@ pub fn normal(ray: &Ray, hit: &Hit, fractal: &Fractal, settings: &MarchSettings)
 /// `normal` for many hits, four to a call of the lane kernel (its 16
 /// estimates), so a hit does not pay for a call of its own: `out(i, ray,
 /// hit, …)` gets what `normal` gives for each hit (`i` as given with it),
-/// bit for bit.
+/// bit for bit (each lane of the kernel is independent of the others).
 pub fn normals_many<'h>(
     hits: impl IntoIterator<Item = (usize, &'h Ray, &'h Hit)>,
     fractal: &Fractal,
     settings: &MarchSettings,
     mut out: impl FnMut(usize, &'h Ray, &'h Hit, (DVec3, u32)),
 ) {
-    // Four tetrahedra fill a call (the batch below is spelt out as four).
-    const PER_CALL: usize = VECTOR / 4;
-    const { assert!(PER_CALL == 4) };
-    let mut hits = hits.into_iter();
+    let mut hits = hits.into_iter().peekable();
     let mut estimates = [Estimate::IDLE; VECTOR];
-    loop {
-        let mut batch: [Option<(usize, &Ray, &Hit)>; PER_CALL] = [None; PER_CALL];
-        for (slot, hit) in batch.iter_mut().zip(hits.by_ref()) {
-            *slot = Some(hit);
-        }
-        let [Some(a), Some(b), Some(c), Some(d)] = batch else {
-            // The last few, one call each.
-            for (i, ray, hit) in batch.into_iter().flatten() {
-                out(i, ray, hit, normal(ray, hit, fractal, settings));
-            }
-            return;
-        };
-        let batch = [a, b, c, d];
-        let mut points = [DVec3::ZERO; VECTOR];
-        let mut footprints = [0.0; VECTOR];
-        for (k, &(_, ray, hit)) in batch.iter().enumerate() {
-            let (p, f) = normal_points(ray, hit, settings);
+    while hits.peek().is_some() {
+        // The last call's spare lanes idle outside the bailout ball.
+        let mut batch = [None; VECTOR / 4];
+        let mut points = [crate::fractal::IDLE_POINT; VECTOR];
+        let mut footprints = [1.0; VECTOR];
+        for (k, (slot, hit)) in batch.iter_mut().zip(hits.by_ref()).enumerate() {
+            let (p, f) = normal_points(hit.1, hit.2, settings);
             points[4 * k..4 * k + 4].copy_from_slice(&p);
             footprints[4 * k..4 * k + 4].fill(f);
+            *slot = Some(hit);
         }
         fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
-        for (k, &(i, ray, hit)) in batch.iter().enumerate() {
+        for (k, &(i, ray, hit)) in batch.iter().flatten().enumerate() {
             out(i, ray, hit, normal_from(ray, &estimates[4 * k..4 * k + 4]));
         }
     }
@@ -729,7 +717,7 @@ mod tests {
                     "{hits} hits: too few misses or hits"
                 );
                 // The hits' normals four to a call, as one at a time (the
-                // last ones, fewer than four, by `normal` itself).
+                // last call's spare lanes idle).
                 let hit_rays: Vec<(usize, &Ray, &Hit)> = rays
                     .iter()
                     .zip(&many)

@@ -523,7 +523,6 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         rays,
         marched,
         surfaces,
-        surface_costs,
         walks,
         shadows,
         occluded,
@@ -549,13 +548,12 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         let (f, q, run) = (&scene.fractal, &scene.quality, scene.cone_rays());
         crate::march::march_camera_rays(rays, f, q, run, marched, cone_free);
         // Where each ray met the surface, with its normal (the row's hits
-        // four to a kernel call), and what that cost.
+        // four to a kernel call); each pixel's cost goes straight to its sum.
         surfaces.clear();
-        surface_costs.clear();
-        for result in marched.iter() {
+        surfaces.resize(w, None);
+        for (spent, result) in spent_row.iter_mut().zip(marched.iter()) {
             stats.primary_evaluations += result.evaluations as u64;
-            surfaces.push(None);
-            surface_costs.push(result.evaluations as u64);
+            *spent += result.evaluations as u64;
         }
         let hits = rays
             .iter()
@@ -568,7 +566,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             &scene.quality,
             |x, ray, hit, (nrm, evals)| {
                 stats.normal_evaluations += evals as u64;
-                surface_costs[x] += evals as u64;
+                spent_row[x] += evals as u64;
                 surfaces[x] = Some(SurfacePoint::from_hit(ray, hit, nrm));
             },
         );
@@ -619,11 +617,10 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             }
             None => &[][..],
         };
-        for (x, (((ray, result), at), surface_cost)) in rays
+        for (x, ((ray, result), at)) in rays
             .iter()
             .zip(marched.iter())
             .zip(surfaces.iter())
-            .zip(surface_costs.iter())
             .enumerate()
         {
             let before = stats.stage_total();
@@ -678,7 +675,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             colour_row[x][1] += c.y as f64;
             colour_row[x][2] += c.z as f64;
             stats.samples += 1;
-            spent_row[x] += surface_cost + stats.stage_total() - before;
+            spent_row[x] += stats.stage_total() - before;
         }
         debug_assert!(outcomes.next().is_none(), "a shadow outcome per ray walked");
     }
@@ -693,9 +690,8 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
 struct RowScratch {
     rays: Vec<crate::march::Ray>,
     marched: Vec<MarchResult>,
-    /// Where each camera ray met the surface, and the estimates that took.
+    /// Where each camera ray met the surface.
     surfaces: Vec<Option<SurfacePoint>>,
-    surface_costs: Vec<u64>,
     walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     shadows: Vec<(f32, u64)>,
     /// Each pixel's ambient occlusion and its cost, where it hit.

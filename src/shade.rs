@@ -390,6 +390,8 @@ impl crate::march::Walk for ShadowWalk {
 }
 
 /// Ambient light reaching a surface point: 1 in the open, less in crevices.
+/// One point alone: the tests' reference for `occlusions`.
+#[cfg(test)]
 pub fn occlusion(
     fractal: &Fractal,
     ao: &AmbientOcclusion,
@@ -428,16 +430,19 @@ pub fn occlusions(
         })
         .peekable();
     let (mut blocked, mut weights, mut weight, mut spent) = (0.0, 0.0, 1.0, 0);
+    let mut estimates = [crate::fractal::Estimate::IDLE; VECTOR];
     while samples.peek().is_some() {
-        let mut lanes = [None; VECTOR];
-        for (lane, sample) in lanes.iter_mut().zip(samples.by_ref()) {
-            *lane = Some(sample);
-        }
         // Lanes past the last sample idle outside the bailout ball.
-        let points = lanes.map(|l| l.map_or(crate::fractal::IDLE_POINT, |(.., p, _)| p));
-        let footprints = lanes.map(|l| l.map_or(1.0, |(.., f)| f));
-        let estimates = fractal.estimate_lanes(points, footprints);
-        for (&(i, k, d, ..), e) in lanes.iter().flatten().zip(&estimates) {
+        let mut lanes = [(0, 0, 0.0); VECTOR];
+        let mut points = [crate::fractal::IDLE_POINT; VECTOR];
+        let mut footprints = [1.0; VECTOR];
+        let mut live = 0;
+        for (k, (i, sample, d, point, footprint)) in samples.by_ref().take(VECTOR).enumerate() {
+            (lanes[k], points[k], footprints[k]) = ((i, sample, d), point, footprint);
+            live = k + 1;
+        }
+        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
+        for (&(i, k, d), e) in lanes[..live].iter().zip(&estimates) {
             if k == 1 {
                 (blocked, weights, weight, spent) = (0.0, 0.0, 1.0, 0);
             }
@@ -525,8 +530,11 @@ impl Look {
         c * (1.0 - self.trap_occlusion + self.trap_occlusion * depth)
     }
 
-    /// Radiance of a hit with the scene's effects. Stages of effects that are
-    /// off never run; `counts` hears what the others spent.
+    /// Radiance of a hit with the scene's effects, its shadow rays walked one
+    /// at a time: the tests' reference for `shade_with`, which rendering
+    /// uses. Stages of effects that are off never run; `counts` hears what
+    /// the others spent.
+    #[cfg(test)]
     pub fn shade(
         &self,
         effects: &Effects,
@@ -581,9 +589,9 @@ impl Look {
         shadows: &mut dyn Iterator<Item = (f32, u64)>,
         occluded: Option<(f32, u64)>,
     ) -> Vec3 {
+        debug_assert_eq!(occluded.is_some(), effects.ambient_occlusion.is_some());
         let mut ambient = 1.0f32;
-        if effects.ambient_occlusion.is_some() {
-            let (a, spent) = occluded.expect("the occlusion at a point, with occlusion on");
+        if let Some((a, spent)) = occluded {
             ambient = a;
             counts.occlusion += spent;
         }
@@ -758,7 +766,8 @@ pub fn preetham(dir: DVec3, to_sun: DVec3, turbidity: Real) -> Vec3 {
 
 /// Radiance of a path-traced camera sample that hit `at`. `random(d)` is the
 /// sample's d-th uniform number (deterministic per pixel and sample).
-/// `trace_paths` for one path.
+/// `trace_paths` for one path: the tests' reference for it.
+#[cfg(test)]
 #[allow(clippy::too_many_arguments)] // the sample's whole context, passed plainly
 pub fn trace_path(
     look: &Look,
@@ -945,7 +954,7 @@ pub fn trace_paths(
         {
             let (radiance, counts) = &mut out[i];
             counts.bounces += result.evaluations as u64;
-            let Some(path) = slot.as_mut() else { continue };
+            let path = slot.as_mut().expect("only paths that go on are walked");
             if result.hit.is_none() {
                 let dir = ray.dir;
                 let sky = match environment {
@@ -976,17 +985,17 @@ pub fn trace_paths(
             going_on.push((i, r));
         }
         // The hits the paths go on from, their normals four to a kernel call.
-        let hits = going_on
-            .iter()
-            .filter_map(|&(i, r)| Some((i, &rays[r], marched[r].hit.as_ref()?)));
+        let hits = going_on.iter().map(|&(i, r)| {
+            let hit = marched[r].hit.as_ref().expect("a path goes on from a hit");
+            (i, &rays[r], hit)
+        });
         normals_many(hits, fractal, settings, |i, ray, hit, (nrm, spent)| {
             out[i].1.bounces += spent as u64;
-            if let Some(path) = paths[i].as_mut() {
-                path.here = SurfacePoint {
-                    t: path.here.t + hit.t,
-                    ..SurfacePoint::from_hit(ray, hit, nrm)
-                };
-            }
+            let path = paths[i].as_mut().expect("a path that goes on");
+            path.here = SurfacePoint {
+                t: path.here.t + hit.t,
+                ..SurfacePoint::from_hit(ray, hit, nrm)
+            };
         });
     }
 }
