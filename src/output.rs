@@ -412,8 +412,8 @@ fn encode_exr(
 /// took about 90 ms, most of a core, while the pool waited), and compresses
 /// on a pool of its own as wide as the machine, whatever `--threads` says.
 /// Here each line of a channel is copied from the film in one loop
-/// (`film_block`, whose channel names must match `encode_exr`'s); a block
-/// with a channel it does not know is filled whole through exrs' closure.
+/// (`film_block`, whose channel names must match `encode_exr`'s); a layer
+/// with a channel it does not know is filled through exrs' closure.
 /// The bytes are the same as exrs' writer's (tested).
 fn write_exr_blocks<'i, L>(
     out: &mut (impl Write + std::io::Seek),
@@ -431,6 +431,12 @@ where
     let headers = image.write().infer_meta_data();
     let layers = image.layer_data.create_writer(&headers);
     exr::block::write(out, headers, true, |meta, chunks| {
+        // Each layer's channels found in the film once, not per block.
+        let planes: Vec<_> = meta
+            .headers
+            .iter()
+            .map(|header| film_planes(film, &header.channels))
+            .collect();
         let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
         // Enough blocks a batch to keep every thread busy; few enough that
         // the compressed batch is small beside the film.
@@ -439,9 +445,10 @@ where
             let compressed: Vec<_> = blocks
                 .par_iter()
                 .map(|&(in_header, index)| {
-                    let channels = &meta.headers[index.layer].channels;
-                    let data = film_block(film, channels, index)
-                        .unwrap_or_else(|| layers.extract_uncompressed_block(&meta.headers, index));
+                    let data = match &planes[index.layer] {
+                        Some(planes) => film_block(film, planes, index),
+                        None => layers.extract_uncompressed_block(&meta.headers, index),
+                    };
                     UncompressedBlock { index, data }
                         .compress_to_chunk(&meta.headers)
                         .map(|chunk| (in_header, chunk))
@@ -471,10 +478,7 @@ fn put_line(
             .chunks_exact_mut(4)
             .zip(values)
             .for_each(|(out, v)| out.copy_from_slice(&v.to_ne_bytes())),
-        SampleType::U32 => line
-            .chunks_exact_mut(4)
-            .zip(values)
-            .for_each(|(out, v)| out.copy_from_slice(&(v as u32).to_ne_bytes())),
+        SampleType::U32 => unreachable!("film_planes gives float planes float samples"),
     }
 }
 
@@ -519,28 +523,43 @@ impl<'f> Plane<'f> {
     }
 }
 
-/// The uncompressed bytes of the block at `index` straight from the film:
-/// line by line, each channel's samples of the line in a row, in the
-/// header's channel order and sample types, native-endian (exrs' layout).
-/// `None` if a channel is not one of the film's.
-fn film_block(
-    film: &Film,
+/// The film's plane for each channel of a layer, in the header's order,
+/// with the channel's sample type; `None` if a channel is not one of the
+/// film's or wants a sample type its plane does not hold (counts as u32,
+/// the rest as f16 or f32).
+fn film_planes<'f>(
+    film: &'f Film,
     channels: &exr::meta::attribute::ChannelList,
-    index: exr::block::BlockIndex,
-) -> Option<Vec<u8>> {
+) -> Option<Vec<(Plane<'f>, exr::meta::attribute::SampleType)>> {
     use exr::meta::attribute::SampleType;
-    let planes = channels
+    channels
         .list
         .iter()
-        .map(|c| Some((Plane::named(film, &c.name.to_string())?, c.sample_type)))
-        .collect::<Option<Vec<_>>>()?;
+        .map(|c| {
+            let plane = Plane::named(film, &c.name.to_string())?;
+            let counts = matches!(plane, Plane::Counts(_));
+            (counts == (c.sample_type == SampleType::U32)).then_some((plane, c.sample_type))
+        })
+        .collect()
+}
+
+/// The uncompressed bytes of the block at `index` straight from the film's
+/// `planes` (`film_planes`): line by line, each channel's samples of the
+/// line in a row, in the header's channel order and sample types,
+/// native-endian (exrs' layout).
+fn film_block(
+    film: &Film,
+    planes: &[(Plane, exr::meta::attribute::SampleType)],
+    index: exr::block::BlockIndex,
+) -> Vec<u8> {
     let (x0, y0) = (index.pixel_position.x(), index.pixel_position.y());
     let (w, h) = (index.pixel_size.width(), index.pixel_size.height());
-    let mut data = vec![0u8; w * h * channels.bytes_per_pixel];
+    let bytes_per_pixel: usize = planes.iter().map(|(_, s)| s.bytes_per_sample()).sum();
+    let mut data = vec![0u8; w * h * bytes_per_pixel];
     let mut lines = data.as_mut_slice();
     for y in y0..y0 + h {
         let row = y * film.width as usize + x0..y * film.width as usize + x0 + w;
-        for &(ref plane, sample) in &planes {
+        for &(ref plane, sample) in planes {
             let (line, rest) =
                 std::mem::take(&mut lines).split_at_mut(w * sample.bytes_per_sample());
             lines = rest;
@@ -548,16 +567,15 @@ fn film_block(
                 Plane::Vectors(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
                 Plane::Floats(v) => put_line(line, v[row.clone()].iter().copied(), sample),
                 Plane::Traps(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
-                Plane::Counts(v) if sample == SampleType::U32 => {
+                Plane::Counts(v) => {
                     for (out, count) in line.chunks_exact_mut(4).zip(&v[row.clone()]) {
                         out.copy_from_slice(&count.to_ne_bytes());
                     }
                 }
-                Plane::Counts(_) => return None,
             }
         }
     }
-    Some(data)
+    data
 }
 
 /// `rows` as CSV: a header of the field names, then a line per row.
@@ -1001,6 +1019,10 @@ mod tests {
             };
             let (ours, theirs) = (encode(false), encode(true));
             assert!(ours.len() > n * 12, "{} bytes", ours.len());
+            // The film holds every channel of the file: no block went
+            // through exrs' closure, so the two writers really differ.
+            let meta = exr::meta::MetaData::read_from_buffered(&ours[..], false).unwrap();
+            assert!(film_planes(film, &meta.headers[0].channels).is_some());
             assert!(
                 ours == theirs,
                 "{} bytes against {}",
