@@ -625,7 +625,8 @@ fn render_only_rows(
     let frame = timeline.scene_at(0);
     let (w, h) = (timeline.width, timeline.height);
     let pools = thread_pools(&options.threads);
-    let mut counts = FrameStats::default();
+    // Each pool's own counts, so the rows can show they do not depend on it.
+    let mut counts = vec![FrameStats::default(); pools.len()];
     let walls = alternate(
         options.runs,
         pools.len(),
@@ -635,21 +636,24 @@ fn render_only_rows(
             let film = pools[i]
                 .1
                 .install(|| crate::render::render_frame(&frame, 0, w, h, &|| {}));
-            counts = film.stats;
+            counts[i] = film.stats;
             Ok(start.elapsed().as_secs_f64())
         },
     )
     .expect("an in-process timing has no error to return");
-    let frames = Work {
-        frames: 1,
-        pixels: w as u64 * h as u64,
-        stats: counts,
-    };
+    let works: Vec<Work> = counts
+        .into_iter()
+        .map(|stats| Work {
+            frames: 1,
+            pixels: w as u64 * h as u64,
+            stats,
+        })
+        .collect();
     pool_rows(
         &format!("{} (render only)", scene.name),
         &pools,
         walls,
-        &frames,
+        &works,
         &options.peak,
         base,
     )
@@ -669,20 +673,21 @@ fn thread_pools(threads: &[usize]) -> Vec<(usize, rayon::ThreadPool)> {
         .collect()
 }
 
-/// The rows of `work` timed in this process on each pool (`walls[i]` on
-/// `pools[i]`), with their speed-ups over the one-thread pool.
+/// The rows of work timed in this process on each pool (`walls[i]` and
+/// `works[i]` on `pools[i]`), with their speed-ups over the one-thread pool.
 fn pool_rows(
     scene: &str,
     pools: &[(usize, rayon::ThreadPool)],
     walls: Vec<Vec<f64>>,
-    work: &Work,
+    works: &[Work],
     peak: &Peak,
     base: Row,
 ) -> Vec<Row> {
     let mut rows: Vec<Row> = pools
         .iter()
         .zip(walls)
-        .map(|((threads, _), walls)| {
+        .zip(works)
+        .map(|(((threads, _), walls), work)| {
             let runs: Vec<Measurement> = walls
                 .iter()
                 .map(|&wall_s| Measurement {
@@ -940,10 +945,10 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
     // then samples of enough passes to last 0.2 s each on the widest pool
     // (as a warm pass times them; longer on fewer threads), so fork/join is
     // a small part of what is timed.
+    let mut iterations_per_pass = 0;
     for (_, pool) in &pools {
-        pass(pool);
+        iterations_per_pass = pass(pool); // the same points: the same count
     }
-    let iterations_per_pass = pass(widest);
     let start = Instant::now();
     pass(widest);
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
@@ -971,7 +976,9 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
             ..FrameStats::default()
         },
     };
-    pool_rows("kernel", &pools, walls, &work, &options.peak, base)
+    // Every pool makes the same passes over the same points.
+    let works = vec![work; pools.len()];
+    pool_rows("kernel", &pools, walls, &works, &options.peak, base)
 }
 
 /// The rows as CSV, one header line first.
