@@ -163,7 +163,8 @@ pub struct Estimate {
 }
 
 impl Estimate {
-    /// A placeholder, overwritten before use.
+    /// A placeholder: where the kernel skips a register of padding, its
+    /// lanes keep this (zero iterations, zero orbits).
     pub const IDLE: Estimate = Estimate {
         distance: 0.0,
         traps: OrbitTraps {
@@ -394,7 +395,8 @@ pub struct Orbit<T> {
 
 #[cfg(test)]
 impl Orbit<f64> {
-    /// A placeholder, overwritten before use.
+    /// A placeholder: where the kernel skips a register of padding, its
+    /// lanes keep this (zero iterations, zero orbits).
     const IDLE: Orbit<f64> = Orbit {
         z: [0.0; 3],
         r: 0.0,
@@ -813,8 +815,9 @@ type Stored = [f64; REGISTER];
 /// `Kernel<Orbit<f64>>` writes the orbits into its output, `Kernel<Estimate>`
 /// the analytic estimates, finished in the registers. Only the first
 /// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
-/// register of nothing but padding is neither iterated nor finished, its
-/// results left as they were (`Finished::IDLE` from `in_vectors`).
+/// register of nothing but padding is loaded but neither iterated nor
+/// finished, its results left as they were (`Finished::IDLE` from
+/// `in_vectors`).
 struct Kernel<'a, Out> {
     fractal: &'a Fractal,
     points: &'a [DVec3; VECTOR],

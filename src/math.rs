@@ -73,7 +73,7 @@ impl<S: pulp::Simd> Arith for Vector<S> {
     }
 }
 
-/// What `ln` needs beyond `Arith`: constants and a lane-by-lane choice.
+/// What `ln_in_range` needs beyond `Arith`: constants and a lane-by-lane choice.
 /// Implemented for one f64 and for a `Vector` of them, so the scalar
 /// estimate and the vector kernel take the same logarithm to the bit.
 pub trait Lanes: Arith {
