@@ -14,6 +14,39 @@ use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
+/// `println!` that returns an error instead of panicking when standard
+/// output is gone (`mandelreel info t.ron | head`): `OutputClosed`, which
+/// ends the command quietly.
+macro_rules! out {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::stdout_error)?
+    }};
+}
+
+/// Standard output was closed by its reader (`| head`): the command stops
+/// there, with no message and exit code 0, as a command killed by the
+/// broken pipe would have printed nothing more either.
+#[derive(Debug)]
+pub struct OutputClosed;
+
+impl std::fmt::Display for OutputClosed {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("standard output was closed")
+    }
+}
+
+impl std::error::Error for OutputClosed {}
+
+/// `OutputClosed` for a broken pipe; any other failure to write is an error.
+pub fn stdout_error(error: std::io::Error) -> anyhow::Error {
+    if error.kind() == std::io::ErrorKind::BrokenPipe {
+        OutputClosed.into()
+    } else {
+        anyhow::Error::new(error).context("cannot write to standard output")
+    }
+}
+
 /// Exit status: success.
 pub const EXIT_OK: u8 = 0;
 /// Exit status: the work failed (a file could not be read or written).
@@ -243,6 +276,9 @@ pub struct PickArgs {
 
 /// Exit code for an error chain: input errors are the user's to fix.
 pub fn exit_code(error: &anyhow::Error) -> u8 {
+    if error.is::<OutputClosed>() {
+        return EXIT_OK;
+    }
     if error.downcast_ref::<Incomplete>().is_some() {
         return EXIT_INCOMPLETE;
     }
@@ -264,7 +300,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(args) => bench(args),
         Command::Measure { program, args } => {
             let m = crate::bench::measure_child(&program, &args)?;
-            println!(
+            out!(
                 "{}",
                 serde_json::to_string(&m).expect("a measurement serialises")
             );
@@ -848,7 +884,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     } else {
         Format::Exr
     };
-    println!(
+    out!(
         "{}",
         ffmpeg_command(
             &out_dir,
@@ -958,7 +994,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             workers: Vec<String>,
             timeline_changed_since_render: bool,
         }
-        println!(
+        out!(
             "{}",
             serde_json::to_string(&StatusReport {
                 folder: &plan.out_dir,
@@ -972,7 +1008,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             })?
         );
     } else {
-        println!(
+        out!(
             "{}: {complete} of {total} frames complete and current (frames {}..{} of {}, {}x{})",
             plan.out_dir.display(),
             plan.range.start,
@@ -982,7 +1018,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             plan.height
         );
         for (state, frames) in &by_state {
-            println!(
+            out!(
                 "  {:<12} {:>6}  {}",
                 state.name().replace('_', " "),
                 frames.len(),
@@ -990,13 +1026,13 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             );
         }
         if !workers.is_empty() {
-            println!(
+            out!(
                 "  workers: {}",
                 workers.iter().cloned().collect::<Vec<_>>().join(", ")
             );
         }
         if changed {
-            println!(
+            out!(
                 "  note: {} has changed since this folder's last render started",
                 plan.timeline.source.display()
             );
@@ -1033,8 +1069,8 @@ fn info(path: &Path) -> anyhow::Result<()> {
     let t = Timeline::load(path)?;
     let first = t.scene_at(0);
     let base = &first;
-    println!("timeline: {}", path.display());
-    println!(
+    out!("timeline: {}", path.display());
+    out!(
         "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {} sample(s) per pixel",
         t.frame_count,
         t.fps,
@@ -1050,14 +1086,14 @@ fn info(path: &Path) -> anyhow::Result<()> {
         (Some(k), false) => format!("Julia mode, c = ({}, {}, {})", k.x, k.y, k.z),
         (None, false) => "Mandelbrot mode".to_string(),
     };
-    println!(
+    out!(
         "fractal:  {mode}, formula {}, power {}, {} iterations, bailout {} (at frame 0)",
         f.formula.name(),
         f.power,
         f.iterations,
         f.bailout
     );
-    println!(
+    out!(
         "quality:  DE {} in {}, hit threshold {} x footprint, fudge {}, {} max steps",
         f.de.name(),
         f.precision.name(),
@@ -1066,9 +1102,9 @@ fn info(path: &Path) -> anyhow::Result<()> {
         base.quality.max_steps
     );
     if t.tracks.is_empty() {
-        println!("tracks:   none (a still)");
+        out!("tracks:   none (a still)");
     } else {
-        println!("tracks:");
+        out!("tracks:");
         for tr in &t.tracks {
             let first = tr.key_times[0];
             let last = tr.key_times[tr.key_times.len() - 1];
@@ -1085,12 +1121,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
                     (a / b).log10().abs()
                 );
             }
-            println!("{line}");
+            out!("{line}");
         }
     }
     let effects = &base.effects;
     let enabled = effects.enabled();
-    println!(
+    out!(
         "effects:  {}",
         if enabled.is_empty() {
             "none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
@@ -1106,9 +1142,9 @@ fn info(path: &Path) -> anyhow::Result<()> {
         (1, None) => "each camera ray alone".to_string(),
         (n, _) => format!("runs of {n} camera rays share a cone first"),
     };
-    println!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
+    out!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
     if let Some(sh) = &effects.shadows {
-        println!(
+        out!(
             "          + shadow march towards the light, up to {} estimates per lit hit ({})",
             sh.max_steps,
             if sh.softness > 0.0 {
@@ -1119,42 +1155,43 @@ fn info(path: &Path) -> anyhow::Result<()> {
         );
     }
     if let Some(ao) = &effects.ambient_occlusion {
-        println!(
+        out!(
             "          + ambient occlusion, {} estimates per hit",
             ao.samples
         );
     }
     if effects.specular.is_some() {
-        println!("          + specular highlight (no estimates)");
+        out!("          + specular highlight (no estimates)");
     }
     if effects.fog.is_some() {
-        println!("          + fog over hit distance (no estimates)");
+        out!("          + fog over hit distance (no estimates)");
     }
     if effects.glow.is_some() {
-        println!("          + glow from each ray's nearest approach (no estimates; its rays march without cones)");
+        out!("          + glow from each ray's nearest approach (no estimates; its rays march without cones)");
     }
     if let Some(pt) = &effects.path_tracing {
-        println!(
+        out!(
             "          + path tracing per hit: up to {} bounces (Russian roulette from the third), each with a march and a normal, plus a ray to the {}° sun",
             pt.max_bounces, pt.sun_angle_degrees
         );
     }
     if let Some(m) = &effects.motion_blur {
-        println!(
+        out!(
             "          + motion blur: each of the {} samples sees the timeline at its own time over {} of the frame interval",
             base.samples_per_pixel, m.shutter
         );
     }
     let lens = base.camera.frame();
     if lens.has_lens() {
-        println!(
+        out!(
             "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel > 1)",
             lens.aperture_radius, lens.focus_distance
         );
     }
-    println!(
+    out!(
         "          {} sample(s) per pixel: {}x the per-sample work",
-        base.samples_per_pixel, base.samples_per_pixel
+        base.samples_per_pixel,
+        base.samples_per_pixel
     );
     // Measured, not guessed: frame 0 as a 64-pixel-wide thumbnail, as declared
     // and with every effect off (same samples), counting the estimates.
@@ -1174,13 +1211,13 @@ fn info(path: &Path) -> anyhow::Result<()> {
     let layers = crate::render::Layers::default();
     let with = crate::render::render_frame_in_time(&scenes, 0, probe_w, probe_h, layers, &|| {});
     let without = crate::render::render_frame_in_time(&plain, 0, probe_w, probe_h, layers, &|| {});
-    println!(
+    out!(
         "cost:     frame 0 at {probe_w}x{probe_h}: {} estimates, {:.2}x the same frame without effects ({})",
         with.stats.de_evaluations,
         with.stats.de_evaluations as f64 / without.stats.de_evaluations.max(1) as f64,
         without.stats.de_evaluations
     );
-    println!("output:   out/{}/ by default", t.name);
+    out!("output:   out/{}/ by default", t.name);
     Ok(())
 }
 
@@ -1264,28 +1301,32 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         },
     };
     if args.json {
-        println!("{}", serde_json::to_string(&report)?);
+        out!("{}", serde_json::to_string(&report)?);
         return Ok(());
     }
-    println!("frame {}, pixel ({x}, {y}) of {width}x{height}", args.frame);
+    out!("frame {}, pixel ({x}, {y}) of {width}x{height}", args.frame);
     match hit {
         Some((h, n)) => {
-            println!(
+            out!(
                 "hit:       ({:.12}, {:.12}, {:.12})",
-                h.point.x, h.point.y, h.point.z
+                h.point.x,
+                h.point.y,
+                h.point.z
             );
-            println!("distance:  {:.6e} along the ray from the camera", h.t);
-            println!("normal:    ({:.4}, {:.4}, {:.4})", n.x, n.y, n.z);
-            println!(
+            out!("distance:  {:.6e} along the ray from the camera", h.t);
+            out!("normal:    ({:.4}, {:.4}, {:.4})", n.x, n.y, n.z);
+            out!(
                 "footprint: {:.3e} (one pixel's width there)",
                 report.pixel_footprint
             );
-            println!(
+            out!(
                 "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
-                h.point.x, h.point.y, h.point.z
+                h.point.x,
+                h.point.y,
+                h.point.z
             );
         }
-        None => println!("miss: the ray leaves the bounding sphere without meeting the fractal"),
+        None => out!("miss: the ray leaves the bounding sphere without meeting the fractal"),
     }
     Ok(())
 }
@@ -1357,7 +1398,7 @@ fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
     std::fs::write(&csv, crate::accuracy::to_csv(&report.rows)).map_err(|e| Error::io(&csv, e))?;
     std::fs::write(&md, &table).map_err(|e| Error::io(&md, e))?;
     crate::accuracy::write_chart(&report.rows, &title, &png)?;
-    println!("{table}");
+    out!("{table}");
     eprintln!(
         "wrote {}, {} and {}",
         csv.display(),
@@ -1382,7 +1423,7 @@ fn sheet(args: SheetArgs) -> anyhow::Result<()> {
     let shown = output::evenly_spaced(&frames, args.count);
     let out = args.out.unwrap_or_else(|| args.dir.join("sheet.png"));
     output::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
-    println!(
+    out!(
         "{} frames of {} tiled into {}",
         shown.len(),
         frames.len(),
@@ -1451,8 +1492,8 @@ fn bench(args: BenchArgs) -> anyhow::Result<()> {
         quiet: args.quiet,
     };
     let md = crate::bench::run_and_write(&options)?;
-    println!("{md}");
-    println!(
+    out!("{md}");
+    out!(
         "written: {}",
         options
             .results

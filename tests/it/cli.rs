@@ -148,6 +148,43 @@ fn info_reports_frames_tracks_and_effects() {
 }
 
 #[test]
+fn a_closed_standard_output_ends_quietly() {
+    // `mandelreel info t.ron | head -1`: the reader is gone before the
+    // first line, so every write fails with a broken pipe.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(7, 6.0));
+    for args in [
+        &["info", "t.ron"][..],
+        &["pick", "t.ron", "--pixel", "24,13"][..],
+    ] {
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let out = d
+            .command(args)
+            .stdout(writer)
+            .output()
+            .expect("run mandelreel");
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{args:?}: {:?} {stderr}", out.status);
+        assert!(stderr.is_empty(), "{args:?}: {stderr}");
+    }
+    // Any other failure to write is still an error (Linux's /dev/full).
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = d
+            .command(&["info", "t.ron"])
+            .stdout(full)
+            .output()
+            .expect("run mandelreel");
+        assert_eq!(out.status.code(), Some(1));
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            stderr.contains("cannot write to standard output"),
+            "{stderr}"
+        );
+    }
+}
+
+#[test]
 fn pick_json_hits_the_bulb_in_the_centre_and_misses_in_the_corner() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(2, 8.0));
