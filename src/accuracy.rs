@@ -145,7 +145,7 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
             s.quality.hit_threshold = v
         });
     }
-    for v in [0.5, 0.7, 1.0] {
+    for v in [0.5, 0.7, 0.9, 1.0] {
         add("fudge", format!("{v}"), &|s| s.quality.fudge = v);
     }
     for v in [1.0, 1.2, 1.5, 1.8] {

@@ -52,7 +52,7 @@ impl Default for MarchSettings {
     fn default() -> Self {
         MarchSettings {
             hit_threshold: 0.5,
-            fudge: 0.9,
+            fudge: 1.0,
             max_steps: 300,
             normal_step: 0.5,
             bounding_radius: 1.5,
