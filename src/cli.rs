@@ -982,61 +982,70 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         .ok()
         .zip(output::JobRecord::read(&plan.out_dir).ok())
         .is_some_and(|(now, job)| now != job.timeline_text);
-    if args.json {
-        #[derive(Serialize)]
-        struct StatusReport<'a> {
-            folder: &'a Path,
-            timeline: &'a Path,
-            frames: (u32, u32),
-            total: usize,
-            complete: usize,
-            states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
-            workers: Vec<String>,
-            timeline_changed_since_render: bool,
-        }
-        out!(
-            "{}",
-            serde_json::to_string(&StatusReport {
-                folder: &plan.out_dir,
-                timeline: &plan.timeline.source,
-                frames: (plan.range.start, plan.range.end),
-                total,
-                complete,
-                states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
-                workers: workers.iter().cloned().collect(),
-                timeline_changed_since_render: changed,
-            })?
-        );
-    } else {
-        out!(
-            "{}: {complete} of {total} frames complete and current (frames {}..{} of {}, {}x{})",
-            plan.out_dir.display(),
-            plan.range.start,
-            plan.range.end,
-            plan.timeline.source.display(),
-            plan.width,
-            plan.height
-        );
-        for (state, frames) in &by_state {
+    // The exit status says whether the sequence is complete even when the
+    // report's reader has gone (`status out/zoom | head -1`).
+    let report = || -> anyhow::Result<()> {
+        if args.json {
+            #[derive(Serialize)]
+            struct StatusReport<'a> {
+                folder: &'a Path,
+                timeline: &'a Path,
+                frames: (u32, u32),
+                total: usize,
+                complete: usize,
+                states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
+                workers: Vec<String>,
+                timeline_changed_since_render: bool,
+            }
             out!(
-                "  {:<12} {:>6}  {}",
-                state.name().replace('_', " "),
-                frames.len(),
-                ranges(frames)
+                "{}",
+                serde_json::to_string(&StatusReport {
+                    folder: &plan.out_dir,
+                    timeline: &plan.timeline.source,
+                    frames: (plan.range.start, plan.range.end),
+                    total,
+                    complete,
+                    states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
+                    workers: workers.iter().cloned().collect(),
+                    timeline_changed_since_render: changed,
+                })?
             );
-        }
-        if !workers.is_empty() {
+        } else {
             out!(
-                "  workers: {}",
-                workers.iter().cloned().collect::<Vec<_>>().join(", ")
+                "{}: {complete} of {total} frames complete and current (frames {}..{} of {}, {}x{})",
+                plan.out_dir.display(),
+                plan.range.start,
+                plan.range.end,
+                plan.timeline.source.display(),
+                plan.width,
+                plan.height
             );
+            for (state, frames) in &by_state {
+                out!(
+                    "  {:<12} {:>6}  {}",
+                    state.name().replace('_', " "),
+                    frames.len(),
+                    ranges(frames)
+                );
+            }
+            if !workers.is_empty() {
+                out!(
+                    "  workers: {}",
+                    workers.iter().cloned().collect::<Vec<_>>().join(", ")
+                );
+            }
+            if changed {
+                out!(
+                    "  note: {} has changed since this folder's last render started",
+                    plan.timeline.source.display()
+                );
+            }
         }
-        if changed {
-            out!(
-                "  note: {} has changed since this folder's last render started",
-                plan.timeline.source.display()
-            );
-        }
+        Ok(())
+    };
+    match report() {
+        Err(e) if !e.is::<OutputClosed>() => return Err(e),
+        _ => {}
     }
     if complete == total {
         Ok(())

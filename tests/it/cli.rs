@@ -168,6 +168,20 @@ fn a_closed_standard_output_ends_quietly() {
         assert!(out.status.success(), "{args:?}: {:?} {stderr}", out.status);
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
+    // `status` still says by its exit status that nothing is rendered yet.
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    let out = d
+        .command(&["status", "t.ron"])
+        .stdout(writer)
+        .output()
+        .expect("run mandelreel");
+    assert_eq!(out.status.code(), Some(4), "{:?}", out);
+    assert!(
+        out.stderr.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     // Any other failure to write is still an error (Linux's /dev/full).
     if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
         let out = d
