@@ -156,6 +156,7 @@ fn a_closed_standard_output_ends_quietly() {
     for args in [
         &["info", "t.ron"][..],
         &["pick", "t.ron", "--pixel", "24,13"][..],
+        &["pick", "t.ron", "--pixel", "24,13", "--json"][..],
     ] {
         let (reader, writer) = std::io::pipe().expect("a pipe");
         drop(reader);
@@ -169,19 +170,21 @@ fn a_closed_standard_output_ends_quietly() {
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
     // `status` still says by its exit status that nothing is rendered yet.
-    let (reader, writer) = std::io::pipe().expect("a pipe");
-    drop(reader);
-    let out = d
-        .command(&["status", "t.ron"])
-        .stdout(writer)
-        .output()
-        .expect("run mandelreel");
-    assert_eq!(out.status.code(), Some(4), "{:?}", out);
-    assert!(
-        out.stderr.is_empty(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    for args in [&["status", "t.ron"][..], &["status", "t.ron", "--json"][..]] {
+        let (reader, writer) = std::io::pipe().expect("a pipe");
+        drop(reader);
+        let out = d
+            .command(args)
+            .stdout(writer)
+            .output()
+            .expect("run mandelreel");
+        assert_eq!(out.status.code(), Some(4), "{args:?}: {out:?}");
+        assert!(
+            out.stderr.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
     // Any other failure to write is still an error (Linux's /dev/full).
     if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
         let out = d
