@@ -147,6 +147,16 @@ fn info_reports_frames_tracks_and_effects() {
     assert!(d.files("out").is_empty(), "info must not write anything");
 }
 
+/// Runs the binary with a standard output whose reader is already gone.
+fn with_closed_stdout(d: &Dir, args: &[&str]) -> std::process::Output {
+    let (reader, writer) = std::io::pipe().expect("a pipe");
+    drop(reader);
+    d.command(args)
+        .stdout(writer)
+        .output()
+        .expect("run mandelreel")
+}
+
 #[test]
 fn a_closed_standard_output_ends_quietly() {
     // `mandelreel info t.ron | head -1`: the reader is gone before the
@@ -158,32 +168,17 @@ fn a_closed_standard_output_ends_quietly() {
         &["pick", "t.ron", "--pixel", "24,13"][..],
         &["pick", "t.ron", "--pixel", "24,13", "--json"][..],
     ] {
-        let (reader, writer) = std::io::pipe().expect("a pipe");
-        drop(reader);
-        let out = d
-            .command(args)
-            .stdout(writer)
-            .output()
-            .expect("run mandelreel");
+        let out = with_closed_stdout(&d, args);
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{args:?}: {:?} {stderr}", out.status);
         assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
     // `status` still says by its exit status that nothing is rendered yet.
     for args in [&["status", "t.ron"][..], &["status", "t.ron", "--json"][..]] {
-        let (reader, writer) = std::io::pipe().expect("a pipe");
-        drop(reader);
-        let out = d
-            .command(args)
-            .stdout(writer)
-            .output()
-            .expect("run mandelreel");
+        let out = with_closed_stdout(&d, args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(4), "{args:?}: {out:?}");
-        assert!(
-            out.stderr.is_empty(),
-            "{args:?}: {}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        assert!(stderr.is_empty(), "{args:?}: {stderr}");
     }
     // Any other failure to write is still an error (Linux's /dev/full).
     if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
