@@ -40,6 +40,12 @@ pub struct MarchSettings {
 }
 
 impl MarchSettings {
+    /// Where `ray` enters and leaves the bounding sphere, if it meets it.
+    #[inline]
+    pub fn interval(&self, ray: &Ray) -> Option<(Real, Real)> {
+        sphere_interval(ray.origin, ray.dir, self.bounding_radius)
+    }
+
     /// The plain step an estimate allows: `fudge` times the estimate, no
     /// longer than the bounding sphere is wide.
     #[inline]
@@ -148,29 +154,39 @@ pub fn march_many(
 /// all (`ConeWalk`): the stretch where the surface is still far off
 /// compared with the run's width is walked once for the run, and each ray
 /// starts where the cone stopped. The cone's estimates are shared out over
-/// the run's rays. `free` is scratch space, kept by the caller. `run` is
-/// `Scene::cone_rays` (1: every ray alone).
+/// the run's rays. `scratch` is kept by the caller from row to row. `run`
+/// is `Scene::cone_rays` (1: every ray alone), which `settings.cone_rays`
+/// does not override.
 pub fn march_camera_rays(
     rays: &[Ray],
     fractal: &Fractal,
     settings: &MarchSettings,
     run: u32,
     results: &mut [MarchResult],
-    free: &mut Vec<(Real, u32)>,
+    scratch: &mut ConeScratch,
 ) {
     let run = run.max(1) as usize;
     if run == 1 {
         return march_many(rays, fractal, settings, results);
     }
     debug_assert_eq!(rays.len(), results.len());
+    let ConeScratch { intervals, free } = scratch;
+    // Each ray's way through the bounding sphere, once: the cones and the
+    // rays after them both start from it.
+    intervals.clear();
+    intervals.extend(rays.iter().map(|ray| settings.interval(ray)));
     free.clear();
     free.resize(rays.len().div_ceil(run), (0.0, 0));
-    let cones = rays.chunks(run).map(|run| ConeWalk::start(run, settings));
+    let cones = rays
+        .chunks(run)
+        .zip(intervals.chunks(run))
+        .map(|(run, intervals)| ConeWalk::start(run, intervals));
     walk_many(cones, fractal, settings, |i, out| free[i] = out);
     let walks = rays
         .iter()
+        .zip(intervals.iter())
         .enumerate()
-        .map(|(k, ray)| Marcher::start_from(ray, settings, free[k / run].0));
+        .map(|(k, (ray, &interval))| Marcher::start_in(ray, settings, interval, free[k / run].0));
     walk_many(walks, fractal, settings, |i, result| results[i] = result);
     // Each ray of a run takes its share of the cone's estimates (the first
     // ones one more while there is a remainder), so the frame's total and
@@ -181,6 +197,14 @@ pub fn march_camera_rays(
             r.evaluations += evaluations / n + u32::from((k as u32) < evaluations % n);
         }
     }
+}
+
+/// `march_camera_rays`' scratch space: each ray's bounding-sphere interval
+/// and, for each run, where its rays may start and what its cone cost.
+#[derive(Default)]
+pub struct ConeScratch {
+    intervals: Vec<Option<(Real, Real)>>,
+    free: Vec<(Real, u32)>,
 }
 
 /// A march along the axis of a cone that holds a run of rays: each step
@@ -206,21 +230,20 @@ struct ConeWalk {
 
 impl ConeWalk {
     /// The cone of `run` (rays from nearly one point, in nearly one
-    /// direction), from where the first of them enters the bounding sphere;
-    /// the walk's output, 0 and no estimates, if none does.
-    fn start(run: &[Ray], settings: &MarchSettings) -> Result<ConeWalk, (Real, u32)> {
+    /// direction, with their bounding-sphere `intervals`), from where the
+    /// first of them enters the bounding sphere; the walk's output, 0 and
+    /// no estimates, if none does.
+    fn start(run: &[Ray], intervals: &[Option<(Real, Real)>]) -> Result<ConeWalk, (Real, u32)> {
         let (first, last) = (run[0], run[run.len() - 1]);
         let origin = (first.origin + last.origin) * 0.5;
         let dir = normalize_or(first.dir + last.dir, first.dir);
         let mut spread: (Real, Real) = (0.0, 0.0);
         let mut t_start = Real::INFINITY;
         let mut t_end: Real = 0.0;
-        for ray in run {
+        for (ray, interval) in run.iter().zip(intervals) {
             spread.0 = spread.0.max((ray.origin - origin).length());
             spread.1 = spread.1.max((ray.dir - dir).length());
-            if let Some((enter, exit)) =
-                sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-            {
+            if let Some((enter, exit)) = *interval {
                 t_start = t_start.min(enter);
                 t_end = t_end.max(exit);
             }
@@ -392,19 +415,19 @@ struct Marcher {
 impl Marcher {
     /// Starts at the bounding sphere, or the miss of a ray that passes it by.
     fn start(ray: &Ray, settings: &MarchSettings) -> Result<Marcher, MarchResult> {
-        Marcher::start_from(ray, settings, 0.0)
+        Marcher::start_in(ray, settings, settings.interval(ray), 0.0)
     }
 
-    /// `start`, but no nearer than `t_free`: the ray is known to meet no
-    /// surface before it (a cone around it was marched that far).
-    fn start_from(
+    /// `start` with the ray's bounding-sphere `interval` already known, and
+    /// no nearer than `t_free`: the ray is known to meet no surface before
+    /// it (a cone around it was marched that far).
+    fn start_in(
         ray: &Ray,
         settings: &MarchSettings,
+        interval: Option<(Real, Real)>,
         t_free: Real,
     ) -> Result<Marcher, MarchResult> {
-        let Some((t_enter, t_exit)) =
-            sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-        else {
+        let Some((t_enter, t_exit)) = interval else {
             return Err(MarchResult::default());
         };
         let t_enter = t_enter.max(t_free);
@@ -655,6 +678,12 @@ mod tests {
         Fractal::unit_ball()
     }
 
+    /// Each ray's bounding-sphere interval, as `march_camera_rays` gives
+    /// them to a cone.
+    fn intervals(rays: &[Ray], settings: &MarchSettings) -> Vec<Option<(Real, Real)>> {
+        rays.iter().map(|ray| settings.interval(ray)).collect()
+    }
+
     fn ray(origin: DVec3, dir: DVec3) -> Ray {
         Ray {
             origin,
@@ -822,8 +851,11 @@ mod tests {
                             .chunks(run_length)
                             .zip(first_crossings.chunks(run_length));
                         for (run, first_crossings) in runs {
-                            let (t_free, _) =
-                                walk_one(ConeWalk::start(run, &settings), f, &settings);
+                            let (t_free, _) = walk_one(
+                                ConeWalk::start(run, &intervals(run, &settings)),
+                                f,
+                                &settings,
+                            );
                             for (ray, crossing) in run.iter().zip(first_crossings) {
                                 let enter =
                                     sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
@@ -864,8 +896,11 @@ mod tests {
         let run: Vec<Ray> = (0..8)
             .map(|k| ray(origin, DVec3::new(1e-3 * k as Real, 0.0, -1.0)))
             .collect();
-        let (t_free, evaluations) =
-            walk_one(ConeWalk::start(&run, &settings), &unit_ball(), &settings);
+        let (t_free, evaluations) = walk_one(
+            ConeWalk::start(&run, &intervals(&run, &settings)),
+            &unit_ball(),
+            &settings,
+        );
         // From the sphere (t = 1.5) it stepped to the centre, inside: back.
         assert_eq!(evaluations, 2);
         assert!((1.5..2.0).contains(&t_free), "cone stopped at {t_free}");
@@ -885,12 +920,12 @@ mod tests {
                     .into_iter()
                     .enumerate()
                 {
-                    let (results, free) = (&mut marched[k], &mut Vec::new());
-                    march_camera_rays(&rays, f, &settings, cone_rays, results, free);
+                    let (results, scratch) = (&mut marched[k], &mut ConeScratch::default());
+                    march_camera_rays(&rays, f, &settings, cone_rays, results, scratch);
                     evaluations[k] += marched[k].iter().map(|m| m.evaluations as u64).sum::<u64>();
                 }
-                let mut alone = vec![MarchResult::default(); rays.len()];
-                march_many(&rays, f, &settings, &mut alone);
+                let alone: Vec<MarchResult> =
+                    rays.iter().map(|ray| march(ray, f, &settings)).collect();
                 // One ray a cone is every ray alone, to the bit.
                 assert_eq!(format!("{alone:?}"), format!("{:?}", marched[0]));
                 for ((ray, a), c) in rays.iter().zip(&alone).zip(&marched[1]) {

@@ -696,8 +696,9 @@ struct RowScratch {
     shadows: Vec<(f32, u64)>,
     /// Each pixel's ambient occlusion and its cost, where it hit.
     occluded: Vec<Option<(f32, u64)>>,
-    /// Where each run of camera rays may start, and what its cone cost.
-    cone_free: Vec<(crate::math::Real, u32)>,
+    /// Each camera ray's bounding-sphere interval; where each run of them
+    /// may start, and what its cone cost.
+    cone_free: crate::march::ConeScratch,
     /// The row's path-traced samples, traced together.
     paths: crate::shade::PathScratch,
 }

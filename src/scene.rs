@@ -168,13 +168,30 @@ impl Scene {
     /// glow needs each ray's own nearest approach, and estimators other
     /// than the analytic one have finite differences that can overestimate
     /// a step a cone would trust for all its rays.
-    pub fn march_alone_reason(&self) -> Option<String> {
+    pub fn march_alone_reason(&self) -> Option<MarchAlone> {
         if self.effects.glow.is_some() {
-            Some("for glow".into())
+            Some(MarchAlone::Glow)
         } else if self.fractal.de != crate::fractal::DeMethod::Analytic {
-            Some(format!("for the {} estimator", self.fractal.de.name()))
+            Some(MarchAlone::Estimator(self.fractal.de))
         } else {
             None
+        }
+    }
+}
+
+/// Why a scene's camera rays march alone (`Scene::march_alone_reason`).
+/// Asked for every row, so a value rather than a message.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MarchAlone {
+    Glow,
+    Estimator(crate::fractal::DeMethod),
+}
+
+impl std::fmt::Display for MarchAlone {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            MarchAlone::Glow => f.write_str("for glow"),
+            MarchAlone::Estimator(de) => write!(f, "for the {} estimator", de.name()),
         }
     }
 }
