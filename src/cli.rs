@@ -16,30 +16,23 @@ use std::time::Instant;
 
 /// `println!` that returns an error instead of panicking when standard
 /// output is gone (`mandelreel info t.ron | head`): `OutputClosed`, which
-/// ends the command quietly.
+/// `run` turns into a quiet success.
 macro_rules! out {
     ($($arg:tt)*) => {{
         use std::io::Write as _;
-        writeln!(std::io::stdout(), $($arg)*).map_err($crate::cli::stdout_error)?
+        writeln!(std::io::stdout(), $($arg)*).map_err(stdout_error)?
     }};
 }
 
 /// Standard output was closed by its reader (`| head`): the command stops
 /// there, with no message and exit code 0, as a command killed by the
 /// broken pipe would have printed nothing more either.
-#[derive(Debug)]
-pub struct OutputClosed;
-
-impl std::fmt::Display for OutputClosed {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str("standard output was closed")
-    }
-}
-
-impl std::error::Error for OutputClosed {}
+#[derive(Debug, thiserror::Error)]
+#[error("standard output was closed")]
+struct OutputClosed;
 
 /// `OutputClosed` for a broken pipe; any other failure to write is an error.
-pub fn stdout_error(error: std::io::Error) -> anyhow::Error {
+fn stdout_error(error: std::io::Error) -> anyhow::Error {
     if error.kind() == std::io::ErrorKind::BrokenPipe {
         OutputClosed.into()
     } else {
@@ -276,10 +269,7 @@ pub struct PickArgs {
 
 /// Exit code for an error chain: input errors are the user's to fix.
 pub fn exit_code(error: &anyhow::Error) -> u8 {
-    if error.is::<OutputClosed>() {
-        return EXIT_OK;
-    }
-    if error.downcast_ref::<Incomplete>().is_some() {
+    if error.is::<Incomplete>() {
         return EXIT_INCOMPLETE;
     }
     match error.downcast_ref::<Error>() {
@@ -290,7 +280,7 @@ pub fn exit_code(error: &anyhow::Error) -> u8 {
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
-    match cli.command {
+    let result = match cli.command {
         Command::Render(args) => render(args),
         Command::Info { timeline } => info(&timeline),
         Command::Pick(args) => pick(args),
@@ -298,15 +288,23 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Status(args) => status(args),
         Command::Accuracy(args) => accuracy(args),
         Command::Bench(args) => bench(args),
-        Command::Measure { program, args } => {
-            let m = crate::bench::measure_child(&program, &args)?;
-            out!(
-                "{}",
-                serde_json::to_string(&m).expect("a measurement serialises")
-            );
-            Ok(())
-        }
+        Command::Measure { program, args } => measure(&program, &args),
+    };
+    // A reader that went away ends the command quietly (`status` has
+    // already turned it into its exit status).
+    match result {
+        Err(error) if error.is::<OutputClosed>() => Ok(()),
+        other => other,
     }
+}
+
+fn measure(program: &Path, args: &[String]) -> anyhow::Result<()> {
+    let m = crate::bench::measure_child(program, args)?;
+    out!(
+        "{}",
+        serde_json::to_string(&m).expect("a measurement serialises")
+    );
+    Ok(())
 }
 
 /// Parses `WxH`.
@@ -1043,9 +1041,10 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         }
         Ok(())
     };
-    match report() {
-        Err(e) if !e.is::<OutputClosed>() => return Err(e),
-        _ => {}
+    if let Err(e) = report() {
+        if !e.is::<OutputClosed>() {
+            return Err(e);
+        }
     }
     if complete == total {
         Ok(())

@@ -9,11 +9,8 @@ fn main() -> ExitCode {
     match mandelreel::cli::run(cli) {
         Ok(()) => ExitCode::from(mandelreel::cli::EXIT_OK),
         Err(error) => {
-            // `status` has already said what is incomplete, and a closed
-            // standard output has no one to tell: no "error:" for those.
-            let quiet = error.is::<mandelreel::cli::Incomplete>()
-                || error.is::<mandelreel::cli::OutputClosed>();
-            if !quiet {
+            // `status` has already said what is incomplete; no "error:" for that.
+            if !error.is::<mandelreel::cli::Incomplete>() {
                 eprintln!("error: {error:#}");
             }
             ExitCode::from(mandelreel::cli::exit_code(&error))
