@@ -209,8 +209,9 @@ pub struct ConeScratch {
 
 /// A march along the axis of a cone that holds a run of rays: each step
 /// is the estimate less how far the farthest ray can be from the axis
-/// point there, so every ray's own path to the next point stays inside
-/// the ball the estimate clears. It stops where that shared step falls
+/// point there, shortened by how much further the rays spread over the
+/// step, so every ray's own path to the next point stays inside the ball
+/// the estimate clears (with a fudge of 1 too). It stops where that shared step falls
 /// below a pixel footprint (the rays must go on alone), where every ray has
 /// left the bounding sphere, or, a step back, at a point inside the set.
 #[derive(Clone, Copy)]
@@ -288,8 +289,12 @@ impl Walk for ConeWalk {
             // last point the cone stepped from, and find the crossing alone.
             return Some((self.previous, self.evaluations));
         }
+        // Over a step s a ray drifts s·spread.1 further from the axis while
+        // the axis point moves s: a ray's point at t + s is within
+        // reach + s·(1 + spread.1) of this axis point, which this step
+        // keeps within the plain step the estimate allows.
         let reach = self.spread.0 + self.t * self.spread.1;
-        let step = settings.step(estimate.distance) - reach;
+        let step = (settings.step(estimate.distance) - reach) / (1.0 + self.spread.1);
         if step < footprint || self.steps >= settings.max_steps {
             return Some((self.t, self.evaluations));
         }
