@@ -11,7 +11,7 @@
 //! estimate (the smallest k·h/t along the shadow march); distance-field
 //! occlusion compares the estimate with the distance stepped along the normal.
 
-use crate::fractal::{Fractal, OrbitTraps, VECTOR};
+use crate::fractal::{Fractal, OrbitTraps};
 use crate::march::MarchSettings;
 use crate::math::{mix, normalize_or, sphere_interval, DVec3, Real, Vec3};
 use serde::{Deserialize, Serialize};
@@ -408,56 +408,107 @@ pub fn occlusion(
 }
 
 /// `occlusion` at many surface points (index, point, normal, distance from
-/// the camera, footprint), their samples packed side by side across the
-/// points, `VECTOR` to a call of the lane kernel, so a point's few samples
-/// do not pay for a call of their own. `out(i, …)` gets point `i`'s, bit
-/// for bit what it would get alone: each point sums its samples in order.
+/// the camera, footprint), each an `OcclusionWalk`, walked side by side
+/// (`march::walk_many`) so a point's few samples do not pay for a call of
+/// the lane kernel of their own. `out(i, …)` gets point `i`'s, bit for bit
+/// what it would get alone: each point sums its samples in order.
 pub fn occlusions(
     fractal: &Fractal,
     ao: &AmbientOcclusion,
     points: impl IntoIterator<Item = (usize, DVec3, DVec3, Real, Real)>,
     mut out: impl FnMut(usize, (f32, u64)),
 ) {
-    let n = ao.samples.max(1);
-    // Sample k of n at each point: its distance along the normal.
-    let mut samples = points
-        .into_iter()
-        .flat_map(|(i, point, normal, t, footprint)| {
-            (1..=n).map(move |k| {
-                let d = ao.radius * t * k as Real / n as Real;
-                (i, k, d, point + normal * d, footprint)
-            })
-        })
-        .peekable();
-    let (mut blocked, mut weights, mut weight, mut spent) = (0.0, 0.0, 1.0, 0);
-    let mut estimates = [crate::fractal::Estimate::IDLE; VECTOR];
-    while samples.peek().is_some() {
-        // Lanes past the last sample idle outside the bailout ball.
-        let mut lanes = [(0, 0, 0.0); VECTOR];
-        let mut points = [crate::fractal::IDLE_POINT; VECTOR];
-        let mut footprints = [1.0; VECTOR];
-        let mut live = 0;
-        for (k, (i, sample, d, point, footprint)) in samples.by_ref().take(VECTOR).enumerate() {
-            (lanes[k], points[k], footprints[k]) = ((i, sample, d), point, footprint);
-            live = k + 1;
+    let walks = points.into_iter().map(|(i, point, normal, t, footprint)| {
+        Ok(OcclusionWalk::start(ao, i, point, normal, t, footprint))
+    });
+    // `walk_many` needs no quality settings for these walks.
+    let settings = MarchSettings::default();
+    crate::march::walk_many(walks, fractal, &settings, |_, (i, found)| out(i, found));
+}
+
+/// One surface point's ambient occlusion (see `occlusions`): `samples`
+/// estimates at evenly spaced distances along the normal, out to `radius`
+/// times the camera distance, each weighing 0.6 of the one before.
+#[derive(Clone, Copy, Debug)]
+struct OcclusionWalk {
+    /// The point's index, handed back with its output.
+    index: usize,
+    point: DVec3,
+    normal: DVec3,
+    /// Distance from the camera, and the footprint there.
+    t: Real,
+    footprint: Real,
+    radius: Real,
+    strength: Real,
+    /// The sample to take next, 1 to `n`.
+    k: u32,
+    n: u32,
+    blocked: Real,
+    weights: Real,
+    weight: Real,
+    spent: u64,
+}
+
+impl OcclusionWalk {
+    fn start(
+        ao: &AmbientOcclusion,
+        index: usize,
+        point: DVec3,
+        normal: DVec3,
+        t: Real,
+        footprint: Real,
+    ) -> OcclusionWalk {
+        OcclusionWalk {
+            index,
+            point,
+            normal,
+            t,
+            footprint,
+            radius: ao.radius,
+            strength: ao.strength as Real,
+            k: 1,
+            n: ao.samples.max(1),
+            blocked: 0.0,
+            weights: 0.0,
+            weight: 1.0,
+            spent: 0,
         }
-        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
-        for (&(i, k, d), e) in lanes[..live].iter().zip(&estimates) {
-            if k == 1 {
-                (blocked, weights, weight, spent) = (0.0, 0.0, 1.0, 0);
-            }
-            spent += e.orbits as u64;
-            // Where the field is nearer than the distance stepped, geometry crowds
-            // in. The estimate is about half the true distance near the surface
-            // (the ½ in ½·ln r·r/dr, kept for safe marching), so double it here.
-            blocked += weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
-            weights += weight;
-            weight *= 0.6;
-            if k == n {
-                let ambient = 1.0 - ao.strength as Real * blocked / weights;
-                out(i, (ambient.clamp(0.0, 1.0) as f32, spent));
-            }
+    }
+
+    /// How far along the normal sample `k` lies.
+    fn distance(&self) -> Real {
+        self.radius * self.t * self.k as Real / self.n as Real
+    }
+}
+
+impl crate::march::Walk for OcclusionWalk {
+    type Output = (usize, (f32, u64));
+
+    fn next_point(&self) -> (DVec3, Real) {
+        (self.point + self.normal * self.distance(), self.footprint)
+    }
+
+    fn advance(
+        &mut self,
+        e: &crate::fractal::Estimate,
+        _: Real,
+        _: &Fractal,
+        _: &MarchSettings,
+    ) -> Option<Self::Output> {
+        let d = self.distance();
+        self.spent += e.orbits as u64;
+        // Where the field is nearer than the distance stepped, geometry crowds
+        // in. The estimate is about half the true distance near the surface
+        // (the ½ in ½·ln r·r/dr, kept for safe marching), so double it here.
+        self.blocked += self.weight * ((d - 2.0 * e.distance) / d).clamp(0.0, 1.0);
+        self.weights += self.weight;
+        self.weight *= 0.6;
+        if self.k < self.n {
+            self.k += 1;
+            return None;
         }
+        let ambient = 1.0 - self.strength * self.blocked / self.weights;
+        Some((self.index, (ambient.clamp(0.0, 1.0) as f32, self.spent)))
     }
 }
 
