@@ -565,11 +565,11 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
 
     // The same frame rendered in this process on pools of each size: the
     // renderer's own scaling, without start-up and file writing.
-    rows.extend(render_only_rows(first, &timeline, options, base()));
+    rows.extend(render_only_rows(first, &timeline, options, base())?);
 
     // The kernel alone, on pools of each size: analytic estimates at points
     // where marching spends its time.
-    rows.extend(kernel_rows(&timeline, options, base()));
+    rows.extend(kernel_rows(&timeline, options, base())?);
 
     // Peak memory of a big EXR frame against its output buffers.
     if let Some((w, h)) = options.memory_size {
@@ -621,10 +621,10 @@ fn render_only_rows(
     timeline: &Timeline,
     options: &Options,
     base: Row,
-) -> Vec<Row> {
+) -> Result<Vec<Row>> {
     let frame = timeline.scene_at(0);
     let (w, h) = (timeline.width, timeline.height);
-    let pools = thread_pools(&options.threads);
+    let pools = thread_pools(&options.threads)?;
     // Each pool's own counts, so the rows can show they do not depend on it.
     let mut counts = vec![FrameStats::default(); pools.len()];
     let walls = alternate(
@@ -649,26 +649,30 @@ fn render_only_rows(
             stats,
         })
         .collect();
-    pool_rows(
+    Ok(pool_rows(
         &format!("{} (render only)", scene.name),
         &pools,
         walls,
         &works,
         &options.peak,
         base,
-    )
+    ))
 }
 
-/// A rayon pool of each size in `threads`, in that order.
-fn thread_pools(threads: &[usize]) -> Vec<(usize, rayon::ThreadPool)> {
+/// A rayon pool of each size in `threads`, in that order; an error names
+/// the size the system would not start.
+fn thread_pools(threads: &[usize]) -> Result<Vec<(usize, rayon::ThreadPool)>> {
     threads
         .iter()
-        .filter_map(|&t| {
+        .map(|&t| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(t)
                 .build()
-                .ok()?;
-            Some((t, pool))
+                .map_err(|e| Error::Usage {
+                    option: "--threads".into(),
+                    message: format!("could not start a pool of {t} threads: {e}"),
+                })?;
+            Ok((t, pool))
         })
         .collect()
 }
@@ -905,10 +909,10 @@ fn depth_rows(
 /// marcher spends most of its estimates), on a pool of each size in
 /// `options.threads`, alternating: the kernel's own thread scaling, with no
 /// start-up, scheduling of rows or file writing in it.
-pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row> {
+pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Result<Vec<Row>> {
     let fractal = timeline.scene_at(0).fractal;
     let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
-    let pools = thread_pools(&options.threads);
+    let pools = thread_pools(&options.threads)?;
     // One pass over the points on a pool: its orbit iterations.
     let pass = |pool: &rayon::ThreadPool| {
         pool.install(|| {
@@ -939,23 +943,22 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
         })
     };
     let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
     // Every pool warmed once (its threads started, the points in cache);
     // then samples of enough passes to last 0.2 s each on the widest pool
     // (as a warm pass times them; longer on fewer threads), so fork/join is
     // a small part of what is timed.
-    let mut iterations_per_pass = 0;
-    for (_, pool) in &pools {
-        iterations_per_pass = pass(pool); // the same points: the same count
-    }
+    // Each pool's own count of a pass's iterations (the same points, so
+    // the same count: the rows show it).
+    let iterations_per_pass: Vec<u64> = pools.iter().map(|(_, pool)| pass(pool)).collect();
     let start = Instant::now();
     pass(widest);
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
         .ceil()
         .max(1.0) as u64;
     let walls = alternate(
-        5,
+        options.runs,
         pools.len(),
         |_| {},
         |i| -> Result<f64> {
@@ -967,18 +970,26 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Vec<Row
         },
     )
     .expect("an in-process timing has no error to return");
-    let work = Work {
-        frames: 0,
-        pixels: 0,
-        stats: FrameStats {
-            de_evaluations: points.len() as u64 * passes,
-            de_iterations: iterations_per_pass * passes,
-            ..FrameStats::default()
-        },
-    };
-    // Every pool makes the same passes over the same points.
-    let works = vec![work; pools.len()];
-    pool_rows("kernel", &pools, walls, &works, &options.peak, base)
+    let works: Vec<Work> = iterations_per_pass
+        .iter()
+        .map(|&iterations| Work {
+            frames: 0,
+            pixels: 0,
+            stats: FrameStats {
+                de_evaluations: points.len() as u64 * passes,
+                de_iterations: iterations * passes,
+                ..FrameStats::default()
+            },
+        })
+        .collect();
+    Ok(pool_rows(
+        "kernel",
+        &pools,
+        walls,
+        &works,
+        &options.peak,
+        base,
+    ))
 }
 
 /// The rows as CSV, one header line first.

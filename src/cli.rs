@@ -111,7 +111,8 @@ pub struct BenchArgs {
     /// Skip Mandelbulber2 even if it is installed.
     #[arg(long)]
     pub no_mandelbulber: bool,
-    /// Runs of each renderer per scene (alternating); medians are reported.
+    /// Runs of each renderer per scene, and samples per thread count of the
+    /// kernel rows (alternating); medians are reported.
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
     /// Thread counts for the scaling rows, comma-separated [default: 1, 2, 4, … up to every logical CPU].
