@@ -584,13 +584,14 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             });
         }
         let mut outcomes = shadows.iter().copied();
-        // The row's ambient occlusion, its samples packed across the hits.
+        // The row's ambient occlusion, its samples packed across the hits
+        // (left empty when it is off).
         occluded.clear();
-        occluded.resize(w, None);
         if let (None, Some(ao)) = (
             &scene.effects.path_tracing,
             &scene.effects.ambient_occlusion,
         ) {
+            occluded.resize(w, None);
             let hits = surfaces.iter().enumerate().filter_map(|(x, at)| {
                 let at = at.as_ref()?;
                 Some((x, at.point, at.normal, at.t, at.footprint))
@@ -630,7 +631,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 result,
                 at.as_ref(),
                 &mut outcomes,
-                occluded[x],
+                occluded.get(x).copied().flatten(),
                 traced.get(x).copied(),
                 camera.up,
                 scale,
