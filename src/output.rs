@@ -294,84 +294,61 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
     writer.finish().map_err(|e| e.to_string())
 }
 
+/// Where an EXR channel's samples come from in the film.
+#[derive(Clone, Copy)]
+enum Source {
+    /// Component `k` of the colour, the normal or the albedo.
+    Colour(usize),
+    Normal(usize),
+    Albedo(usize),
+    Alpha,
+    Depth,
+    /// Trap `k` (origin, x, y, z).
+    Trap(usize),
+    /// The distance estimates spent on the pixel (the `steps` layer).
+    Steps,
+}
+
+/// Every channel a frame's EXR can hold, with its sample type and where
+/// its samples come from: the one list the header and the blocks are both
+/// made from. A channel whose layer the film lacks is left out.
+const EXR_CHANNELS: [(&str, exr::meta::attribute::SampleType, Source); 16] = {
+    use exr::meta::attribute::SampleType::{F16, F32, U32};
+    use Source::*;
+    [
+        ("R", F16, Colour(0)),
+        ("G", F16, Colour(1)),
+        ("B", F16, Colour(2)),
+        ("A", F16, Alpha),
+        ("Z", F32, Depth),
+        ("N.X", F32, Normal(0)),
+        ("N.Y", F32, Normal(1)),
+        ("N.Z", F32, Normal(2)),
+        ("albedo.R", F16, Albedo(0)),
+        ("albedo.G", F16, Albedo(1)),
+        ("albedo.B", F16, Albedo(2)),
+        ("trap.origin", F32, Trap(0)),
+        ("trap.x", F32, Trap(1)),
+        ("trap.y", F32, Trap(2)),
+        ("trap.z", F32, Trap(3)),
+        // Cost heat map: distance estimates spent per pixel.
+        ("DE", U32, Steps),
+    ]
+};
+
 fn encode_exr(
     out: &mut (impl Write + std::io::Seek),
     film: &Film,
     hash: &str,
     aovs: &[Aov],
 ) -> std::result::Result<(), String> {
-    use exr::image::recursive::{NoneMore, Recursive};
     use exr::prelude::*;
-    // The file's channels are described here, with the value of each pixel
-    // in each (the closure below): exrs infers the headers from this, and
-    // its own writer, which the block writer (`write_exr_blocks`) is tested
-    // against, reads the pixels through it. No per-channel copy of the
-    // frame, so a 4K frame costs little beyond the film itself. Layers not
-    // asked for are `None` and not written; their tuple slots are ignored.
-    let channel = |name: &str, sample: SampleType| ChannelDescription::named(name, sample);
-    let optional =
-        |present: bool, name: &str, sample: SampleType| present.then(|| channel(name, sample));
-    let (normal, albedo, traps) = (
-        film.normal.is_some(),
-        film.albedo.is_some(),
-        film.traps.is_some(),
-    );
-    let channels = Recursive::new(NoneMore, channel("R", SampleType::F16));
-    let channels = Recursive::new(channels, channel("G", SampleType::F16));
-    let channels = Recursive::new(channels, channel("B", SampleType::F16));
-    let channels = Recursive::new(channels, channel("A", SampleType::F16));
-    let channels = Recursive::new(channels, channel("Z", SampleType::F32));
-    let channels = Recursive::new(channels, optional(normal, "N.X", SampleType::F32));
-    let channels = Recursive::new(channels, optional(normal, "N.Y", SampleType::F32));
-    let channels = Recursive::new(channels, optional(normal, "N.Z", SampleType::F32));
-    let channels = Recursive::new(channels, optional(albedo, "albedo.R", SampleType::F16));
-    let channels = Recursive::new(channels, optional(albedo, "albedo.G", SampleType::F16));
-    let channels = Recursive::new(channels, optional(albedo, "albedo.B", SampleType::F16));
-    let channels = Recursive::new(channels, optional(traps, "trap.origin", SampleType::F32));
-    let channels = Recursive::new(channels, optional(traps, "trap.x", SampleType::F32));
-    let channels = Recursive::new(channels, optional(traps, "trap.y", SampleType::F32));
-    let channels = Recursive::new(channels, optional(traps, "trap.z", SampleType::F32));
-    // Cost heat map: distance estimates spent per pixel.
-    let channels = Recursive::new(
-        channels,
-        optional(aovs.contains(&Aov::Steps), "DE", SampleType::U32),
-    );
-    let width = film.width as usize;
-    let pixel = |at: Vec2<usize>| {
-        let i = at.y() * width + at.x();
-        let c = film.colour[i];
-        let n = film
-            .normal
-            .as_ref()
-            .map_or(crate::math::Vec3::ZERO, |n| n[i]);
-        let a = film
-            .albedo
-            .as_ref()
-            .map_or(crate::math::Vec3::ZERO, |a| a[i]);
-        let t = film.traps.as_ref().map_or([0.0; 4], |t| t[i]);
-        (
-            f16::from_f32(c.x),
-            f16::from_f32(c.y),
-            f16::from_f32(c.z),
-            f16::from_f32(film.alpha[i]),
-            film.depth[i],
-            n.x,
-            n.y,
-            n.z,
-            f16::from_f32(a.x),
-            f16::from_f32(a.y),
-            f16::from_f32(a.z),
-            t[0],
-            t[1],
-            t[2],
-            t[3],
-            film.evaluations[i],
-        )
-    };
-    let channels = SpecificChannels {
-        channels,
-        pixels: pixel,
-    };
+    // The film's channels, in name order as the format asks.
+    let mut channels: Vec<(&str, SampleType, Plane)> = EXR_CHANNELS
+        .iter()
+        .filter_map(|&(name, sample, source)| Some((name, sample, Plane::of(film, aovs, source)?)))
+        .collect();
+    channels.sort_by_key(|&(name, ..)| name);
     let mut attributes = LayerAttributes::named("");
     attributes.software_name = Some(Text::from(
         format!("mandelreel {}", env!("CARGO_PKG_VERSION")).as_str(),
@@ -385,58 +362,54 @@ fn encode_exr(
     attributes.comments = Some(Text::from(
         format!("{STATS_KEY}: {}", stats_text(film)).as_str(),
     ));
-    let layer = Layer::new(
-        (film.width as usize, film.height as usize),
-        attributes,
-        // Increasing line order: exrs otherwise writes blocks in the order its
-        // compression threads finish, and the bytes would differ run to run.
-        Encoding {
-            line_order: LineOrder::Increasing,
-            ..Encoding::FAST_LOSSLESS
-        },
-        channels,
-    );
-    let image = Image::from_layer(layer);
-    #[cfg(test)]
-    if tests::EXRS_OWN_WRITER.get() {
-        // The reference the block writer is tested against.
-        return image.write().to_buffered(out).map_err(|e| e.to_string());
-    }
-    write_exr_blocks(out, &image, film).map_err(|e| e.to_string())
+    let size = (film.width as usize, film.height as usize);
+    let header = exr::meta::header::Header::new(
+        Text::from(""),
+        size,
+        channels
+            .iter()
+            .map(|&(name, sample, _)| ChannelDescription::named(name, sample))
+            .collect(),
+    )
+    // RLE in 64-pixel tiles (exrs' `FAST_LOSSLESS`), in increasing line
+    // order: exrs otherwise orders blocks as its threads finish them, and
+    // the bytes would differ run to run.
+    .with_encoding(
+        Compression::RLE,
+        exr::meta::BlockDescription::Tiles(exr::meta::attribute::TileDescription {
+            tile_size: Vec2(64, 64),
+            level_mode: exr::meta::attribute::LevelMode::Singular,
+            rounding_mode: exr::math::RoundingMode::Down,
+        }),
+        LineOrder::Increasing,
+    )
+    .with_attributes(attributes);
+    let planes: Vec<_> = channels
+        .into_iter()
+        .map(|(_, sample, plane)| (plane, sample))
+        .collect();
+    write_exr_blocks(out, header, film, &planes).map_err(|e| e.to_string())
 }
 
-/// Writes `image` (the film's channels as `encode_exr` describes them) with
-/// its blocks filled and compressed on rayon's pool, a batch at a time, and
-/// written in file order. exrs' own writer fills every block on the calling
-/// thread through the per-pixel closure, about 45 ns a pixel (a 1080p frame
-/// took about 90 ms, most of a core, while the pool waited), and compresses
-/// on a pool of its own as wide as the machine, whatever `--threads` says.
-/// Here each line of a channel is copied from the film in one loop
-/// (`film_block`, whose channel names must match `encode_exr`'s); a layer
-/// with a channel it does not know is filled through exrs' closure.
-/// The bytes are the same as exrs' writer's (tested).
-fn write_exr_blocks<'i, L>(
+/// Writes the one-layer file `header` describes, its blocks filled from
+/// the film's `planes` (one per channel, in the header's order) and
+/// compressed on rayon's pool, a batch at a time, written in file order.
+/// (exrs' own writer fills every block on the calling thread through a
+/// per-pixel closure, about 45 ns a pixel: a 1080p frame took about 90 ms,
+/// most of a core, while the pool waited; and it compresses on a pool of
+/// its own as wide as the machine, whatever `--threads` says.) Here each
+/// line of a channel is copied from the film in one loop (`film_block`).
+fn write_exr_blocks(
     out: &mut (impl Write + std::io::Seek),
-    image: &'i exr::image::Image<L>,
+    header: exr::meta::header::Header,
     film: &Film,
-) -> exr::error::UnitResult
-where
-    L: exr::image::write::layers::WritableLayers<'i>,
-{
+    planes: &[(Plane, exr::meta::attribute::SampleType)],
+) -> exr::error::UnitResult {
     use exr::block::writer::ChunksWriter;
     use exr::block::UncompressedBlock;
-    use exr::image::write::layers::LayersWriter;
-    use exr::image::write::WritableImage;
     use rayon::prelude::*;
-    let headers = image.write().infer_meta_data();
-    let layers = image.layer_data.create_writer(&headers);
+    let headers: exr::meta::Headers = std::iter::once(header).collect();
     exr::block::write(out, headers, true, |meta, chunks| {
-        // Each layer's channels found in the film once, not per block.
-        let planes: Vec<_> = meta
-            .headers
-            .iter()
-            .map(|header| film_planes(film, &header.channels))
-            .collect();
         let blocks: Vec<_> = meta.enumerate_ordered_header_block_indices().collect();
         // Enough blocks a batch to keep every thread busy; few enough that
         // the compressed batch is small beside the film.
@@ -445,10 +418,7 @@ where
             let compressed: Vec<_> = blocks
                 .par_iter()
                 .map(|&(in_header, index)| {
-                    let data = match &planes[index.layer] {
-                        Some(planes) => film_block(film, planes, index),
-                        None => layers.extract_uncompressed_block(&meta.headers, index),
-                    };
+                    let data = film_block(film, planes, index);
                     UncompressedBlock { index, data }
                         .compress_to_chunk(&meta.headers)
                         .map(|chunk| (in_header, chunk))
@@ -478,7 +448,7 @@ fn put_line(
             .chunks_exact_mut(4)
             .zip(values)
             .for_each(|(out, v)| out.copy_from_slice(&v.to_ne_bytes())),
-        SampleType::U32 => unreachable!("film_planes gives float planes float samples"),
+        SampleType::U32 => unreachable!("EXR_CHANNELS gives float planes float samples"),
     }
 }
 
@@ -493,58 +463,24 @@ enum Plane<'f> {
 }
 
 impl<'f> Plane<'f> {
-    /// The plane of the channel `encode_exr` names `name`, if the film has it.
-    fn named(film: &'f Film, name: &str) -> Option<Plane<'f>> {
+    /// The plane `source` names, if the film has it (the steps layer only
+    /// where `aovs` asks for it).
+    fn of(film: &'f Film, aovs: &[Aov], source: Source) -> Option<Plane<'f>> {
         use Plane::*;
-        let component = |prefix: &str, names: [&str; 3]| {
-            names
-                .iter()
-                .position(|n| name.strip_prefix(prefix) == Some(n))
-        };
-        Some(match name {
-            "A" => Floats(&film.alpha),
-            "Z" => Floats(&film.depth),
-            "DE" => Counts(&film.evaluations),
-            _ => {
-                if let Some(k) = component("", ["R", "G", "B"]) {
-                    Vectors(&film.colour, k)
-                } else if let Some(k) = component("N.", ["X", "Y", "Z"]) {
-                    Vectors(film.normal.as_deref()?, k)
-                } else if let Some(k) = component("albedo.", ["R", "G", "B"]) {
-                    Vectors(film.albedo.as_deref()?, k)
-                } else {
-                    let k = ["origin", "x", "y", "z"]
-                        .iter()
-                        .position(|n| name.strip_prefix("trap.") == Some(n))?;
-                    Traps(film.traps.as_deref()?, k)
-                }
-            }
+        Some(match source {
+            Source::Colour(k) => Vectors(&film.colour, k),
+            Source::Normal(k) => Vectors(film.normal.as_deref()?, k),
+            Source::Albedo(k) => Vectors(film.albedo.as_deref()?, k),
+            Source::Alpha => Floats(&film.alpha),
+            Source::Depth => Floats(&film.depth),
+            Source::Trap(k) => Traps(film.traps.as_deref()?, k),
+            Source::Steps => Counts(aovs.contains(&Aov::Steps).then_some(&film.evaluations)?),
         })
     }
 }
 
-/// The film's plane for each channel of a layer, in the header's order,
-/// with the channel's sample type; `None` if a channel is not one of the
-/// film's or wants a sample type its plane does not hold (counts as u32,
-/// the rest as f16 or f32).
-fn film_planes<'f>(
-    film: &'f Film,
-    channels: &exr::meta::attribute::ChannelList,
-) -> Option<Vec<(Plane<'f>, exr::meta::attribute::SampleType)>> {
-    use exr::meta::attribute::SampleType;
-    channels
-        .list
-        .iter()
-        .map(|c| {
-            let plane = Plane::named(film, &c.name.to_string())?;
-            let counts = matches!(plane, Plane::Counts(_));
-            (counts == (c.sample_type == SampleType::U32)).then_some((plane, c.sample_type))
-        })
-        .collect()
-}
-
 /// The uncompressed bytes of the block at `index` straight from the film's
-/// `planes` (`film_planes`): line by line, each channel's samples of the
+/// `planes` (one per channel, from `EXR_CHANNELS`): line by line, each channel's samples of the
 /// line in a row, in the header's channel order and sample types,
 /// native-endian (exrs' layout).
 fn film_block(
@@ -963,13 +899,8 @@ mod tests {
     use crate::math::Vec3;
     use crate::render::FrameStats;
 
-    thread_local! {
-        /// Makes `encode_exr` on this thread write through exrs' own writer.
-        pub static EXRS_OWN_WRITER: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
-    }
-
     #[test]
-    fn exr_blocks_are_the_bytes_of_exrs_own_writer() {
+    fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
         // A size of 3×2 of exrs' 64-pixel tiles, cut short at the right and
         // the bottom; every layer and values that differ per pixel and
         // channel (some negative, some past f16's range), with and without
@@ -1008,28 +939,74 @@ mod tests {
             ..full.clone()
         };
         let all = [Aov::Normal, Aov::Albedo, Aov::Traps, Aov::Steps];
-        for (film, aovs) in [(&full, &all[..]), (&plain, &[][..])] {
-            let encode = |own: bool| {
-                EXRS_OWN_WRITER.set(own);
-                let mut bytes = std::io::Cursor::new(Vec::new());
-                let result = encode_exr(&mut bytes, film, "h", aovs);
-                EXRS_OWN_WRITER.set(false);
-                result.unwrap();
-                bytes.into_inner()
-            };
-            let (ours, theirs) = (encode(false), encode(true));
-            assert!(ours.len() > n * 12, "{} bytes", ours.len());
-            // The film holds every channel of the file: no block went
-            // through exrs' closure, so the two writers really differ.
-            let meta = exr::meta::MetaData::read_from_buffered(&ours[..], false).unwrap();
-            assert!(film_planes(film, &meta.headers[0].channels).is_some());
-            assert!(
-                ours == theirs,
-                "{} bytes against {}",
-                ours.len(),
-                theirs.len()
-            );
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("tiles.exr");
+        for (film, aovs, channels) in [(&full, &all[..], 16), (&plain, &[][..], 5)] {
+            write_frame(&path, Format::Exr, film, "h", aovs).unwrap();
+            let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
+            let layer = &image.layer_data[0];
+            assert_eq!(layer.size, exr::math::Vec2(w as usize, h as usize));
+            assert_eq!(layer.channel_data.list.len(), channels);
+            for i in 0..n {
+                for (name, value) in expected_samples(film, !aovs.is_empty(), i) {
+                    assert_eq!(read_sample(layer, name, i), value, "{name} at pixel {i}");
+                }
+            }
         }
+    }
+
+    /// What the EXR of `film` should hold at pixel `i` in each channel it
+    /// has, as read back (f16 channels rounded to f16).
+    fn expected_samples(film: &Film, steps: bool, i: usize) -> Vec<(&'static str, f32)> {
+        let half = |x: f32| exr::prelude::f16::from_f32(x).to_f32();
+        let mut expected = vec![
+            ("R", half(film.colour[i].x)),
+            ("G", half(film.colour[i].y)),
+            ("B", half(film.colour[i].z)),
+            ("A", half(film.alpha[i])),
+            ("Z", film.depth[i]),
+        ];
+        if let Some(normal) = &film.normal {
+            expected.extend([
+                ("N.X", normal[i].x),
+                ("N.Y", normal[i].y),
+                ("N.Z", normal[i].z),
+            ]);
+        }
+        if let Some(albedo) = &film.albedo {
+            expected.extend([
+                ("albedo.R", half(albedo[i].x)),
+                ("albedo.G", half(albedo[i].y)),
+                ("albedo.B", half(albedo[i].z)),
+            ]);
+        }
+        if let Some(traps) = &film.traps {
+            expected.extend([
+                ("trap.origin", traps[i][0]),
+                ("trap.x", traps[i][1]),
+                ("trap.y", traps[i][2]),
+                ("trap.z", traps[i][3]),
+            ]);
+        }
+        if steps {
+            expected.push(("DE", film.evaluations[i] as f32));
+        }
+        expected
+    }
+
+    /// Sample `i` of the channel `name` of `layer`, as f32.
+    fn read_sample(
+        layer: &exr::image::Layer<exr::image::AnyChannels<exr::image::FlatSamples>>,
+        name: &str,
+        i: usize,
+    ) -> f32 {
+        let c = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("channel {name} missing"));
+        c.sample_data.value_by_flat_index(i).to_f32()
     }
 
     fn film() -> Film {
@@ -1090,42 +1067,9 @@ mod tests {
         let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
         let layer = &image.layer_data[0];
         assert_eq!(layer.channel_data.list.len(), 16);
-        let get = |name: &str, i: usize| -> f32 {
-            let c = layer
-                .channel_data
-                .list
-                .iter()
-                .find(|c| c.name.to_string() == name)
-                .unwrap_or_else(|| panic!("channel {name} missing"));
-            c.sample_data.value_by_flat_index(i).to_f32()
-        };
-        let half = |x: f32| exr::prelude::f16::from_f32(x).to_f32();
-        let (normal, albedo, traps) = (
-            f.normal.as_ref().unwrap(),
-            f.albedo.as_ref().unwrap(),
-            f.traps.as_ref().unwrap(),
-        );
         for i in 0..6 {
-            let expected = [
-                ("R", half(f.colour[i].x)),
-                ("G", half(f.colour[i].y)),
-                ("B", half(f.colour[i].z)),
-                ("A", half(f.alpha[i])),
-                ("Z", f.depth[i]),
-                ("N.X", normal[i].x),
-                ("N.Y", normal[i].y),
-                ("N.Z", normal[i].z),
-                ("albedo.R", half(albedo[i].x)),
-                ("albedo.G", half(albedo[i].y)),
-                ("albedo.B", half(albedo[i].z)),
-                ("trap.origin", traps[i][0]),
-                ("trap.x", traps[i][1]),
-                ("trap.y", traps[i][2]),
-                ("trap.z", traps[i][3]),
-                ("DE", f.evaluations[i] as f32),
-            ];
-            for (name, value) in expected {
-                assert_eq!(get(name, i), value, "{name} at pixel {i}");
+            for (name, value) in expected_samples(&f, true, i) {
+                assert_eq!(read_sample(layer, name, i), value, "{name} at pixel {i}");
             }
         }
         // Without layers only the five standard channels are written.
