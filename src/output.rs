@@ -336,6 +336,20 @@ const EXR_CHANNELS: [(&str, exr::meta::attribute::SampleType, Source); 16] = {
     ]
 };
 
+// Counts, and only counts, are stored as u32 (`film_block` and `put_line`
+// rely on it).
+const _: () = {
+    let mut i = 0;
+    while i < EXR_CHANNELS.len() {
+        let (_, sample, source) = EXR_CHANNELS[i];
+        assert!(
+            matches!(source, Source::Steps)
+                == matches!(sample, exr::meta::attribute::SampleType::U32)
+        );
+        i += 1;
+    }
+};
+
 fn encode_exr(
     out: &mut (impl Write + std::io::Seek),
     film: &Film,
@@ -924,10 +938,10 @@ mod tests {
             depth: (0..n).map(|i| v(i, 4) * 1e5).collect(),
             evaluations: (0..n).map(|i| i as u32 * 97).collect(),
             normal: Some(vectors(5)),
-            albedo: Some(vectors(6)),
+            albedo: Some(vectors(8)),
             traps: Some(
                 (0..n)
-                    .map(|i| [v(i, 7), v(i, 8), v(i, 9), v(i, 10)])
+                    .map(|i| [v(i, 11), v(i, 12), v(i, 13), v(i, 14)])
                     .collect(),
             ),
             stats: FrameStats::default(),
@@ -1044,21 +1058,29 @@ mod tests {
 
     #[test]
     fn exr_channels_hold_each_pixels_film_values() {
-        // Distinct values per pixel and channel, so a pixel or channel read
-        // from the wrong place shows.
+        // Distinct values per pixel and channel (k numbers the channels),
+        // exact in f16, so a pixel or channel read from the wrong place shows.
         let mut f = film();
-        let v = |i: usize, k: usize| (i * 4 + k) as f32 * 0.25 + 0.125;
+        let v = |i: usize, k: usize| (i * 16 + k) as f32 * 0.25 + 0.125;
         f.colour = (0..6)
             .map(|i| Vec3::new(v(i, 0), v(i, 1), v(i, 2)))
             .collect();
         f.alpha = (0..6).map(|i| v(i, 3) / 8.0).collect();
         f.depth = (0..6).map(|i| 1.0 + i as f32 / 3.0).collect();
         f.evaluations = (0..6).map(|i| 10 + i as u32).collect();
-        f.normal = Some((0..6).map(|i| Vec3::new(-v(i, 0), v(i, 1), 0.1)).collect());
-        f.albedo = Some((0..6).map(|i| Vec3::new(v(i, 2), 0.5, v(i, 0))).collect());
+        f.normal = Some(
+            (0..6)
+                .map(|i| Vec3::new(-v(i, 4), v(i, 5), v(i, 6)))
+                .collect(),
+        );
+        f.albedo = Some(
+            (0..6)
+                .map(|i| Vec3::new(v(i, 7), v(i, 8), v(i, 9)))
+                .collect(),
+        );
         f.traps = Some(
             (0..6)
-                .map(|i| [v(i, 0), v(i, 1), v(i, 2), v(i, 3)])
+                .map(|i| [v(i, 10), v(i, 11), v(i, 12), v(i, 13)])
                 .collect(),
         );
         let dir = tempfile::tempdir().unwrap();
