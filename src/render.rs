@@ -585,7 +585,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         }
         let mut outcomes = shadows.iter().copied();
         // The row's ambient occlusion, its samples packed across the hits
-        // (left empty when it is off).
+        // (left empty when it is off, or replaced by path tracing).
         occluded.clear();
         if let (None, Some(ao)) = (
             &scene.effects.path_tracing,
