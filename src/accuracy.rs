@@ -153,7 +153,7 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
             s.quality.over_relaxation = v
         });
     }
-    for v in [1, 4, 16, 64] {
+    for v in [1, 4, 8, 16, 64] {
         add("cone_rays", v.to_string(), &|s| s.quality.cone_rays = v);
     }
     for k in [0.25, 0.5, 2.0] {

@@ -1149,7 +1149,10 @@ fn info(path: &Path) -> anyhow::Result<()> {
     let cones = match (base.cone_rays(), base.march_alone_reason()) {
         (1, Some(why)) => format!("each camera ray alone, {why}"),
         (1, None) => "each camera ray alone".to_string(),
-        (n, _) => format!("runs of {n} camera rays share a cone first"),
+        (n, _) => {
+            let (columns, rows) = crate::march::cone_block(n);
+            format!("blocks of {columns}×{rows} camera rays share a cone first")
+        }
     };
     out!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
     if let Some(sh) = &effects.shadows {

@@ -31,11 +31,12 @@ pub struct MarchSettings {
     /// unbounding spheres of successive points overlap; where they do not,
     /// the step is taken back and the ray goes on at the plain step. 1 turns it off.
     pub over_relaxation: Real,
-    /// Camera rays, neighbours along a row, that first march together along
-    /// one cone holding them all, until the surface is within a pixel of the
-    /// cone, and then go on alone (`march_camera_rays`); 1 marches every ray
-    /// alone. Not used with glow, which needs each ray's nearest approach,
-    /// nor with estimators other than the analytic one (`Scene::cone_rays`).
+    /// Camera rays, a block of neighbouring pixels (`cone_block`: 16 is 4×4),
+    /// that first march together along one cone holding them all, until
+    /// the surface is within a pixel of the cone, and then go on alone
+    /// (`march_camera_rays`); 1 marches every ray alone. Not used with
+    /// glow, which needs each ray's nearest approach, nor with estimators
+    /// other than the analytic one (`Scene::cone_rays`).
     pub cone_rays: u32,
 }
 
@@ -63,9 +64,29 @@ impl Default for MarchSettings {
             normal_step: 0.5,
             bounding_radius: 1.5,
             over_relaxation: 1.2,
-            cone_rays: 8,
+            cone_rays: 16,
         }
     }
+}
+
+/// The most image rows a block of cone rays spans (`cone_block`): the
+/// renderer takes rows this many at a time.
+pub const CONE_BLOCK_ROWS: usize = 4;
+
+/// The block of pixels (columns, rows) whose camera rays share a cone, for
+/// `n` rays a cone: as square as the rows allow, for the tightest cone
+/// (4 rows once n is a multiple of 4 and at least 16, 2 once it is even
+/// and at least 4, else one row).
+pub fn cone_block(n: u32) -> (usize, usize) {
+    let n = n.max(1) as usize;
+    let rows = if n.is_multiple_of(4) && n >= 16 {
+        4
+    } else if n.is_multiple_of(2) && n >= 4 {
+        2
+    } else {
+        1
+    };
+    (n / rows, rows)
 }
 
 /// A ray through a pixel: origin, unit direction, and the angle one pixel subtends.
@@ -149,49 +170,65 @@ pub fn march_many(
     walk_many(walks, fractal, settings, |i, result| results[i] = result);
 }
 
-/// Camera rays of a row, marched as `march_many` does, but each run of
-/// `run` neighbours first shares one march along a cone that holds them
-/// all (`ConeWalk`): the stretch where the surface is still far off
-/// compared with the run's width is walked once for the run, and each ray
-/// starts where the cone stopped. The cone's estimates are shared out over
-/// the run's rays. `scratch` is kept by the caller from row to row. `run`
-/// is `Scene::cone_rays` (1: every ray alone), which `settings.cone_rays`
-/// does not override.
+/// Camera rays marched as `march_many` does, but each run of neighbours
+/// (`runs`: the lengths of consecutive runs of `rays`, summing to its
+/// length) first shares one march along a cone that holds them all
+/// (`ConeWalk`): the stretch where the surface is still far off compared
+/// with the run's width is walked once for the run, and each ray starts
+/// where the cone stopped. The cone's estimates are shared out over the
+/// run's rays. `scratch` is kept by the caller from call to call. Runs of
+/// one ray march every ray alone.
 pub fn march_camera_rays(
     rays: &[Ray],
     fractal: &Fractal,
     settings: &MarchSettings,
-    run: u32,
+    runs: &[u32],
     results: &mut [MarchResult],
     scratch: &mut ConeScratch,
 ) {
-    let run = run.max(1) as usize;
-    if run == 1 {
+    debug_assert_eq!(rays.len(), results.len());
+    debug_assert_eq!(runs.iter().map(|&n| n as usize).sum::<usize>(), rays.len());
+    if runs.iter().all(|&n| n == 1) {
         return march_many(rays, fractal, settings, results);
     }
-    debug_assert_eq!(rays.len(), results.len());
-    let ConeScratch { intervals, free } = scratch;
+    let ConeScratch {
+        intervals,
+        free,
+        run_of,
+    } = scratch;
     // Each ray's way through the bounding sphere, once: the cones and the
     // rays after them both start from it.
     intervals.clear();
     intervals.extend(rays.iter().map(|ray| settings.interval(ray)));
+    // Each ray's run, and each run's rays.
+    run_of.clear();
+    for (k, &n) in runs.iter().enumerate() {
+        run_of.extend(std::iter::repeat_n(k as u32, n as usize));
+    }
+    let spans = || {
+        runs.iter().scan(0, |start, &n| {
+            let span = *start..*start + n as usize;
+            *start = span.end;
+            Some(span)
+        })
+    };
     free.clear();
-    free.resize(rays.len().div_ceil(run), (0.0, 0));
-    let cones = rays
-        .chunks(run)
-        .zip(intervals.chunks(run))
-        .map(|(run, intervals)| ConeWalk::start(run, intervals));
+    free.resize(runs.len(), (0.0, 0));
+    let cones = spans().map(|span| ConeWalk::start(&rays[span.clone()], &intervals[span]));
     walk_many(cones, fractal, settings, |i, out| free[i] = out);
-    let walks = rays
-        .iter()
-        .zip(intervals.iter())
-        .enumerate()
-        .map(|(k, (ray, &interval))| Marcher::start_in(ray, settings, interval, free[k / run].0));
+    let walks =
+        rays.iter()
+            .zip(intervals.iter())
+            .zip(run_of.iter())
+            .map(|((ray, &interval), &run)| {
+                Marcher::start_in(ray, settings, interval, free[run as usize].0)
+            });
     walk_many(walks, fractal, settings, |i, result| results[i] = result);
     // Each ray of a run takes its share of the cone's estimates (the first
     // ones one more while there is a remainder), so the frame's total and
     // the per-pixel cost map both hold them.
-    for (results, &(_, evaluations)) in results.chunks_mut(run).zip(free.iter()) {
+    for (span, &(_, evaluations)) in spans().zip(free.iter()) {
+        let results = &mut results[span];
         let n = results.len() as u32;
         for (k, r) in results.iter_mut().enumerate() {
             r.evaluations += evaluations / n + u32::from((k as u32) < evaluations % n);
@@ -200,11 +237,12 @@ pub fn march_camera_rays(
 }
 
 /// `march_camera_rays`' scratch space: each ray's bounding-sphere interval
-/// and, for each run, where its rays may start and what its cone cost.
+/// and run; for each run, where its rays may start and what its cone cost.
 #[derive(Default)]
 pub struct ConeScratch {
     intervals: Vec<Option<(Real, Real)>>,
     free: Vec<(Real, u32)>,
+    run_of: Vec<u32>,
 }
 
 /// A march along the axis of a cone that holds a run of rays: each step
@@ -915,51 +953,79 @@ mod tests {
     fn rays_after_a_cone_find_the_surface_they_find_alone() {
         let settings = MarchSettings::default();
         for f in &cone_test_fractals() {
-            let (mut both, mut near, mut differ, mut evaluations) = (0, 0, 0, [0u64; 2]);
+            let (mut both, mut near, mut differ) = (0, [0; 2], [0; 2]);
+            let mut evaluations = [0u64; 3];
             for rays in camera_rows(DVec3::new(-2.2, -1.1, 0.9), 6, 64, 1.5e-3) {
-                let mut marched = [
-                    vec![MarchResult::default(); rays.len()],
-                    vec![MarchResult::default(); rays.len()],
-                ];
-                for (k, cone_rays) in [1, MarchSettings::default().cone_rays]
+                let mut marched = [(); 3].map(|_| vec![MarchResult::default(); rays.len()]);
+                // Every ray alone; runs of 8; runs of uneven lengths.
+                let uneven = [13, 7, 16, 1, 27];
+                for (k, runs) in [vec![1; 64], vec![8; 8], uneven.to_vec()]
                     .into_iter()
                     .enumerate()
                 {
                     let (results, scratch) = (&mut marched[k], &mut ConeScratch::default());
-                    march_camera_rays(&rays, f, &settings, cone_rays, results, scratch);
+                    march_camera_rays(&rays, f, &settings, &runs, results, scratch);
                     evaluations[k] += marched[k].iter().map(|m| m.evaluations as u64).sum::<u64>();
                 }
                 let alone: Vec<MarchResult> =
                     rays.iter().map(|ray| march(ray, f, &settings)).collect();
                 // One ray a cone is every ray alone, to the bit.
                 assert_eq!(format!("{alone:?}"), format!("{:?}", marched[0]));
-                for ((ray, a), c) in rays.iter().zip(&alone).zip(&marched[1]) {
-                    match (a.hit, c.hit) {
-                        (Some(a), Some(c)) => {
-                            both += 1;
-                            near += ((a.t - c.t).abs() <= 2.0 * ray.footprint(a.t)) as usize;
+                for (k, cones) in marched[1..].iter().enumerate() {
+                    for ((ray, a), c) in rays.iter().zip(&alone).zip(cones) {
+                        match (a.hit, c.hit) {
+                            (Some(a), Some(c)) => {
+                                both += (k == 0) as usize;
+                                near[k] += ((a.t - c.t).abs() <= 2.0 * ray.footprint(a.t)) as usize;
+                            }
+                            (None, None) => {}
+                            _ => differ[k] += 1,
                         }
-                        (None, None) => {}
-                        _ => differ += 1,
                     }
                 }
             }
             // The same surface within a couple of footprints, nearly everywhere,
-            // for fewer estimates.
+            // for fewer estimates, with runs of 8 and of uneven lengths.
             assert!(both > 100, "{f:?}: {both} hits");
-            assert!(
-                near * 100 >= both * 95,
-                "{f:?}: {near} of {both} within 2 footprints"
-            );
-            assert!(
-                differ * 100 <= 3 * 6 * 64,
-                "{f:?}: {differ} hit/miss differ"
-            );
-            assert!(
-                evaluations[1] * 10 < evaluations[0] * 9,
-                "{f:?}: {evaluations:?}"
-            );
+            for k in 0..2 {
+                assert!(
+                    near[k] * 100 >= both * 95,
+                    "{f:?}: {} of {both} within 2 footprints",
+                    near[k]
+                );
+                assert!(
+                    differ[k] * 100 <= 3 * 6 * 64,
+                    "{f:?}: {} hit/miss differ",
+                    differ[k]
+                );
+                assert!(
+                    evaluations[k + 1] * 10 < evaluations[0] * 9,
+                    "{f:?}: {evaluations:?}"
+                );
+            }
         }
+    }
+
+    #[test]
+    fn cone_blocks_are_as_square_as_four_rows_allow() {
+        let shapes: Vec<_> = [1, 2, 3, 4, 8, 12, 16, 32, 64, 9].map(cone_block).to_vec();
+        assert_eq!(
+            shapes,
+            [
+                (1, 1),
+                (2, 1),
+                (3, 1),
+                (2, 2),
+                (4, 2),
+                (6, 2),
+                (4, 4),
+                (8, 4),
+                (16, 4),
+                (9, 1)
+            ]
+        );
+        assert!(shapes.iter().all(|&(_, rows)| rows <= CONE_BLOCK_ROWS));
+        assert_eq!(cone_block(MarchSettings::default().cone_rays), (4, 4));
     }
 
     #[test]

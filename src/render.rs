@@ -188,17 +188,18 @@ pub fn render_frame_in_time(
     let n = scenes[0].samples_per_pixel.max(1);
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     let mut film = Film::blank(width, height, layers);
-    // Every row renders in parallel into this thread's one-row sums (the
-    // running sums, f64 colour and counters, exist for a row at a time, not
-    // the frame) and is finished straight into its place in the film: no
-    // point where threads wait for each other.
+    // Every band of rows renders in parallel into this thread's one-band
+    // sums (the running sums, f64 colour and counters, exist for a band at
+    // a time, not the frame) and is finished straight into its place in the
+    // film: no point where threads wait for each other.
     film.stats = film
-        .rows_mut()
+        .bands_mut()
         .enumerate()
-        .map(|(y, pixels)| {
+        .map(|(band, pixels)| {
             let mut sums = ROW_SUMS.take();
-            sums.reset(width, 1, layers);
-            let stats = render_row(&frame, y, sums.all_mut());
+            let rows = pixels.colour.len() / width as usize;
+            sums.reset(width, rows as u32, layers);
+            let stats = render_band(&frame, band * BAND_ROWS, sums.all_mut());
             let max_pixel = finish_pixels(&sums, n, pixels);
             ROW_SUMS.set(sums);
             stats.finished(max_pixel)
@@ -287,17 +288,19 @@ impl Accumulation {
         }
     }
 
-    /// The sums row by row, for rendering rows in parallel.
-    fn rows_mut(&mut self) -> impl IndexedParallelIterator<Item = RowSums<'_>> {
-        let (w, h) = (self.width as usize, self.height);
+    /// The sums a band of `BAND_ROWS` rows at a time, for rendering bands
+    /// in parallel.
+    fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = RowSums<'_>> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let band = BAND_ROWS * w;
         self.colour
-            .par_chunks_mut(w)
-            .zip(self.hits.par_chunks_mut(w))
-            .zip(self.depth.par_chunks_mut(w))
-            .zip(self.spent.par_chunks_mut(w))
-            .zip(optional_rows(&mut self.normal, w, h))
-            .zip(optional_rows(&mut self.albedo, w, h))
-            .zip(optional_rows(&mut self.traps, w, h))
+            .par_chunks_mut(band)
+            .zip(self.hits.par_chunks_mut(band))
+            .zip(self.depth.par_chunks_mut(band))
+            .zip(self.spent.par_chunks_mut(band))
+            .zip(optional_bands(&mut self.normal, w, h))
+            .zip(optional_bands(&mut self.albedo, w, h))
+            .zip(optional_bands(&mut self.traps, w, h))
             .map(
                 |((((((colour, hits), depth), spent), normal), albedo), traps)| RowSums {
                     colour,
@@ -352,20 +355,22 @@ struct FilmPixels<'a> {
 }
 
 impl Film {
-    /// The film row by row, for finishing rows in parallel.
-    fn rows_mut(&mut self) -> impl IndexedParallelIterator<Item = FilmPixels<'_>> {
-        let (w, h) = (self.width as usize, self.height);
+    /// The film a band of `BAND_ROWS` rows at a time, for finishing bands
+    /// in parallel.
+    fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = FilmPixels<'_>> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let band = BAND_ROWS * w;
         let normal = self.normal.as_deref_mut().unwrap_or_default();
         let albedo = self.albedo.as_deref_mut().unwrap_or_default();
         let traps = self.traps.as_deref_mut().unwrap_or_default();
         self.colour
-            .par_chunks_mut(w)
-            .zip(self.alpha.par_chunks_mut(w))
-            .zip(self.depth.par_chunks_mut(w))
-            .zip(self.evaluations.par_chunks_mut(w))
-            .zip(optional_rows(normal, w, h))
-            .zip(optional_rows(albedo, w, h))
-            .zip(optional_rows(traps, w, h))
+            .par_chunks_mut(band)
+            .zip(self.alpha.par_chunks_mut(band))
+            .zip(self.depth.par_chunks_mut(band))
+            .zip(self.evaluations.par_chunks_mut(band))
+            .zip(optional_bands(normal, w, h))
+            .zip(optional_bands(albedo, w, h))
+            .zip(optional_bands(traps, w, h))
             .map(
                 |((((((colour, alpha), depth), evaluations), normal), albedo), traps)| FilmPixels {
                     colour,
@@ -428,12 +433,13 @@ pub fn render_samples(
 ) {
     let samples = acc.samples_done..until;
     let frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
-    // One row per task; rayon spreads rows over threads and each pixel depends
-    // only on its own samples, so the result is independent of the split.
+    // One band of rows per task; rayon spreads bands over threads and each
+    // pixel depends only on its own samples and its band, so the result is
+    // independent of the split.
     let stats = acc
-        .rows_mut()
+        .bands_mut()
         .enumerate()
-        .map(|(y, sums)| render_row(&frame, y, sums))
+        .map(|(band, sums)| render_band(&frame, band * BAND_ROWS, sums))
         .reduce(FrameStats::default, |a, b| a + b);
     acc.stats = acc.stats + stats;
     acc.samples_done = until;
@@ -487,8 +493,13 @@ impl<'a> FrameSetup<'a> {
     }
 }
 
-/// Adds `frame.samples` of every pixel of image row `y` to `sums`.
-fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
+/// The image rows rendered together: the rows a block of cone rays can
+/// span (`march::CONE_BLOCK_ROWS`).
+const BAND_ROWS: usize = crate::march::CONE_BLOCK_ROWS;
+
+/// Adds `frame.samples` of every pixel of the band of image rows from `y0`
+/// (as many as `sums` holds) to `sums`.
+fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
     let FrameSetup {
         scenes,
         frame_index,
@@ -498,6 +509,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         ..
     } = *frame;
     let w = width as usize;
+    let rows = sums.colour.len() / w.max(1);
     let RowSums {
         colour: colour_row,
         hits: hits_row,
@@ -508,18 +520,20 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         traps: mut traps_row,
     } = sums;
     let mut stats = FrameStats::default();
-    // A row runs start to end on one thread, so this thread's
-    // count of orbit iterations measures exactly the row's.
+    // A band runs start to end on one thread, so this thread's
+    // count of orbit iterations measures exactly the band's.
     let iterations_before = crate::fractal::iterations_on_this_thread();
-    // Each sample index at a time over the whole row, so the
-    // row's camera rays march side by side, in cones
+    // Each sample index at a time over the whole band, so the
+    // band's camera rays march side by side, a block of pixels to a cone
     // (`march_camera_rays`); each
     // pixel still takes its samples in order.
-    // This thread's buffers, kept from row to row: allocating
-    // and freeing them per row made the allocator hand pages
+    // This thread's buffers, kept from band to band: allocating
+    // and freeing them per band made the allocator hand pages
     // back and fault them in again, flushing the other cores' TLBs.
     let mut scratch = ROW_SCRATCH.take();
     let RowScratch {
+        order,
+        runs,
         rays,
         marched,
         surfaces,
@@ -529,12 +543,17 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         cone_free,
         paths,
     } = &mut scratch;
-    marched.resize(w, MarchResult::default());
+    marched.resize(rows * w, MarchResult::default());
     for s in frame.samples.clone() {
         let k = s as usize % scenes.len();
         let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
+        // The band's pixels block by block (`cone_blocks`): ray i is the
+        // pixel `order[i]` of the band.
+        let block = crate::march::cone_block(scene.cone_rays());
+        cone_blocks(w, rows, block, order, runs);
         rays.clear();
-        rays.extend((0..w).map(|x| {
+        rays.extend(order.iter().map(|&p| {
+            let (x, y) = (p % w, y0 + p / w);
             let pixel = (y * w + x) as u64;
             let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
             if camera.has_lens() {
@@ -545,15 +564,15 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 camera.ray(x as Real + ox, y as Real + oy, width, height)
             }
         }));
-        let (f, q, run) = (&scene.fractal, &scene.quality, scene.cone_rays());
-        crate::march::march_camera_rays(rays, f, q, run, marched, cone_free);
-        // Where each ray met the surface, with its normal (the row's hits
+        let (f, q) = (&scene.fractal, &scene.quality);
+        crate::march::march_camera_rays(rays, f, q, runs, marched, cone_free);
+        // Where each ray met the surface, with its normal (the band's hits
         // four to a kernel call); each pixel's cost goes straight to its sum.
         surfaces.clear();
-        surfaces.resize(w, None);
-        for (spent, result) in spent_row.iter_mut().zip(marched.iter()) {
+        surfaces.resize(rays.len(), None);
+        for (&p, result) in order.iter().zip(marched.iter()) {
             stats.primary_evaluations += result.evaluations as u64;
-            *spent += result.evaluations as u64;
+            spent_row[p] += result.evaluations as u64;
         }
         let hits = rays
             .iter()
@@ -564,10 +583,10 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             hits,
             &scene.fractal,
             &scene.quality,
-            |x, ray, hit, (nrm, evals)| {
+            |i, ray, hit, (nrm, evals)| {
                 stats.normal_evaluations += evals as u64;
-                spent_row[x] += evals as u64;
-                surfaces[x] = Some(SurfacePoint::from_hit(ray, hit, nrm));
+                spent_row[order[i]] += evals as u64;
+                surfaces[i] = Some(SurfacePoint::from_hit(ray, hit, nrm));
             },
         );
         // The row's shadow rays, walked side by side. Shading takes their
@@ -591,7 +610,7 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             &scene.effects.path_tracing,
             &scene.effects.ambient_occlusion,
         ) {
-            occluded.resize(w, None);
+            occluded.resize(rays.len(), None);
             let hits = surfaces.iter().enumerate().filter_map(|(x, at)| {
                 let at = at.as_ref()?;
                 Some((x, at.point, at.normal, at.t, at.footprint))
@@ -601,8 +620,9 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
         // The row's path-traced samples, a bounce at a time side by side.
         let traced = match &scene.effects.path_tracing {
             Some(pt) => {
-                let random =
-                    |x: usize, d: u32| sample_1d(scene.seed, frame_index, (y * w + x) as u64, s, d);
+                let random = |i: usize, d: u32| {
+                    sample_1d(scene.seed, frame_index, (y0 * w + order[i]) as u64, s, d)
+                };
                 crate::shade::trace_paths(
                     &scene.look,
                     pt,
@@ -618,12 +638,13 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
             }
             None => &[][..],
         };
-        for (x, ((ray, result), at)) in rays
+        for (i, ((ray, result), at)) in rays
             .iter()
             .zip(marched.iter())
             .zip(surfaces.iter())
             .enumerate()
         {
+            let x = order[i];
             let before = stats.stage_total();
             let c = trace(
                 scene,
@@ -631,8 +652,8 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                 result,
                 at.as_ref(),
                 &mut outcomes,
-                occluded.get(x).copied().flatten(),
-                traced.get(x).copied(),
+                occluded.get(i).copied().flatten(),
+                traced.get(i).copied(),
                 camera.up,
                 scale,
                 frame.environment.as_deref(),
@@ -667,7 +688,12 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
                     }
                 }
             }
-            debug_assert!(c.is_finite(), "non-finite sample at pixel ({x}, {y})");
+            debug_assert!(
+                c.is_finite(),
+                "non-finite sample at pixel ({}, {})",
+                x % w,
+                y0 + x / w
+            );
             if !c.is_finite() {
                 stats.repaired_samples += 1;
             }
@@ -682,13 +708,46 @@ fn render_row(frame: &FrameSetup, y: usize, sums: RowSums) -> FrameStats {
     }
     ROW_SCRATCH.set(scratch);
     stats.de_iterations += crate::fractal::iterations_on_this_thread() - iterations_before;
-    (frame.on_row)();
+    for _ in 0..rows {
+        (frame.on_row)();
+    }
     stats
 }
 
-/// A row's working buffers (see `render_row`).
+/// The `rows`×`w` pixels of a band (as offsets into its sums, row after
+/// row) into `order` block by block, `block` (columns, rows) at a time:
+/// down the band's groups of block rows, across each group a block after
+/// another, each block's pixels row by row; `runs` gets each block's size
+/// (narrower at the right edge, lower in a short band). A block's camera
+/// rays march one cone.
+fn cone_blocks(
+    w: usize,
+    rows: usize,
+    (bw, bh): (usize, usize),
+    order: &mut Vec<usize>,
+    runs: &mut Vec<u32>,
+) {
+    order.clear();
+    runs.clear();
+    for y in (0..rows).step_by(bh) {
+        let gh = bh.min(rows - y);
+        for x in (0..w).step_by(bw) {
+            let gw = bw.min(w - x);
+            for yy in y..y + gh {
+                order.extend(yy * w + x..yy * w + x + gw);
+            }
+            runs.push((gw * gh) as u32);
+        }
+    }
+}
+
+/// A band's working buffers (see `render_band`).
 #[derive(Default)]
 struct RowScratch {
+    /// Each camera ray's pixel in the band, and the blocks' sizes
+    /// (`cone_blocks`).
+    order: Vec<usize>,
+    runs: Vec<u32>,
     rays: Vec<crate::march::Ray>,
     marched: Vec<MarchResult>,
     /// Where each camera ray met the surface.
@@ -710,17 +769,18 @@ thread_local! {
     static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
 }
 
-/// Rows of an optional layer for the parallel zip: `Some(row)` per image row
-/// when the layer is collected, `None` for each row otherwise.
-fn optional_rows<T: Send>(
+/// Bands of `BAND_ROWS` rows of an optional layer for the parallel zip:
+/// `Some(band)` per band when the layer is collected, `None` for each band
+/// otherwise.
+fn optional_bands<T: Send>(
     layer: &mut [T],
     width: usize,
-    height: u32,
+    height: usize,
 ) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
     let rows: Vec<Option<&mut [T]>> = if layer.is_empty() {
-        (0..height).map(|_| None).collect()
+        (0..height.div_ceil(BAND_ROWS)).map(|_| None).collect()
     } else {
-        layer.chunks_mut(width).map(Some).collect()
+        layer.chunks_mut(BAND_ROWS * width).map(Some).collect()
     };
     rows.into_par_iter()
 }
@@ -948,6 +1008,41 @@ mod tests {
         assert!(render_frame(&closed, 0, 32, 24, &|| {}).colour == a.colour);
         // The lens costs marching only through its extra rays' paths: same sample count.
         assert_eq!(a.stats.samples, b.stats.samples);
+    }
+
+    #[test]
+    fn cone_blocks_cover_a_band_in_rectangles() {
+        // Widths that the block divides and that it does not, full and
+        // short bands, and every block shape the renderer uses.
+        for (w, rows) in [(8, 4), (10, 4), (7, 3), (5, 1), (1, 4)] {
+            for n in [1, 2, 4, 8, 12, 16, 32] {
+                let (bw, bh) = crate::march::cone_block(n);
+                let (mut order, mut runs) = (vec![], vec![]);
+                cone_blocks(w, rows, (bw, bh), &mut order, &mut runs);
+                // Every pixel of the band exactly once.
+                let mut sorted = order.clone();
+                sorted.sort_unstable();
+                assert_eq!(
+                    sorted,
+                    (0..w * rows).collect::<Vec<_>>(),
+                    "{w}x{rows} n={n}"
+                );
+                // Each run is a rectangle of at most bw×bh pixels, row by row.
+                let mut at = 0;
+                for &run in &runs {
+                    let block = &order[at..at + run as usize];
+                    at += run as usize;
+                    let xs = block.iter().map(|p| p % w);
+                    let ys = block.iter().map(|p| p / w);
+                    let (x0, x1) = (xs.clone().min().unwrap(), xs.max().unwrap());
+                    let (y0, y1) = (ys.clone().min().unwrap(), ys.max().unwrap());
+                    assert!(x1 - x0 < bw && y1 - y0 < bh, "{w}x{rows} n={n}: {block:?}");
+                    assert_eq!(block.len(), (x1 - x0 + 1) * (y1 - y0 + 1), "{block:?}");
+                    assert!(block.windows(2).all(|p| p[0] < p[1]), "{block:?}");
+                }
+                assert_eq!(at, order.len());
+            }
+        }
     }
 
     #[test]
