@@ -547,7 +547,7 @@ impl Plan {
     }
 
     /// Renders one frame and writes every format. A frame of one sample per
-    /// pixel is rendered row by row (`render_frame_in_time`), without the
+    /// pixel is rendered band by band (`render_frame_in_time`), without the
     /// whole frame's running sums. Others run in waves of samples, saving
     /// their accumulation every `checkpoint_every` and continuing from a
     /// saved one for the same inputs; the result is bit-identical either way.

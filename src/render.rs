@@ -1,9 +1,12 @@
-//! Turning a scene into a film: camera rays, the deterministic sampler, rows of
-//! pixels spread over rayon's threads (a row's camera rays and shadow rays
-//! marched side by side), and per-frame counters.
+//! Turning a scene into a film: camera rays, the deterministic sampler, bands
+//! of four rows of pixels spread over rayon's threads (a band's camera rays,
+//! in cones over blocks of pixels, and its shadow rays marched side by side),
+//! and per-frame counters.
 //!
-//! Every pixel depends only on (scene, frame, pixel, sample), never on which
-//! thread ran it or in which order, so the image is identical for any thread count.
+//! Every pixel depends only on (scene, frame, pixel, sample) and on the
+//! pixels its camera rays share a cone with (fixed by the image size and
+//! `quality.cone_rays`), never on which thread ran it or in which order, so
+//! the image is identical for any thread count.
 
 use crate::march::{normals_many, walk_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
@@ -107,7 +110,7 @@ impl FrameStats {
             + self.sun_evaluations
     }
 
-    /// These counts as a finished frame (or row) reports them: the stage
+    /// These counts as a finished frame (or band) reports them: the stage
     /// total and the most any one pixel took.
     fn finished(self, max_pixel_evaluations: u64) -> FrameStats {
         FrameStats {
@@ -275,7 +278,7 @@ impl Accumulation {
         }
     }
 
-    /// All the sums as one run of pixels (for a one-row accumulation, its row).
+    /// All the sums as one run of pixels (for a one-band accumulation, its band).
     fn all_mut(&mut self) -> RowSums<'_> {
         RowSums {
             colour: &mut self.colour,
@@ -332,7 +335,7 @@ impl Accumulation {
     }
 }
 
-/// One row of an accumulation's sums.
+/// One band of an accumulation's sums.
 struct RowSums<'a> {
     colour: &'a mut [[f64; 3]],
     hits: &'a mut [u32],
@@ -343,7 +346,7 @@ struct RowSums<'a> {
     traps: Option<&'a mut [[f32; 4]]>,
 }
 
-/// Pixels of a film (a row, or all of them).
+/// Pixels of a film (a band, or all of them).
 struct FilmPixels<'a> {
     colour: &'a mut [Vec3],
     alpha: &'a mut [f32],
@@ -445,7 +448,7 @@ pub fn render_samples(
     acc.samples_done = until;
 }
 
-/// What every row of one frame's rendering shares, worked out once.
+/// What every band of one frame's rendering shares, worked out once.
 struct FrameSetup<'a> {
     scenes: &'a [Scene],
     frame_index: u32,
@@ -589,7 +592,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
                 surfaces[i] = Some(SurfacePoint::from_hit(ray, hit, nrm));
             },
         );
-        // The row's shadow rays, walked side by side. Shading takes their
+        // The band's shadow rays, walked side by side. Shading takes their
         // outcomes back in the same order, pixel after pixel.
         shadows.clear();
         if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
@@ -603,7 +606,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
             });
         }
         let mut outcomes = shadows.iter().copied();
-        // The row's ambient occlusion, its samples packed across the hits
+        // The band's ambient occlusion, its samples packed across the hits
         // (left empty when it is off, or replaced by path tracing).
         occluded.clear();
         if let (None, Some(ao)) = (
@@ -617,7 +620,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
             });
             crate::shade::occlusions(&scene.fractal, ao, hits, |x, out| occluded[x] = Some(out));
         }
-        // The row's path-traced samples, a bounce at a time side by side.
+        // The band's path-traced samples, a bounce at a time side by side.
         let traced = match &scene.effects.path_tracing {
             Some(pt) => {
                 let random = |i: usize, d: u32| {
@@ -759,13 +762,13 @@ struct RowScratch {
     /// Each camera ray's bounding-sphere interval; where each run of them
     /// may start, and what its cone cost.
     cone_free: crate::march::ConeScratch,
-    /// The row's path-traced samples, traced together.
+    /// The band's path-traced samples, traced together.
     paths: crate::shade::PathScratch,
 }
 
 thread_local! {
     static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
-    /// One row's sums for `render_frame_in_time`, kept like `ROW_SCRATCH`.
+    /// One band's sums for `render_frame_in_time`, kept like `ROW_SCRATCH`.
     static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
 }
 
@@ -1041,8 +1044,46 @@ mod tests {
                     assert!(block.windows(2).all(|p| p[0] < p[1]), "{block:?}");
                 }
                 assert_eq!(at, order.len());
+                // As few blocks as the band holds, the first a whole one.
+                assert_eq!(runs.len(), w.div_ceil(bw) * rows.div_ceil(bh));
+                assert_eq!(runs[0] as usize, bw.min(w) * bh.min(rows));
             }
         }
+    }
+
+    #[test]
+    fn cones_in_blocks_find_the_pixels_rays_alone_find() {
+        // A width that blocks of 4 do not divide and a last band of two
+        // rows: each pixel's hit and depth, with its rays marched in 4×4
+        // cones, against every ray alone. A pixel's sums taken from
+        // another pixel's ray would move the silhouette.
+        let (w, h) = (37, 30);
+        let mut alone = Scene::default();
+        alone.quality.cone_rays = 1;
+        let blocks = Scene::default();
+        assert_eq!(crate::march::cone_block(blocks.cone_rays()), (4, 4));
+        let (a, b) = (
+            render_frame(&alone, 0, w, h, &|| {}),
+            render_frame(&blocks, 0, w, h, &|| {}),
+        );
+        let pixel_angle = (blocks.camera.fov_degrees.to_radians() / h as Real) as f32;
+        let (mut hits, mut agree, mut near) = (0, 0, 0);
+        for i in 0..(w * h) as usize {
+            agree += (a.alpha[i] == b.alpha[i]) as usize;
+            if a.alpha[i] > 0.0 && b.alpha[i] > 0.0 {
+                hits += 1;
+                let footprint = a.depth[i] * pixel_angle;
+                near += ((a.depth[i] - b.depth[i]).abs() <= 2.0 * footprint) as usize;
+            }
+        }
+        let n = (w * h) as usize;
+        assert!(hits > n / 4, "{hits} hits of {n}");
+        assert!(agree * 100 >= n * 98, "{agree} of {n} agree on hit or miss");
+        assert!(
+            near * 100 >= hits * 95,
+            "{near} of {hits} hits within 2 footprints"
+        );
+        assert!(b.stats.primary_evaluations < a.stats.primary_evaluations);
     }
 
     #[test]
