@@ -540,26 +540,13 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
                 timed(&exe, &render_args(&scene.timeline, &out, threads, &[]))
             },
         )?;
-        let mut scaling: Vec<Row> = options
-            .threads
-            .iter()
-            .zip(timings)
-            .map(|(&threads, runs)| {
-                timing_row(
-                    Row {
-                        scene: format!("{} (scaling)", scene.name),
-                        renderer: "mandelreel".into(),
-                        threads,
-                        ..base()
-                    },
-                    &runs,
-                    Some(work),
-                    peak,
-                )
-            })
-            .collect();
-        scale_to_one_thread(&mut scaling);
-        rows.extend(scaling);
+        let runs = options.threads.iter().zip(timings);
+        rows.extend(thread_rows(
+            &format!("{} (scaling)", scene.name),
+            runs.map(|(&threads, runs)| (threads, runs, work)),
+            peak,
+            &base(),
+        ));
     }
     let first = &scenes[0];
     let (timeline, _) = loaded.swap_remove(0);
@@ -688,12 +675,12 @@ fn pool_rows(
     peak: &Peak,
     base: Row,
 ) -> Vec<Row> {
-    let mut rows: Vec<Row> = pools
+    let runs = pools
         .iter()
         .zip(walls)
         .zip(works)
         .map(|(((threads, _), walls), work)| {
-            let runs: Vec<Measurement> = walls
+            let runs = walls
                 .iter()
                 .map(|&wall_s| Measurement {
                     wall_s,
@@ -701,17 +688,29 @@ fn pool_rows(
                     exit_code: 0,
                 })
                 .collect();
-            timing_row(
-                Row {
-                    scene: scene.into(),
-                    renderer: "mandelreel".into(),
-                    threads: *threads,
-                    ..base.clone()
-                },
-                &runs,
-                Some(work),
-                peak,
-            )
+            (*threads, runs, work)
+        });
+    thread_rows(scene, runs, peak, &base)
+}
+
+/// A row of mandelreel's timings per thread count (`runs`: the count, its
+/// runs and the work they did), with their speed-ups over one thread.
+fn thread_rows<'w>(
+    scene: &str,
+    runs: impl IntoIterator<Item = (usize, Vec<Measurement>, &'w Work)>,
+    peak: &Peak,
+    base: &Row,
+) -> Vec<Row> {
+    let mut rows: Vec<Row> = runs
+        .into_iter()
+        .map(|(threads, runs, work)| {
+            let row = Row {
+                scene: scene.into(),
+                renderer: "mandelreel".into(),
+                threads,
+                ..base.clone()
+            };
+            timing_row(row, &runs, Some(work), peak)
         })
         .collect();
     scale_to_one_thread(&mut rows);
