@@ -1299,7 +1299,9 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         normal: hit.map(|(_, n)| arr(n)),
         pixel_footprint: ray.footprint(
             hit.map(|(h, _)| h.t).unwrap_or(
-                crate::math::sphere_interval(ray.origin, ray.dir, scene.quality.bounding_radius)
+                scene
+                    .quality
+                    .interval(&ray)
                     .map(|(_, far)| far)
                     .unwrap_or(0.0),
             ),

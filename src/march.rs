@@ -88,11 +88,11 @@ pub const CONE_BLOCK_ROWS: usize = 4;
 /// rays stay nearest the cone's axis; on a tie the one with fewer rows.
 pub fn cone_block(n: u32) -> (usize, usize) {
     let n = n.max(1) as usize;
-    let rows = [1, 2, 4]
-        .into_iter()
-        .filter(|&rows| n.is_multiple_of(rows))
+    // Row counts that divide a band, and `n`; 1 always does.
+    let rows = (1..=CONE_BLOCK_ROWS)
+        .filter(|&rows| CONE_BLOCK_ROWS.is_multiple_of(rows) && n.is_multiple_of(rows))
         .min_by_key(|&rows| (n / rows).pow(2) + rows * rows)
-        .unwrap_or(1);
+        .expect("one row divides everything");
     (n / rows, rows)
 }
 
@@ -198,20 +198,13 @@ pub fn march_camera_rays(
     if runs.iter().all(|&n| n == 1) {
         return march_many(rays, fractal, settings, results);
     }
-    let ConeScratch {
-        intervals,
-        free,
-        run_of,
-    } = scratch;
+    let ConeScratch { intervals, free } = scratch;
     // Each ray's way through the bounding sphere, once: the cones and the
     // rays after them both start from it.
     intervals.clear();
     intervals.extend(rays.iter().map(|ray| settings.interval(ray)));
-    // Each ray's run, and each run's rays.
-    run_of.clear();
-    for (k, &n) in runs.iter().enumerate() {
-        run_of.extend(std::iter::repeat_n(k as u32, n as usize));
-    }
+    let intervals = &*intervals;
+    // Each run's rays.
     let spans = || {
         runs.iter().scan(0, |start, &n| {
             let span = *start..*start + n as usize;
@@ -223,13 +216,11 @@ pub fn march_camera_rays(
     free.resize(runs.len(), (0.0, 0));
     let cones = spans().map(|span| ConeWalk::start(&rays[span.clone()], &intervals[span]));
     walk_many(cones, fractal, settings, |i, out| free[i] = out);
-    let walks =
-        rays.iter()
-            .zip(intervals.iter())
-            .zip(run_of.iter())
-            .map(|((ray, &interval), &run)| {
-                Marcher::start_in(ray, settings, interval, free[run as usize].0)
-            });
+    // Each ray from where its run's cone stopped, in order (`walk_many`
+    // numbers the walks as they come).
+    let walks = spans().zip(free.iter()).flat_map(|(span, &(t_free, _))| {
+        span.map(move |i| Marcher::start_in(&rays[i], settings, intervals[i], t_free))
+    });
     walk_many(walks, fractal, settings, |i, result| results[i] = result);
     // Each ray of a run takes its share of the cone's estimates (the first
     // ones one more while there is a remainder), so the frame's total and
@@ -243,23 +234,25 @@ pub fn march_camera_rays(
     }
 }
 
-/// `march_camera_rays`' scratch space: each ray's bounding-sphere interval
-/// and run; for each run, where its rays may start and what its cone cost.
+/// `march_camera_rays`' scratch space: each ray's bounding-sphere interval;
+/// for each run, where its rays may start and what its cone cost.
 #[derive(Default)]
 pub struct ConeScratch {
     intervals: Vec<Option<(Real, Real)>>,
     free: Vec<(Real, u32)>,
-    run_of: Vec<u32>,
 }
 
 /// A march along the axis of a cone that holds a run of rays: each step
 /// is the share of the estimate it trusts (`CONE_TRUST`) less how far the
-/// farthest ray can be from the axis
-/// point there, shortened by how much further the rays spread over the
-/// step, so every ray's own path to the next point stays inside the ball
-/// the estimate clears (with a fudge of 1 too). It stops where that shared step falls
-/// below a pixel footprint (the rays must go on alone), where every ray has
-/// left the bounding sphere, or, a step back, at a point inside the set.
+/// farthest ray can be from the axis point there, shortened by how much
+/// further the rays spread over the step, so every ray's own path to the
+/// next point stays inside the ball the estimate clears (with a fudge of 1
+/// too). It stops where that shared step falls below a pixel footprint (the
+/// rays must go on alone), where every ray has left the bounding sphere,
+/// or, a step back, at a point inside the set. The axis runs between the
+/// run's first and last rays, the centre of a block when those are its
+/// opposite corners, as `render::cone_blocks` orders them; any run is safe,
+/// since the spread is taken over all its rays.
 #[derive(Clone, Copy)]
 struct ConeWalk {
     /// The cone's axis, with the run's first ray's footprint.
@@ -606,8 +599,7 @@ pub fn march_by_membership(
     min_step: Real,
     max_tests: u32,
 ) -> (Option<Real>, u32) {
-    let Some((t_enter, t_exit)) = sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-    else {
+    let Some((t_enter, t_exit)) = settings.interval(ray) else {
         return (None, 0);
     };
     let at = |t: Real| ray.at(t);
@@ -943,9 +935,9 @@ mod tests {
                                 &settings,
                             );
                             for (ray, crossing) in run.iter().zip(first_crossings) {
-                                let enter =
-                                    sphere_interval(ray.origin, ray.dir, settings.bounding_radius)
-                                        .map_or(Real::INFINITY, |(enter, _)| enter);
+                                let enter = settings
+                                    .interval(ray)
+                                    .map_or(Real::INFINITY, |(enter, _)| enter);
                                 if aperture == 0.0 {
                                     advanced +=
                                         (t_free > enter + 20.0 * ray.footprint(enter)) as usize;
