@@ -535,6 +535,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
     // back and fault them in again, flushing the other cores' TLBs.
     let mut scratch = ROW_SCRATCH.take();
     let RowScratch {
+        laid_out,
         order,
         runs,
         rays,
@@ -551,9 +552,13 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
         let k = s as usize % scenes.len();
         let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
         // The band's pixels block by block (`cone_blocks`): ray i is the
-        // pixel `order[i]` of the band.
-        let block = crate::march::cone_block(scene.cone_rays());
-        cone_blocks(w, rows, block, order, runs);
+        // pixel `order[i]` of the band. Laid out again only when the shape
+        // changes (a thread's bands and samples mostly share one).
+        let layout = (w, rows, crate::march::cone_block(scene.cone_rays()));
+        if *laid_out != Some(layout) {
+            cone_blocks(w, rows, layout.2, order, runs);
+            *laid_out = Some(layout);
+        }
         rays.clear();
         rays.extend(order.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
@@ -647,7 +652,8 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
             .zip(surfaces.iter())
             .enumerate()
         {
-            let x = order[i];
+            // The pixel's offset in the band.
+            let p = order[i];
             let before = stats.stage_total();
             let c = trace(
                 scene,
@@ -669,15 +675,15 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
                 ..
             }) = at.as_ref()
             {
-                hits_row[x] += 1;
+                hits_row[p] += 1;
                 stats.hits += 1;
-                depth_row[x] = depth_row[x].min(t as f32);
+                depth_row[p] = depth_row[p].min(t as f32);
                 if let Some(row) = normal_row.as_deref_mut() {
-                    row[x] += nrm.as_vec3();
+                    row[p] += nrm.as_vec3();
                 }
                 // Only a requested albedo layer pays for the albedo.
                 if let Some(row) = albedo_row.as_deref_mut() {
-                    row[x] += scene.look.albedo(&traps);
+                    row[p] += scene.look.albedo(&traps);
                 }
                 if let Some(row) = traps_row.as_deref_mut() {
                     let v = [
@@ -687,25 +693,25 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
                         traps.planes.z as f32,
                     ];
                     for k in 0..4 {
-                        row[x][k] += v[k];
+                        row[p][k] += v[k];
                     }
                 }
             }
             debug_assert!(
                 c.is_finite(),
                 "non-finite sample at pixel ({}, {})",
-                x % w,
-                y0 + x / w
+                p % w,
+                y0 + p / w
             );
             if !c.is_finite() {
                 stats.repaired_samples += 1;
             }
             let c = finite_or_zero(c);
-            colour_row[x][0] += c.x as f64;
-            colour_row[x][1] += c.y as f64;
-            colour_row[x][2] += c.z as f64;
+            colour_row[p][0] += c.x as f64;
+            colour_row[p][1] += c.y as f64;
+            colour_row[p][2] += c.z as f64;
             stats.samples += 1;
-            spent_row[x] += stats.stage_total() - before;
+            spent_row[p] += stats.stage_total() - before;
         }
         debug_assert!(outcomes.next().is_none(), "a shadow outcome per ray walked");
     }
@@ -748,7 +754,9 @@ fn cone_blocks(
 #[derive(Default)]
 struct RowScratch {
     /// Each camera ray's pixel in the band, and the blocks' sizes
-    /// (`cone_blocks`).
+    /// (`cone_blocks`), for the width, rows and block shape they were laid
+    /// out for.
+    laid_out: Option<(usize, usize, (usize, usize))>,
     order: Vec<usize>,
     runs: Vec<u32>,
     rays: Vec<crate::march::Ray>,
