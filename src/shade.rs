@@ -400,11 +400,10 @@ pub fn occlusion(
     t: Real,
     footprint: Real,
 ) -> (f32, u64) {
-    let mut found = (f32::NAN, 0);
-    occlusions(fractal, ao, [(0, point, normal, t, footprint)], |_, out| {
-        found = out
-    });
-    found
+    // One walk alone, estimate by estimate: the reference `occlusions`'
+    // lanes are held to.
+    let walk = OcclusionWalk::start(ao, 0, point, normal, t, footprint);
+    crate::march::walk_one(Ok(walk), fractal, &MarchSettings::default()).1
 }
 
 /// `occlusion` at many surface points (index, point, normal, distance from
