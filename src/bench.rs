@@ -424,6 +424,9 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     let all_threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let scenes = scenes(&options.scenes, &options.fract_dir)?;
     let scratch = tempfile::tempdir().map_err(|e| Error::io(Path::new("temp"), e))?;
+    // The in-process pools, started before any timing so that a size the
+    // system will not start stops the bench at once.
+    let pools = thread_pools(&options.threads)?;
     let base = || Row {
         machine: options.machine.clone(),
         ..Row::default()
@@ -553,11 +556,11 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
 
     // The same frame rendered in this process on pools of each size: the
     // renderer's own scaling, without start-up and file writing.
-    rows.extend(render_only_rows(first, &timeline, options, base())?);
+    rows.extend(render_only_rows(first, &timeline, &pools, options, base()));
 
     // The kernel alone, on pools of each size: analytic estimates at points
     // where marching spends its time.
-    rows.extend(kernel_rows(&timeline, options, base())?);
+    rows.extend(kernel_rows(&timeline, &pools, options, base()));
 
     // Peak memory of a big EXR frame against its output buffers.
     if let Some((w, h)) = options.memory_size {
@@ -602,17 +605,18 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// Frame 0 of `timeline` rendered in this process on a thread pool of each
-/// size in `options.threads`, alternating, medians over `options.runs`.
+/// Frame 0 of `timeline` rendered in this process on each of `pools`
+/// (`thread_pools` of `options.threads`), alternating, medians over
+/// `options.runs`.
 fn render_only_rows(
     scene: &BenchScene,
     timeline: &Timeline,
+    pools: &[(usize, rayon::ThreadPool)],
     options: &Options,
     base: Row,
-) -> Result<Vec<Row>> {
+) -> Vec<Row> {
     let frame = timeline.scene_at(0);
     let (w, h) = (timeline.width, timeline.height);
-    let pools = thread_pools(&options.threads)?;
     // Each pool's own counts, so the rows can show they do not depend on it.
     let mut counts = vec![FrameStats::default(); pools.len()];
     let walls = alternate(
@@ -637,14 +641,14 @@ fn render_only_rows(
             stats,
         })
         .collect();
-    Ok(pool_rows(
+    pool_rows(
         &format!("{} (render only)", scene.name),
-        &pools,
+        pools,
         walls,
         &works,
         &options.peak,
         base,
-    ))
+    )
 }
 
 /// A rayon pool of each size in `threads`, in that order; an error names
@@ -656,9 +660,11 @@ fn thread_pools(threads: &[usize]) -> Result<Vec<(usize, rayon::ThreadPool)>> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(t)
                 .build()
-                .map_err(|e| Error::Usage {
-                    option: "--threads".into(),
-                    message: format!("could not start a pool of {t} threads: {e}"),
+                .map_err(|e| {
+                    Error::usage(
+                        "--threads",
+                        format!("could not start a pool of {t} threads: {e}"),
+                    )
                 })?;
             Ok((t, pool))
         })
@@ -909,10 +915,14 @@ fn depth_rows(
 /// marcher spends most of its estimates), on a pool of each size in
 /// `options.threads`, alternating: the kernel's own thread scaling, with no
 /// start-up, scheduling of rows or file writing in it.
-pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Result<Vec<Row>> {
+pub fn kernel_rows(
+    timeline: &Timeline,
+    pools: &[(usize, rayon::ThreadPool)],
+    options: &Options,
+    base: Row,
+) -> Vec<Row> {
     let fractal = timeline.scene_at(0).fractal;
     let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
-    let pools = thread_pools(&options.threads)?;
     // One pass over the points on a pool: its orbit iterations.
     let pass = |pool: &rayon::ThreadPool| {
         pool.install(|| {
@@ -943,7 +953,7 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Result<
         })
     };
     let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
-        return Ok(Vec::new());
+        return Vec::new();
     };
     // Every pool warmed once (its threads started, the points in cache);
     // then samples of enough passes to last 0.2 s each on the widest pool
@@ -982,14 +992,7 @@ pub fn kernel_rows(timeline: &Timeline, options: &Options, base: Row) -> Result<
             },
         })
         .collect();
-    Ok(pool_rows(
-        "kernel",
-        &pools,
-        walls,
-        &works,
-        &options.peak,
-        base,
-    ))
+    pool_rows("kernel", pools, walls, &works, &options.peak, base)
 }
 
 /// The rows as CSV, one header line first.
