@@ -330,6 +330,22 @@ fn alternate<T>(
     Ok(timings)
 }
 
+/// `alternate` for work done in this process: `work(i)` for candidate i,
+/// each candidate's wall times in seconds.
+fn timed_in_process(runs: usize, contenders: usize, mut work: impl FnMut(usize)) -> Vec<Vec<f64>> {
+    alternate(
+        runs,
+        contenders,
+        |_| {},
+        |i| -> Result<f64> {
+            let start = Instant::now();
+            work(i);
+            Ok(start.elapsed().as_secs_f64())
+        },
+    )
+    .expect("an in-process timing has no error to return")
+}
+
 fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
@@ -562,6 +578,11 @@ pub fn run(options: &Options) -> Result<Vec<Row>> {
     // where marching spends its time.
     rows.extend(kernel_rows(&timeline, &pools, options, base()));
 
+    // The machine's own ceiling on the same pools: fused multiply-adds in
+    // registers, nothing shared.
+    log(options.quiet, "ceiling: FMA loop");
+    rows.extend(ceiling_rows(&pools, options, base()));
+
     // Peak memory of a big EXR frame against its output buffers.
     if let Some((w, h)) = options.memory_size {
         log(options.quiet, &format!("memory: {w}x{h} EXR"));
@@ -619,20 +640,12 @@ fn render_only_rows(
     let (w, h) = (timeline.width, timeline.height);
     // Each pool's own counts, so the rows can show they do not depend on it.
     let mut counts = vec![FrameStats::default(); pools.len()];
-    let walls = alternate(
-        options.runs,
-        pools.len(),
-        |_| {},
-        |i| -> Result<f64> {
-            let start = Instant::now();
-            let film = pools[i]
-                .1
-                .install(|| crate::render::render_frame(&frame, 0, w, h, &|| {}));
-            counts[i] = film.stats;
-            Ok(start.elapsed().as_secs_f64())
-        },
-    )
-    .expect("an in-process timing has no error to return");
+    let walls = timed_in_process(options.runs, pools.len(), |i| {
+        let film = pools[i]
+            .1
+            .install(|| crate::render::render_frame(&frame, 0, w, h, &|| {}));
+        counts[i] = film.stats;
+    });
     let works: Vec<Work> = counts
         .into_iter()
         .map(|stats| Work {
@@ -967,19 +980,11 @@ pub fn kernel_rows(
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
         .ceil()
         .max(1.0) as u64;
-    let walls = alternate(
-        options.runs,
-        pools.len(),
-        |_| {},
-        |i| -> Result<f64> {
-            let start = Instant::now();
-            for _ in 0..passes {
-                pass(&pools[i].1);
-            }
-            Ok(start.elapsed().as_secs_f64())
-        },
-    )
-    .expect("an in-process timing has no error to return");
+    let walls = timed_in_process(options.runs, pools.len(), |i| {
+        for _ in 0..passes {
+            pass(&pools[i].1);
+        }
+    });
     let works: Vec<Work> = iterations_per_pass
         .iter()
         .map(|&iterations| Work {
@@ -993,6 +998,93 @@ pub fn kernel_rows(
         })
         .collect();
     pool_rows("kernel", pools, walls, &works, &options.peak, base)
+}
+
+/// The scene name of the machine's own ceiling rows (`ceiling_rows`).
+pub const CEILING: &str = "fma ceiling";
+
+/// Independent chains in the ceiling loop: more than the 8 that two FMA
+/// units of 4 cycles' latency need to stay busy, few enough to stay in
+/// registers (16 with AVX2, 32 with AVX-512).
+const CEILING_CHAINS: usize = 12;
+
+/// The multiplier of each chain's `acc ← acc·m + 1`: below 1, so every
+/// chain tends to 1 / (1 − m) = 1024 and stays a normal number.
+const CEILING_FACTOR: f64 = 1.0 - 1.0 / 1024.0;
+
+/// `rounds` rounds of `CEILING_CHAINS` fused multiply-adds on the widest
+/// f64 vectors this processor has (pulp's choice, as the kernel's), with
+/// nothing but registers: the most floating-point work a core of this
+/// machine does, measured rather than assumed. Returns the sum of every
+/// chain's lanes (each `(1 − mʳ) / (1 − m)`) and the flops done (2 per
+/// lane per fused multiply-add).
+pub fn fma_ceiling(rounds: u64) -> (f64, u64) {
+    pulp::Arch::new().dispatch(Ceiling { rounds })
+}
+
+struct Ceiling {
+    rounds: u64,
+}
+
+impl pulp::WithSimd for Ceiling {
+    type Output = (f64, u64);
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) -> (f64, u64) {
+        let (m, one) = (simd.splat_f64s(CEILING_FACTOR), simd.splat_f64s(1.0));
+        let mut chains = [simd.splat_f64s(0.0); CEILING_CHAINS];
+        for _ in 0..std::hint::black_box(self.rounds) {
+            for c in &mut chains {
+                *c = simd.mul_add_f64s(*c, m, one);
+            }
+        }
+        let sum = chains.iter().map(|&c| simd.reduce_sum_f64s(c)).sum();
+        let flops = self.rounds * (CEILING_CHAINS * S::F64_LANES * 2) as u64;
+        (sum, flops)
+    }
+}
+
+/// The machine's ceiling on each of `pools`: `fma_ceiling` on every thread
+/// of the pool at once, the same rounds shared among them, alternating
+/// between pools, medians over `options.runs` samples of about 0.2 s on
+/// the widest pool. Each row's GFLOP/s is what the loop did, its share of
+/// the peak the nominal peak of its threads, its speed-up over the
+/// one-thread pool the machine's own thread scaling: what the kernel's and
+/// the renders' figures can be held against.
+pub fn ceiling_rows(
+    pools: &[(usize, rayon::ThreadPool)],
+    options: &Options,
+    base: Row,
+) -> Vec<Row> {
+    // `rounds` shared among the pool's threads: the flops done.
+    let pass = |pool: &rayon::ThreadPool, rounds: u64| -> u64 {
+        let share = rounds.div_ceil(pool.current_num_threads() as u64);
+        let done = pool.broadcast(|_| fma_ceiling(share));
+        std::hint::black_box(done.iter().map(|d| d.0).sum::<f64>());
+        done.iter().map(|d| d.1).sum()
+    };
+    let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
+        return Vec::new();
+    };
+    for (_, pool) in pools {
+        pass(pool, 1 << 16);
+    }
+    let trial = 1 << 22;
+    let start = Instant::now();
+    pass(widest, trial);
+    let rounds = (trial as f64 * 0.2 / start.elapsed().as_secs_f64().max(1e-6)).ceil() as u64;
+    let mut flops = vec![0; pools.len()];
+    let walls = timed_in_process(options.runs, pools.len(), |i| {
+        flops[i] = pass(&pools[i].1, rounds);
+    });
+    let works = vec![Work::default(); pools.len()];
+    let mut rows = pool_rows(CEILING, pools, walls, &works, &options.peak, base);
+    for (row, flops) in rows.iter_mut().zip(flops) {
+        row.gflops = flops as f64 / row.median_s.max(1e-9) / 1e9;
+        row.peak_gflops = options.peak.gflops_for(row.threads);
+        row.fraction_of_peak = row.gflops / row.peak_gflops.max(1e-9);
+    }
+    rows
 }
 
 /// The rows as CSV, one header line first.
@@ -1019,6 +1111,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
     let is_scene = |r: &Row| {
         r.renderer == "mandelreel"
             && r.scene != "kernel"
+            && r.scene != CEILING
             && !r.scene.contains('@')
             && !r.scene.ends_with("(scaling)")
             && !r.scene.ends_with("(render only)")
@@ -1095,6 +1188,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         }
         md.push('\n');
     }
+    md.push_str(&ceiling_markdown(rows));
     for r in rows
         .iter()
         .filter(|r| r.scene.contains('@') && r.depth_error_mean_px.is_none())
@@ -1112,6 +1206,51 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         );
     }
     md.push_str(&depth_markdown(rows));
+    md
+}
+
+/// The ceiling rows as a paragraph, with the kernel's share of the
+/// ceiling on as many threads; nothing without them.
+fn ceiling_markdown(rows: &[Row]) -> String {
+    let ceiling: Vec<&Row> = rows.iter().filter(|r| r.scene == CEILING).collect();
+    if ceiling.is_empty() {
+        return String::new();
+    }
+    let each: Vec<String> = ceiling
+        .iter()
+        .map(|c| {
+            let noun = if c.threads == 1 { "thread" } else { "threads" };
+            let cores = if c.threads == 1 { "core" } else { "cores" };
+            let mut text = format!(
+                "{} {noun} {:.1} GFLOP/s ({:.2}× the nominal peak of {} {cores}",
+                c.threads, c.gflops, c.fraction_of_peak, c.threads
+            );
+            if c.scaling_vs_one_thread > 0.0 && c.threads != 1 {
+                let _ = write!(text, ", {:.2}× one thread", c.scaling_vs_one_thread);
+            }
+            text + ")"
+        })
+        .collect();
+    let mut md = format!(
+        "\nMachine ceiling, measured (the same pools; {CEILING_CHAINS} independent chains of fused \
+multiply-adds on f64 vectors, in registers, nothing shared): {}.",
+        each.join(", ")
+    );
+    let widest = ceiling.iter().max_by_key(|c| c.threads);
+    let kernel = widest.and_then(|c| {
+        rows.iter()
+            .find(|k| k.scene == "kernel" && k.threads == c.threads)
+            .map(|k| (k, c))
+    });
+    if let Some((k, c)) = kernel {
+        let _ = write!(
+            md,
+            " The kernel alone on {} threads does {:.1}% of the ceiling's flops per second.",
+            k.threads,
+            100.0 * k.gflops / c.gflops.max(1e-9)
+        );
+    }
+    md.push('\n');
     md
 }
 
@@ -1293,6 +1432,37 @@ mod tests {
         assert_eq!(p.gflops_for(1), p.gflops() / 2.0);
         assert_eq!(p.gflops_for(8), p.gflops());
         assert_eq!(default_machine_name(&p), "2core-test");
+    }
+
+    #[test]
+    fn the_ceiling_loop_does_the_work_it_counts() {
+        for rounds in [0, 1, 7, 5000] {
+            let (sum, flops) = fma_ceiling(rounds);
+            // Two flops per lane of each chain's fused multiply-add, each round.
+            let per_round = (CEILING_CHAINS * 2) as u64;
+            let lanes = if rounds == 0 {
+                1
+            } else {
+                flops / (rounds * per_round)
+            };
+            assert_eq!(flops, rounds * per_round * lanes);
+            assert!([1, 2, 4, 8].contains(&lanes), "{lanes} lanes");
+            // Each lane of each chain sums the geometric series 1 + m + … + mʳ⁻¹.
+            let m = CEILING_FACTOR;
+            let lane = (1.0 - m.powi(rounds as i32)) / (1.0 - m);
+            let expected = lane * (CEILING_CHAINS as u64 * lanes) as f64;
+            let tolerance = if rounds == 0 { 0.0 } else { 1e-9 * expected };
+            assert!(
+                (sum - expected).abs() <= tolerance,
+                "{rounds}: {sum} vs {expected}"
+            );
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // The loop runs on vectors as wide as the peak assumes.
+            let (_, flops) = fma_ceiling(1);
+            assert!(flops / (CEILING_CHAINS as u64 * 2) >= 4);
+        }
     }
 
     #[test]

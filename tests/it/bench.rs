@@ -178,6 +178,29 @@ fn bench_writes_results_with_counts_that_match_a_render() {
         "{csv}"
     );
     assert!(md.contains("Its speed-up over one thread"), "{md}");
+    // The machine's ceiling on the same pools: its flops over its median,
+    // against the same nominal peak, scaled to its own one-thread row; a
+    // loop of nothing but fused multiply-adds outruns the kernel.
+    let ceiling_one = row("fma ceiling", "mandelreel", "1");
+    let ceiling = row("fma ceiling", "mandelreel", "2");
+    assert_eq!(num(ceiling_one, "scaling_vs_one_thread"), 1.0);
+    let expected = num(ceiling_one, "median_s") / num(ceiling, "median_s");
+    assert!((num(ceiling, "scaling_vs_one_thread") / expected - 1.0).abs() < 1e-9);
+    for (c, k) in [(ceiling_one, kernel_one), (ceiling, kernel)] {
+        assert!(num(c, "gflops") > num(k, "gflops"), "{csv}");
+        let share = num(c, "gflops") / num(c, "peak_gflops");
+        assert!((num(c, "fraction_of_peak") / share - 1.0).abs() < 1e-9);
+        assert_eq!(num(c, "peak_gflops"), num(k, "peak_gflops"));
+    }
+    let kernel_share = 100.0 * num(kernel, "gflops") / num(ceiling, "gflops");
+    assert!(
+        md.contains(&format!(
+            "The kernel alone on 2 threads does {kernel_share:.1}% of the ceiling"
+        )),
+        "{md}"
+    );
+    // Only the ceiling rows and the kernel's share of them name the ceiling.
+    assert!(!md.contains("| fma ceiling |"), "{md}");
     // The memory row: a peak RSS against the output buffers (64×36 pixels ×
     // 24 bytes: RGB, alpha, depth and the estimate count, 4 bytes each).
     let memory = rows
