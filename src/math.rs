@@ -525,6 +525,8 @@ pub struct SrgbBytes {
 
 /// Below this every value codes to 0 (12.92 · 2⁻¹³ · 255 < 0.5).
 const SRGB_LOWEST: f32 = 1.0 / 8192.0;
+/// The float just below 1: the top of the last bucket.
+const SRGB_BELOW_ONE: f32 = f32::from_bits(1.0f32.to_bits() - 1);
 /// Mantissa bits in the bucket key: 128 buckets per octave.
 const SRGB_KEY_SHIFT: u32 = f32::MANTISSA_DIGITS - 1 - 7;
 const SRGB_FIRST_KEY: u32 = SRGB_LOWEST.to_bits() >> SRGB_KEY_SHIFT;
@@ -578,12 +580,12 @@ impl SrgbBytes {
     /// anything at or below 0, 255 from 1 up.
     #[inline]
     pub fn byte(&self, x: f32) -> u8 {
-        if !x.is_finite() || x < SRGB_LOWEST {
-            return 0;
-        }
-        if x >= 1.0 {
-            return 255;
-        }
+        // Without branches (a frame's values come in no order a predictor
+        // could follow): NaN and infinities become 0; the clamp takes all
+        // below the lowest value to it, whose code is 0 too, and 1 and up to
+        // the float just below 1, whose code is 255.
+        let x = if x.is_finite() { x } else { 0.0 };
+        let x = x.clamp(SRGB_LOWEST, SRGB_BELOW_ONE);
         let i = ((x.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
         self.base[i] + (x >= self.next[i]) as u8
     }
