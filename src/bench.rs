@@ -13,7 +13,7 @@
 
 use crate::error::{Error, Result};
 use crate::math::Real;
-use crate::render::{render_frame_in_time, Film, FrameStats, Layers};
+use crate::render::{render_frame_into, Film, FrameStats, Layers};
 use crate::timeline::Timeline;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -260,9 +260,11 @@ pub struct Work {
 /// Renders every frame of `timeline` at `size` in this process, keeping only the counts.
 pub fn count_work(timeline: &Timeline, size: (u32, u32)) -> Work {
     let mut stats = FrameStats::default();
+    let mut film = Film::default();
     for frame in 0..timeline.frame_count {
         let scenes = timeline.scenes_for_frame(frame);
-        let film = render_frame_in_time(&scenes, frame, size.0, size.1, Layers::default(), &|| {});
+        let (w, h) = size;
+        render_frame_into(&mut film, &scenes, frame, w, h, Layers::default(), &|| {});
         stats = stats + film.stats;
     }
     Work {

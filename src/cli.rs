@@ -547,13 +547,15 @@ impl Plan {
     }
 
     /// Renders one frame and writes every format. A frame of one sample per
-    /// pixel is rendered band by band (`render_frame_in_time`), without the
+    /// pixel is rendered band by band (`render_frame_into`), without the
     /// whole frame's running sums. Others run in waves of samples, saving
     /// their accumulation every `checkpoint_every` and continuing from a
     /// saved one for the same inputs; the result is bit-identical either way.
-    /// Returns the stats and the samples resumed from.
+    /// A one-sample frame renders into `film`, whose buffers the frames of a
+    /// run share. Returns the stats and the samples resumed from.
     fn render_frame(
         &self,
+        film: &mut crate::render::Film,
         frame: u32,
         scenes: &[crate::scene::Scene],
         hash: &str,
@@ -564,7 +566,8 @@ impl Plan {
         let layers = self.layers();
         if n == 1 {
             // One sample is one wave: there is never a checkpoint to resume.
-            let film = crate::render::render_frame_in_time(
+            crate::render::render_frame_into(
+                film,
                 scenes,
                 frame,
                 self.width,
@@ -572,7 +575,7 @@ impl Plan {
                 layers,
                 on_row,
             );
-            return self.write_film(frame, &film, hash).map(|stats| (stats, 0));
+            return self.write_film(frame, film, hash).map(|stats| (stats, 0));
         }
         let checkpoint = output::checkpoint_path(&self.out_dir, frame);
         let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
@@ -773,6 +776,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let started = Instant::now();
     let mut totals = FrameStats::default();
     let mut rendered = 0usize;
+    let mut film = crate::render::Film::default();
     let mut render_one = |frame: u32,
                           scene: &[crate::scene::Scene],
                           hash: &str|
@@ -783,10 +787,14 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let n = scene[0].samples_per_pixel.max(1);
         current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
-        let (stats, resumed) =
-            plan.render_frame(frame, scene, hash, args.checkpoint_seconds, &|| {
-                current.inc(1)
-            })?;
+        let (stats, resumed) = plan.render_frame(
+            &mut film,
+            frame,
+            scene,
+            hash,
+            args.checkpoint_seconds,
+            &|| current.inc(1),
+        )?;
         if resumed > 0 && !args.quiet {
             say(format!(
                 "frame {frame}: resumed from a checkpoint at {resumed} of {n} samples per pixel"
@@ -1221,8 +1229,10 @@ fn info(path: &Path) -> anyhow::Result<()> {
         })
         .collect();
     let layers = crate::render::Layers::default();
-    let with = crate::render::render_frame_in_time(&scenes, 0, probe_w, probe_h, layers, &|| {});
-    let without = crate::render::render_frame_in_time(&plain, 0, probe_w, probe_h, layers, &|| {});
+    let [mut with, mut without] = [(); 2].map(|_| crate::render::Film::default());
+    for (film, scenes) in [(&mut with, &scenes), (&mut without, &plain)] {
+        crate::render::render_frame_into(film, scenes, 0, probe_w, probe_h, layers, &|| {});
+    }
     out!(
         "cost:     frame 0 at {probe_w}x{probe_h}: {} estimates, {:.2}x the same frame without effects ({})",
         with.stats.de_evaluations,

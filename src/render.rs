@@ -18,7 +18,7 @@ use rayon::prelude::*;
 pub const BACKGROUND_DEPTH: f32 = 1.0e10;
 
 /// A rendered frame: linear colour, fractal coverage and camera distance per pixel.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
@@ -41,20 +41,34 @@ pub struct Film {
 impl Film {
     /// A film of zeros with the layers asked for (see `filled`).
     fn blank(width: u32, height: u32, layers: Layers) -> Film {
+        let mut film = Film::default();
+        film.clear(width, height, layers);
+        film
+    }
+
+    /// This film made blank at `width`×`height` with the layers asked for,
+    /// in the buffers it already has: a sequence's frames reuse pages
+    /// already mapped, where a new film's first touch of each page costs a
+    /// fault (about 2 000 at 640×480, some 5% of such a frame on one thread).
+    fn clear(&mut self, width: u32, height: u32, layers: Layers) {
         let pixels = width as usize * height as usize;
-        let layer = |on: bool| on.then(|| filled(pixels, Vec3::ZERO));
-        Film {
-            width,
-            height,
-            colour: filled(pixels, Vec3::ZERO),
-            alpha: filled(pixels, 0.0),
-            depth: filled(pixels, 0.0),
-            evaluations: filled(pixels, 0),
-            normal: layer(layers.normal),
-            albedo: layer(layers.albedo),
-            traps: layers.traps.then(|| filled(pixels, [0.0; 4])),
-            stats: FrameStats::default(),
+        fn layer<T: Clone>(v: &mut Option<Vec<T>>, on: bool, n: usize, value: T) {
+            if on {
+                filled(v.get_or_insert_with(Vec::new), n, value)
+            } else {
+                *v = None
+            }
         }
+        self.width = width;
+        self.height = height;
+        filled(&mut self.colour, pixels, Vec3::ZERO);
+        filled(&mut self.alpha, pixels, 0.0);
+        filled(&mut self.depth, pixels, 0.0);
+        filled(&mut self.evaluations, pixels, 0);
+        layer(&mut self.normal, layers.normal, pixels, Vec3::ZERO);
+        layer(&mut self.albedo, layers.albedo, pixels, Vec3::ZERO);
+        layer(&mut self.traps, layers.traps, pixels, [0.0; 4]);
+        self.stats = FrameStats::default();
     }
 
     /// Bytes per pixel of the buffers every film holds (colour, alpha,
@@ -168,29 +182,36 @@ pub fn render_frame(
     height: u32,
     on_row: &(dyn Fn() + Sync),
 ) -> Film {
-    render_frame_in_time(
+    let mut film = Film::default();
+    render_frame_into(
+        &mut film,
         std::slice::from_ref(scene),
         frame_index,
         width,
         height,
         Layers::default(),
         on_row,
-    )
+    );
+    film
 }
 
-/// Renders a frame whose samples see `scenes` in turn (sample s the scene
-/// s mod len): one scene for a still instant, one per sample for motion blur.
-pub fn render_frame_in_time(
+/// Renders into `film` a frame whose samples see `scenes` in turn (sample
+/// s the scene s mod len): one scene for a still instant, one per sample
+/// for motion blur. The film's buffers are reused (see `Film::clear`), so
+/// a sequence's frames can share one; the pixels are those of a new film,
+/// bit for bit.
+pub fn render_frame_into(
+    film: &mut Film,
     scenes: &[Scene],
     frame_index: u32,
     width: u32,
     height: u32,
     layers: Layers,
     on_row: &(dyn Fn() + Sync),
-) -> Film {
+) {
     let n = scenes[0].samples_per_pixel.max(1);
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
-    let mut film = Film::blank(width, height, layers);
+    film.clear(width, height, layers);
     // Every band of rows renders in parallel into this thread's one-band
     // sums (the running sums, f64 colour and counters, exist for a band at
     // a time, not the frame) and is finished straight into its place in the
@@ -209,17 +230,16 @@ pub fn render_frame_in_time(
         })
         // `+` keeps the larger per-pixel maximum.
         .reduce(FrameStats::default, |a, b| a + b);
-    film
 }
 
-/// `n` copies of `value`, every one written rather than left to the
-/// allocator's zero pages: a zero page first read and then written is
-/// copied on write, and each copy flushes the TLB of every other core
-/// running the frame.
-fn filled<T: Clone>(n: usize, value: T) -> Vec<T> {
-    let mut v = Vec::with_capacity(n);
+/// `v` made `n` copies of `value` (its buffer kept where big enough), every
+/// one written rather than left to the allocator's zero pages: a zero page
+/// first read and then written is copied on write, and each copy flushes
+/// the TLB of every other core running the frame.
+fn filled<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+    v.clear();
+    v.reserve_exact(n);
     v.resize(n, value);
-    v
 }
 
 /// A frame in progress: per-pixel running sums over the samples done so far,
@@ -776,7 +796,7 @@ struct RowScratch {
 
 thread_local! {
     static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
-    /// One band's sums for `render_frame_in_time`, kept like `ROW_SCRATCH`.
+    /// One band's sums for `render_frame_into`, kept like `ROW_SCRATCH`.
     static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
 }
 
@@ -869,6 +889,48 @@ mod tests {
             .map(|&(x, y)| ((x * 2.0) as u8, (y * 2.0) as u8))
             .collect();
         assert_eq!(quadrants.len(), 4);
+    }
+
+    #[test]
+    fn a_reused_film_renders_each_frame_as_a_new_one_would() {
+        // The film first holds another view at another size with every
+        // layer, so anything left of it would show.
+        let mut other = Scene::default();
+        other.camera.position = crate::math::DVec3::new(0.4, -1.9, 1.2);
+        let scene = Scene::default();
+        let every = Layers {
+            normal: true,
+            albedo: true,
+            traps: true,
+        };
+        let mut film = Film::default();
+        render_frame_into(&mut film, &[other], 0, 44, 33, every, &|| {});
+        let normal_only = Layers {
+            normal: true,
+            ..Layers::default()
+        };
+        for (w, h, layers) in [
+            (32, 24, Layers::default()),
+            (40, 30, every),
+            (48, 20, normal_only),
+            (16, 12, every),
+        ] {
+            render_frame_into(
+                &mut film,
+                std::slice::from_ref(&scene),
+                0,
+                w,
+                h,
+                layers,
+                &|| {},
+            );
+            let mut new = Film::default();
+            let one = std::slice::from_ref(&scene);
+            render_frame_into(&mut new, one, 0, w, h, layers, &|| {});
+            assert!(film == new, "{w}x{h} {layers:?}");
+            assert_eq!(film.colour.len(), (w * h) as usize);
+            assert_eq!(film.normal.is_some(), layers.normal);
+        }
     }
 
     #[test]
@@ -1112,7 +1174,8 @@ mod tests {
         let scenes = std::slice::from_ref(&scene);
         // Enough rows that every thread takes several.
         let (w, h) = (12, 130);
-        let at_once = render_frame_in_time(scenes, 3, w, h, layers, &|| {});
+        let mut at_once = Film::default();
+        render_frame_into(&mut at_once, scenes, 3, w, h, layers, &|| {});
         let mut acc = Accumulation::new(w, h, layers);
         for until in [1, 2, 5, 6] {
             render_samples(scenes, 3, &mut acc, until, &|| {});
