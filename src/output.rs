@@ -272,6 +272,10 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
     // fdeflate: several times faster than the default level for a few
     // per cent more bytes; encoding is the one serial stage of a frame.
     encoder.set_compression(png::Compression::Fast);
+    // Paeth on every row rather than the adaptive choice among five: on
+    // our frames both faster (640×480: 0.99 → 0.77 ms) and smaller (1–6%
+    // on S1 and frames of zoom, effects and julia_morph; one-off).
+    encoder.set_filter(png::Filter::Paeth);
     let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
     // The sRGB codes come from a table (a powf per channel cost as much as
     // a twentieth of a small frame), a row at a time straight into place on
