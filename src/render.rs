@@ -39,35 +39,40 @@ pub struct Film {
 }
 
 impl Film {
-    /// A film of zeros with the layers asked for (see `filled`).
+    /// A film of `width`×`height` with the layers asked for, for
+    /// `finish_pixels` to fill (see `Film::prepare`).
     fn blank(width: u32, height: u32, layers: Layers) -> Film {
         let mut film = Film::default();
-        film.clear(width, height, layers);
+        film.prepare(width, height, layers);
         film
     }
 
-    /// This film made blank at `width`×`height` with the layers asked for,
-    /// in the buffers it already has: a sequence's frames reuse pages
-    /// already mapped, where a new film's first touch of each page costs a
-    /// fault (about 2 000 at 640×480, some 5% of such a frame on one thread).
-    fn clear(&mut self, width: u32, height: u32, layers: Layers) {
+    /// This film sized to `width`×`height` with the layers asked for, in
+    /// the buffers it already has where they are big enough, for
+    /// `finish_pixels` to fill: it writes every element of every buffer,
+    /// so no pass clears them first. A sequence's frames thus reuse pages
+    /// already mapped, and a new buffer comes zeroed from the allocator as
+    /// untouched pages, which the threads that finish the bands fault in
+    /// (on one thread first, as a new film once was, that took 3.1–3.4 ms
+    /// of a 640×480 frame; some 1 ms to clear a reused one).
+    fn prepare(&mut self, width: u32, height: u32, layers: Layers) {
         let pixels = width as usize * height as usize;
-        fn layer<T: Clone>(v: &mut Option<Vec<T>>, on: bool, n: usize, value: T) {
+        fn layer<T: bytemuck::Zeroable + Clone>(v: &mut Option<Vec<T>>, on: bool, n: usize) {
             if on {
-                filled(v.get_or_insert_with(Vec::new), n, value)
+                sized(v.get_or_insert_with(Vec::new), n)
             } else {
                 *v = None
             }
         }
         self.width = width;
         self.height = height;
-        filled(&mut self.colour, pixels, Vec3::ZERO);
-        filled(&mut self.alpha, pixels, 0.0);
-        filled(&mut self.depth, pixels, 0.0);
-        filled(&mut self.evaluations, pixels, 0);
-        layer(&mut self.normal, layers.normal, pixels, Vec3::ZERO);
-        layer(&mut self.albedo, layers.albedo, pixels, Vec3::ZERO);
-        layer(&mut self.traps, layers.traps, pixels, [0.0; 4]);
+        sized(&mut self.colour, pixels);
+        sized(&mut self.alpha, pixels);
+        sized(&mut self.depth, pixels);
+        sized(&mut self.evaluations, pixels);
+        layer(&mut self.normal, layers.normal, pixels);
+        layer(&mut self.albedo, layers.albedo, pixels);
+        layer(&mut self.traps, layers.traps, pixels);
         self.stats = FrameStats::default();
     }
 
@@ -197,7 +202,7 @@ pub fn render_frame(
 
 /// Renders into `film` a frame whose samples see `scenes` in turn (sample
 /// s the scene s mod len): one scene for a still instant, one per sample
-/// for motion blur. The film's buffers are reused (see `Film::clear`), so
+/// for motion blur. The film's buffers are reused (see `Film::prepare`), so
 /// a sequence's frames can share one; the pixels are those of a new film,
 /// bit for bit.
 pub fn render_frame_into(
@@ -211,7 +216,7 @@ pub fn render_frame_into(
 ) {
     let n = scenes[0].samples_per_pixel.max(1);
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
-    film.clear(width, height, layers);
+    film.prepare(width, height, layers);
     // Every band of rows renders in parallel into this thread's one-band
     // sums (the running sums, f64 colour and counters, exist for a band at
     // a time, not the frame) and is finished straight into its place in the
@@ -232,14 +237,15 @@ pub fn render_frame_into(
         .reduce(FrameStats::default, |a, b| a + b);
 }
 
-/// `v` made `n` copies of `value` (its buffer kept where big enough), every
-/// one written rather than left to the allocator's zero pages: a zero page
-/// first read and then written is copied on write, and each copy flushes
-/// the TLB of every other core running the frame.
-fn filled<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
-    v.clear();
-    v.reserve_exact(n);
-    v.resize(n, value);
+/// `v` at `n` elements: kept, with whatever values it holds, where its
+/// buffer is big enough; else a new one of zeros from the allocator, whose
+/// untouched pages are faulted in by the first write to each.
+fn sized<T: bytemuck::Zeroable + Clone>(v: &mut Vec<T>, n: usize) {
+    if v.capacity() < n {
+        *v = bytemuck::zeroed_vec(n);
+    } else {
+        v.resize(n, T::zeroed());
+    }
 }
 
 /// A frame in progress: per-pixel running sums over the samples done so far,
@@ -263,7 +269,11 @@ pub struct Accumulation {
 }
 
 impl Accumulation {
-    /// Empty sums for `height` rows (see `filled`).
+    /// Empty sums for `height` rows, every element written rather than left
+    /// to the allocator's zero pages: sums are read before they are
+    /// written, and a zero page first read and then written is copied on
+    /// write, each copy flushing the TLB of every other core running the
+    /// frame.
     pub fn new(width: u32, height: u32, layers: Layers) -> Accumulation {
         let mut acc = Accumulation::default();
         acc.reset(width, height, layers);
@@ -894,7 +904,7 @@ mod tests {
     #[test]
     fn a_reused_film_renders_each_frame_as_a_new_one_would() {
         // The film first holds another view at another size with every
-        // layer, so anything left of it would show.
+        // layer, then values no frame gives, so anything left would show.
         let mut other = Scene::default();
         other.camera.position = crate::math::DVec3::new(0.4, -1.9, 1.2);
         let scene = Scene::default();
@@ -915,6 +925,18 @@ mod tests {
             (48, 20, normal_only),
             (16, 12, every),
         ] {
+            // Values no frame could give, in every element the film holds,
+            // so a pixel finishing missed would show whatever it missed.
+            film.colour.fill(Vec3::splat(-7.0));
+            film.alpha.fill(-7.0);
+            film.depth.fill(-7.0);
+            film.evaluations.fill(7_777_777);
+            for layer in [&mut film.normal, &mut film.albedo].into_iter().flatten() {
+                layer.fill(Vec3::splat(-7.0));
+            }
+            if let Some(traps) = &mut film.traps {
+                traps.fill([-7.0; 4]);
+            }
             render_frame_into(
                 &mut film,
                 std::slice::from_ref(&scene),
