@@ -938,12 +938,18 @@ pub fn kernel_rows(
 ) -> Vec<Row> {
     let fractal = timeline.scene_at(0).fractal;
     let points = crate::math::shell_points(1 << 16, 0.9..1.3, 7);
-    // One pass over the points on a pool: its orbit iterations.
-    let pass = |pool: &rayon::ThreadPool| {
+    const CHUNK: usize = 1024;
+    let chunks = points.len() / CHUNK;
+    // `passes` passes over the points on a pool, as one parallel loop over
+    // their chunks (one fork and join, not one per pass of a millisecond or
+    // two, whose wake-ups and ragged ends the kernel's scaling would carry):
+    // their orbit iterations.
+    let pass = |pool: &rayon::ThreadPool, passes: usize| {
         pool.install(|| {
-            points
-                .par_chunks(1024)
-                .map(|chunk| {
+            (0..passes * chunks)
+                .into_par_iter()
+                .map(|k| {
+                    let chunk = &points[(k % chunks) * CHUNK..][..CHUNK];
                     let before = crate::fractal::iterations_on_this_thread();
                     // A vector of points at a time, into one array of estimates
                     // kept from call to call, as marching asks.
@@ -972,20 +978,18 @@ pub fn kernel_rows(
     };
     // Every pool warmed once (its threads started, the points in cache);
     // then samples of enough passes to last 0.2 s each on the widest pool
-    // (as a warm pass times them; longer on fewer threads), so fork/join is
-    // a small part of what is timed.
+    // (as a warm pass times them; longer on fewer threads), each sample
+    // one parallel loop.
     // Each pool's own count of a pass's iterations (the same points, so
     // the same count: the rows show it).
-    let iterations_per_pass: Vec<u64> = pools.iter().map(|(_, pool)| pass(pool)).collect();
+    let iterations_per_pass: Vec<u64> = pools.iter().map(|(_, pool)| pass(pool, 1)).collect();
     let start = Instant::now();
-    pass(widest);
+    pass(widest, 1);
     let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
         .ceil()
-        .max(1.0) as u64;
+        .max(1.0) as usize;
     let walls = timed_in_process(options.runs, pools.len(), |i| {
-        for _ in 0..passes {
-            pass(&pools[i].1);
-        }
+        pass(&pools[i].1, passes);
     });
     let works: Vec<Work> = iterations_per_pass
         .iter()
@@ -993,8 +997,8 @@ pub fn kernel_rows(
             frames: 0,
             pixels: 0,
             stats: FrameStats {
-                de_evaluations: points.len() as u64 * passes,
-                de_iterations: iterations * passes,
+                de_evaluations: points.len() as u64 * passes as u64,
+                de_iterations: iterations * passes as u64,
                 ..FrameStats::default()
             },
         })
