@@ -802,8 +802,29 @@ pub const VECTOR: usize = 16;
 /// The most f64 lanes one register has (AVX-512's eight).
 const REGISTER: usize = VECTOR / 2;
 
-/// One register's lanes in memory (the first `S::F64_LANES` used).
-type Stored = [f64; REGISTER];
+/// One register's lanes in memory (the first `S::F64_LANES` used), aligned
+/// to a whole cache line so that moving a 512-bit register to or from it
+/// never splits across two lines, wherever the stack happens to be.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Stored([f64; REGISTER]);
+
+impl Stored {
+    const ZERO: Stored = Stored([0.0; REGISTER]);
+}
+
+impl std::ops::Deref for Stored {
+    type Target = [f64; REGISTER];
+    fn deref(&self) -> &[f64; REGISTER] {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Stored {
+    fn deref_mut(&mut self) -> &mut [f64; REGISTER] {
+        &mut self.0
+    }
+}
 
 /// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
 /// each instruction set and picked at run time by the processor (pulp's
@@ -998,7 +1019,7 @@ impl<S: pulp::Simd> Register<S> {
 
     #[inline(always)]
     fn store(v: Vector<S>) -> Stored {
-        let mut a = [0.0; REGISTER];
+        let mut a = Stored::ZERO;
         S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
         a
     }
@@ -1012,7 +1033,7 @@ impl<S: pulp::Simd> Register<S> {
     #[inline(always)]
     fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
         debug_assert_eq!(points.len(), S::F64_LANES);
-        let mut xyz = [[0.0; REGISTER]; 3];
+        let mut xyz = [Stored::ZERO; 3];
         for (k, p) in points.iter().enumerate() {
             (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
         }
@@ -1209,7 +1230,7 @@ fn near_axis_powers(
     n: u32,
     which: &Stored,
 ) -> [Stored; 3] {
-    let mut out = [[0.0; REGISTER]; 3];
+    let mut out = [Stored::ZERO; 3];
     for k in (0..REGISTER).filter(|&k| which[k] != 0.0) {
         let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
         for axis in 0..3 {
