@@ -322,7 +322,8 @@ impl Accumulation {
     }
 
     /// The sums a band of `BAND_ROWS` rows at a time, for rendering bands
-    /// in parallel.
+    /// in parallel, each band a task of its own (`with_max_len(1)`; see
+    /// `BAND_TASKS`).
     fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = RowSums<'_>> {
         let (w, h) = (self.width as usize, self.height as usize);
         let band = BAND_ROWS * w;
@@ -345,6 +346,7 @@ impl Accumulation {
                     traps,
                 },
             )
+            .with_max_len(BAND_TASKS)
     }
 
     /// The finished film, with `n` samples per pixel.
@@ -389,7 +391,7 @@ struct FilmPixels<'a> {
 
 impl Film {
     /// The film a band of `BAND_ROWS` rows at a time, for finishing bands
-    /// in parallel.
+    /// in parallel, each band a task of its own (see `BAND_TASKS`).
     fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = FilmPixels<'_>> {
         let (w, h) = (self.width as usize, self.height as usize);
         let band = BAND_ROWS * w;
@@ -415,6 +417,7 @@ impl Film {
                     traps,
                 },
             )
+            .with_max_len(BAND_TASKS)
     }
 }
 
@@ -529,6 +532,13 @@ impl<'a> FrameSetup<'a> {
 /// The image rows rendered together: the rows a block of cone rays can
 /// span (`march::CONE_BLOCK_ROWS`).
 const BAND_ROWS: usize = crate::march::CONE_BLOCK_ROWS;
+
+/// Bands in one rayon task at most: one. Left to itself, rayon cuts an
+/// indexed loop into a few runs of bands and a thread works through its run
+/// in order, so a thread that runs out of work can take nothing from a
+/// run another thread has begun, and a frame whose costly bands bunch
+/// together ends on one thread.
+const BAND_TASKS: usize = 1;
 
 /// Adds `frame.samples` of every pixel of the band of image rows from `y0`
 /// (as many as `sums` holds) to `sums`.
