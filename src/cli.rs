@@ -1229,10 +1229,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
         })
         .collect();
     let layers = crate::render::Layers::default();
-    let [mut with, mut without] = [(); 2].map(|_| crate::render::Film::default());
-    for (film, scenes) in [(&mut with, &scenes), (&mut without, &plain)] {
-        crate::render::render_frame_into(film, scenes, 0, probe_w, probe_h, layers, &|| {});
-    }
+    let probe = |scenes: &[crate::scene::Scene]| {
+        let mut film = crate::render::Film::default();
+        crate::render::render_frame_into(&mut film, scenes, 0, probe_w, probe_h, layers, &|| {});
+        film
+    };
+    let (with, without) = (probe(&scenes), probe(&plain));
     out!(
         "cost:     frame 0 at {probe_w}x{probe_h}: {} estimates, {:.2}x the same frame without effects ({})",
         with.stats.de_evaluations,

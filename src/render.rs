@@ -51,10 +51,13 @@ impl Film {
     /// the buffers it already has where they are big enough, for
     /// `finish_pixels` to fill: it writes every element of every buffer,
     /// so no pass clears them first. A sequence's frames thus reuse pages
-    /// already mapped, and a new buffer comes zeroed from the allocator as
-    /// untouched pages, which the threads that finish the bands fault in
-    /// (on one thread first, as a new film once was, that took 3.1–3.4 ms
-    /// of a 640×480 frame; some 1 ms to clear a reused one).
+    /// already mapped, and a new buffer comes zeroed from the allocator:
+    /// when it maps fresh memory (glibc does for big blocks, until freeing
+    /// one raises its threshold and it clears reused memory instead, on
+    /// the calling thread), as untouched pages that the threads finishing
+    /// the bands fault in. (Filled on one thread first, as a new film once
+    /// was, that took 3.1–3.4 ms of a 640×480 frame; some 1 ms to clear a
+    /// reused one.)
     fn prepare(&mut self, width: u32, height: u32, layers: Layers) {
         let pixels = width as usize * height as usize;
         fn layer<T: bytemuck::Zeroable + Clone>(v: &mut Option<Vec<T>>, on: bool, n: usize) {
@@ -424,6 +427,26 @@ impl Film {
 /// Averages the sums of `sums` (all its pixels) over `n` samples into
 /// `out`, pixel for pixel; returns the most estimates one pixel took.
 fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64 {
+    // Every element of `out` is written (a film is not cleared before:
+    // `Film::prepare`), which the zips below do only with sums as long.
+    let pixels = sums.colour.len();
+    let layer =
+        |out: Option<usize>, sums: usize| out.is_none_or(|len| len == pixels && sums == len);
+    debug_assert!(
+        [
+            out.colour.len(),
+            out.alpha.len(),
+            out.depth.len(),
+            out.evaluations.len()
+        ]
+        .into_iter()
+        .chain([sums.hits.len(), sums.depth.len(), sums.spent.len()])
+        .all(|len| len == pixels)
+            && layer(out.normal.as_ref().map(|v| v.len()), sums.normal.len())
+            && layer(out.albedo.as_ref().map(|v| v.len()), sums.albedo.len())
+            && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len()),
+        "a band's film and sums differ in size"
+    );
     let inv = 1.0 / n as f64;
     for (c, s) in out.colour.iter_mut().zip(&sums.colour) {
         *c = Vec3::new(
@@ -929,10 +952,13 @@ mod tests {
             normal: true,
             ..Layers::default()
         };
+        // Every layer follows a frame that had it too, so each is reused.
         for (w, h, layers) in [
             (32, 24, Layers::default()),
             (40, 30, every),
+            (24, 16, every),
             (48, 20, normal_only),
+            (16, 12, every),
             (16, 12, every),
         ] {
             // Values no frame could give, in every element the film holds,
