@@ -278,7 +278,7 @@ pub fn count_work(timeline: &Timeline, size: (u32, u32)) -> Work {
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct Row {
     pub machine: String,
-    /// Scene name, `kernel`, or `<scene>@<W>x<H>` for the memory render.
+    /// Scene name, `KERNEL`, `CEILING`, or `<scene>@<W>x<H>` for the memory render.
     pub scene: String,
     pub renderer: String,
     pub threads: usize,
@@ -379,11 +379,17 @@ fn timing_row(mut row: Row, runs: &[Measurement], work: Option<&Work>, peak: &Pe
         row.de_evaluations_per_s = w.stats.de_evaluations as f64 / t;
         row.de_iterations = w.stats.de_iterations;
         row.de_iterations_per_s = w.stats.de_iterations as f64 / t;
-        row.gflops = row.de_iterations_per_s * FLOPS_PER_POWER8_ITERATION as f64 / 1e9;
-        row.peak_gflops = peak.gflops_for(row.threads);
-        row.fraction_of_peak = row.gflops / row.peak_gflops.max(1e-9);
+        let gflops = row.de_iterations_per_s * FLOPS_PER_POWER8_ITERATION as f64 / 1e9;
+        set_gflops(&mut row, gflops, peak);
     }
     row
+}
+
+/// Sets `row`'s GFLOP/s and its share of the nominal peak of its threads.
+fn set_gflops(row: &mut Row, gflops: f64, peak: &Peak) {
+    row.gflops = gflops;
+    row.peak_gflops = peak.gflops_for(row.threads);
+    row.fraction_of_peak = gflops / row.peak_gflops.max(1e-9);
 }
 
 fn mpixels_per_s(pixels: u64, seconds: f64) -> f64 {
@@ -997,17 +1003,20 @@ pub fn kernel_rows(
             frames: 0,
             pixels: 0,
             stats: FrameStats {
-                de_evaluations: points.len() as u64 * passes as u64,
+                de_evaluations: (chunks * CHUNK * passes) as u64,
                 de_iterations: iterations * passes as u64,
                 ..FrameStats::default()
             },
         })
         .collect();
-    pool_rows("kernel", pools, walls, &works, &options.peak, base)
+    pool_rows(KERNEL, pools, walls, &works, &options.peak, base)
 }
 
 /// The scene name of the machine's own ceiling rows (`ceiling_rows`).
 pub const CEILING: &str = "fma ceiling";
+
+/// The scene name of the kernel's rows (`kernel_rows`).
+pub const KERNEL: &str = "kernel";
 
 /// Independent chains in the ceiling loop: more than the 8 that two FMA
 /// units of 4 cycles' latency need to stay busy, few enough to stay in
@@ -1022,8 +1031,8 @@ const CEILING_FACTOR: f64 = 1.0 - 1.0 / 1024.0;
 /// f64 vectors this processor has (pulp's choice, as the kernel's), with
 /// nothing but registers: the most floating-point work a core of this
 /// machine does, measured rather than assumed. Returns the sum of every
-/// chain's lanes (each `(1 − mʳ) / (1 − m)`) and the flops done (2 per
-/// lane per fused multiply-add).
+/// chain's lanes (chain k's each `k·mʳ + (1 − mʳ) / (1 − m)`) and the
+/// flops done (2 per lane per fused multiply-add).
 pub fn fma_ceiling(rounds: u64) -> (f64, u64) {
     pulp::Arch::new().dispatch(Ceiling { rounds })
 }
@@ -1038,7 +1047,9 @@ impl pulp::WithSimd for Ceiling {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) -> (f64, u64) {
         let (m, one) = (simd.splat_f64s(CEILING_FACTOR), simd.splat_f64s(1.0));
-        let mut chains = [simd.splat_f64s(0.0); CEILING_CHAINS];
+        // Chain k starts at k: no two chains alike, so none can be merged.
+        let mut chains: [S::f64s; CEILING_CHAINS] =
+            std::array::from_fn(|k| simd.splat_f64s(k as f64));
         for _ in 0..std::hint::black_box(self.rounds) {
             for c in &mut chains {
                 *c = simd.mul_add_f64s(*c, m, one);
@@ -1086,9 +1097,8 @@ pub fn ceiling_rows(
     let works = vec![Work::default(); pools.len()];
     let mut rows = pool_rows(CEILING, pools, walls, &works, &options.peak, base);
     for (row, flops) in rows.iter_mut().zip(flops) {
-        row.gflops = flops as f64 / row.median_s.max(1e-9) / 1e9;
-        row.peak_gflops = options.peak.gflops_for(row.threads);
-        row.fraction_of_peak = row.gflops / row.peak_gflops.max(1e-9);
+        let gflops = flops as f64 / row.median_s.max(1e-9) / 1e9;
+        set_gflops(row, gflops, &options.peak);
     }
     rows
 }
@@ -1116,7 +1126,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
     md.push_str("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |\n");
     let is_scene = |r: &Row| {
         r.renderer == "mandelreel"
-            && r.scene != "kernel"
+            && r.scene != KERNEL
             && r.scene != CEILING
             && !r.scene.contains('@')
             && !r.scene.ends_with("(scaling)")
@@ -1166,13 +1176,13 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             100.0 * r.fraction_of_peak
         );
     }
-    let kernel: Vec<&Row> = rows.iter().filter(|r| r.scene == "kernel").collect();
+    let kernel: Vec<&Row> = rows.iter().filter(|r| r.scene == KERNEL).collect();
     if let Some(r) = kernel.iter().max_by_key(|r| r.threads) {
         let _ = write!(
             md,
-            "\nKernel alone ({} threads, analytic estimate at points around the bulb): \
+            "\nKernel alone ({}, analytic estimate at points around the bulb): \
 {:.3e} DE iterations/s × {} flops = {:.1} GFLOP/s, {:.1}% of the nominal peak.",
-            r.threads,
+            counted(r.threads, "thread"),
             r.de_iterations_per_s,
             FLOPS_PER_POWER8_ITERATION,
             r.gflops,
@@ -1182,8 +1192,11 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
             let scaling: Vec<String> = kernel
                 .iter()
                 .map(|k| {
-                    let noun = if k.threads == 1 { "thread" } else { "threads" };
-                    format!("{} {noun} {:.2}×", k.threads, k.scaling_vs_one_thread)
+                    format!(
+                        "{} {:.2}×",
+                        counted(k.threads, "thread"),
+                        k.scaling_vs_one_thread
+                    )
                 })
                 .collect();
             let _ = write!(
@@ -1194,7 +1207,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
         }
         md.push('\n');
     }
-    md.push_str(&ceiling_markdown(rows));
+    md.push_str(&ceiling_markdown(rows, peak));
     for r in rows
         .iter()
         .filter(|r| r.scene.contains('@') && r.depth_error_mean_px.is_none())
@@ -1217,7 +1230,7 @@ nominal f64 FMA peak {:.1} GFLOP/s.\n",
 
 /// The ceiling rows as a paragraph, with the kernel's share of the
 /// ceiling on as many threads; nothing without them.
-fn ceiling_markdown(rows: &[Row]) -> String {
+fn ceiling_markdown(rows: &[Row], peak: &Peak) -> String {
     let ceiling: Vec<&Row> = rows.iter().filter(|r| r.scene == CEILING).collect();
     if ceiling.is_empty() {
         return String::new();
@@ -1225,11 +1238,12 @@ fn ceiling_markdown(rows: &[Row]) -> String {
     let each: Vec<String> = ceiling
         .iter()
         .map(|c| {
-            let noun = if c.threads == 1 { "thread" } else { "threads" };
-            let cores = if c.threads == 1 { "core" } else { "cores" };
             let mut text = format!(
-                "{} {noun} {:.1} GFLOP/s ({:.2}× the nominal peak of {} {cores}",
-                c.threads, c.gflops, c.fraction_of_peak, c.threads
+                "{} {:.1} GFLOP/s ({:.2}× the nominal peak of {}",
+                counted(c.threads, "thread"),
+                c.gflops,
+                c.fraction_of_peak,
+                counted(c.threads.min(peak.cores), "core")
             );
             if c.scaling_vs_one_thread > 0.0 && c.threads != 1 {
                 let _ = write!(text, ", {:.2}× one thread", c.scaling_vs_one_thread);
@@ -1245,19 +1259,28 @@ multiply-adds on f64 vectors, in registers, nothing shared): {}.",
     let widest = ceiling.iter().max_by_key(|c| c.threads);
     let kernel = widest.and_then(|c| {
         rows.iter()
-            .find(|k| k.scene == "kernel" && k.threads == c.threads)
+            .find(|k| k.scene == KERNEL && k.threads == c.threads)
             .map(|k| (k, c))
     });
     if let Some((k, c)) = kernel {
         let _ = write!(
             md,
-            " The kernel alone on {} threads does {:.1}% of the ceiling's flops per second.",
-            k.threads,
+            " The kernel alone on {} does {:.1}% of the ceiling's flops per second.",
+            counted(k.threads, "thread"),
             100.0 * k.gflops / c.gflops.max(1e-9)
         );
     }
     md.push('\n');
     md
+}
+
+/// "1 thread", "2 threads": `n` and `noun`, plural unless `n` is 1.
+fn counted(n: usize, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
 }
 
 /// The depth rows as a Markdown table, or nothing without them.
@@ -1442,22 +1465,21 @@ mod tests {
 
     #[test]
     fn the_ceiling_loop_does_the_work_it_counts() {
+        // Two flops per lane of each chain's fused multiply-add, each round.
+        let per_round = (CEILING_CHAINS * 2) as u64;
+        let lanes = fma_ceiling(1).1 / per_round;
         for rounds in [0, 1, 7, 5000] {
             let (sum, flops) = fma_ceiling(rounds);
-            // Two flops per lane of each chain's fused multiply-add, each round.
-            let per_round = (CEILING_CHAINS * 2) as u64;
-            let lanes = if rounds == 0 {
-                1
-            } else {
-                flops / (rounds * per_round)
-            };
             assert_eq!(flops, rounds * per_round * lanes);
             assert!([1, 2, 4, 8].contains(&lanes), "{lanes} lanes");
-            // Each lane of each chain sums the geometric series 1 + m + … + mʳ⁻¹.
+            // Each lane of chain k: its start k shrunk by mʳ, plus the
+            // geometric series 1 + m + … + mʳ⁻¹.
             let m = CEILING_FACTOR;
-            let lane = (1.0 - m.powi(rounds as i32)) / (1.0 - m);
-            let expected = lane * (CEILING_CHAINS as u64 * lanes) as f64;
-            let tolerance = if rounds == 0 { 0.0 } else { 1e-9 * expected };
+            let mr = m.powi(rounds as i32);
+            let series = (1.0 - mr) / (1.0 - m);
+            let chains: f64 = (0..CEILING_CHAINS).map(|k| k as f64 * mr + series).sum();
+            let expected = chains * lanes as f64;
+            let tolerance = 1e-9 * expected;
             assert!(
                 (sum - expected).abs() <= tolerance,
                 "{rounds}: {sum} vs {expected}"
