@@ -42,7 +42,7 @@ pub struct Options {
     /// The Mandelbulber2 program, when it is to be compared.
     pub mandelbulber: Option<PathBuf>,
     /// A/B pairs per scene, and samples per pool of the in-process
-    /// (render only) and kernel rows.
+    /// (render only), kernel and ceiling rows.
     pub runs: usize,
     /// Thread counts for the scaling rows (every scene; in-process on the
     /// first; the kernel alone).

@@ -85,8 +85,9 @@ pub enum Command {
     /// precision on one frame against a reference; write accuracy.csv, .md and .png.
     Accuracy(AccuracyArgs),
     /// Time the benchmark scenes (timelines/bench) against Mandelbulber2 where it is
-    /// installed, measure the kernel against the FMA peak, thread scaling and peak
-    /// memory; write bench/results/<machine>.csv and .md.
+    /// installed, measure the kernel against the FMA peak and the machine's own
+    /// measured ceiling, thread scaling and peak memory; write
+    /// bench/results/<machine>.csv and .md.
     Bench(BenchArgs),
     /// Run a program and print its wall time and peak memory as JSON (used by `bench`).
     #[command(hide = true)]
@@ -112,7 +113,7 @@ pub struct BenchArgs {
     #[arg(long)]
     pub no_mandelbulber: bool,
     /// Runs of each renderer per scene, and samples per thread count of the
-    /// kernel rows (alternating); medians are reported.
+    /// in-process, kernel and ceiling rows (alternating); medians are reported.
     #[arg(long, default_value_t = 5)]
     pub runs: usize,
     /// Thread counts for the scaling rows, comma-separated [default: 1, 2, 4, … up to every logical CPU].
