@@ -412,8 +412,9 @@ impl Orbit<f64> {
 
 /// An orbit being iterated: the loop body of `orbit`. The vector kernel
 /// (`Register::step`) repeats it operation for operation on registers and
-/// ends the same way (`Orbit::ended`, `OrbitTraps::ended`); tests hold the
-/// two to the bit.
+/// ends the same way (`Orbit::ended`, `OrbitTraps::ended`, which
+/// `Register::estimates` repeats by selection); tests hold the two to the
+/// bit.
 #[derive(Clone, Copy)]
 struct OrbitState<T> {
     z: Triplex<T>,
@@ -1139,38 +1140,79 @@ impl<S: pulp::Simd> Register<S> {
 
     /// The analytic estimates at `points` (one per lane) from the finished
     /// orbits, into `out`: `estimate_from_orbit`'s formula, its logarithm
-    /// and division taken in the registers.
+    /// and division taken in the registers, and so is the choice among its
+    /// cases and the traps' ending (`Orbit::ended`), exact as selections;
+    /// the two rare cases (a point outside the bailout from the start, a
+    /// radius outside the logarithm's range) go lane by lane.
     #[inline(always)]
     fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
         // The analytic estimator in f64 is the only one finished here
         // (`estimate_lanes_into` sends the others one point at a time).
         debug_assert!(fractal.de == DeMethod::Analytic && fractal.precision == Precision::F64);
+        let simd = self.simd;
         let (r, dr) = (self.r, self.dr);
-        // `half_r_ln_r_over`, operation for operation.
-        let raw = Self::store(self.splat(0.5) * crate::math::ln_in_range(r) * r / dr);
-        let ends = self.ends();
+        let (zero, one, infinity) = (self.splat(0.0), self.splat(1.0), self.splat(Real::INFINITY));
+        // `half_r_ln_r_over`, operation for operation; then `as_distance`
+        // (0 unless finite, then at least 0: the sum is never −0 here, as
+        // r > 1 past the bailout and dr ≥ 1).
+        let raw = self.splat(0.5) * crate::math::ln_in_range(r) * r / dr;
+        let finite = simd.less_than_f64s(simd.abs_f64s(raw.1), infinity.1);
+        let positive = simd.greater_than_f64s(raw.1, zero.1);
+        let distance = self.select(simd.and_m64s(finite, positive), raw, zero);
+        // `OrbitState::outside`, and the cases of `estimate_from_orbit`.
+        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
+        let escaped = simd.greater_than_f64s(self.r2.1, bailout2.1);
+        let stepped = simd.greater_than_or_equal_f64s(self.i.1, one.1);
+        // `in_ln_range`: at least ½ and finite.
+        let in_range = simd.and_m64s(
+            simd.greater_than_or_equal_f64s(r.1, self.splat(0.5).1),
+            simd.less_than_f64s(r.1, infinity.1),
+        );
+        let usual = simd.and_m64s(escaped, simd.and_m64s(stepped, in_range));
+        let rare = simd.and_m64s(escaped, simd.not_m64s(usual));
+        let distance = self.select(usual, distance, zero);
+        // `OrbitTraps::ended`: an orbit whose origin trap is still +∞ met
+        // no trap and takes those of where it ended (its |z|² is `r2`,
+        // computed as `length_squared` computes it).
+        let untrapped = simd.equal_f64s(self.origin.1, infinity.1);
+        let origin = self.select(untrapped, self.r2, self.origin);
+        // No closures: inside pulp's instruction-set functions one may not
+        // be inlined, which would make each vector operation a call.
+        let mut planes = [Stored::ZERO; 3];
+        for ((plane, z), met) in planes.iter_mut().zip(self.z).zip(self.planes) {
+            let end = Vector(simd, simd.abs_f64s(z.1));
+            *plane = Self::store(self.select(untrapped, end, met));
+        }
+        let store = Self::store;
+        let (distance, origin) = (store(distance), store(origin));
+        let (i, escaped) = (store(self.i), store(self.select(escaped, one, zero)));
         for (k, out) in out.iter_mut().enumerate() {
-            let o = ends.orbit(k, fractal.bailout);
-            let distance = if !o.escaped {
-                0.0
-            } else if o.iterations == 0 {
-                distance_to_ball(points[k], fractal.bailout)
-            } else if crate::math::in_ln_range(o.r) {
-                as_distance(raw[k])
-            } else {
-                as_distance(half_r_ln_r_over(o.r, o.dr))
-            };
             *out = Estimate {
-                distance,
-                traps: o.traps,
-                iterations: o.iterations,
-                escaped: o.escaped,
+                distance: distance[k],
+                traps: OrbitTraps {
+                    origin: origin[k],
+                    planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+                },
+                iterations: i[k] as u32,
+                escaped: escaped[k] != 0.0,
                 orbits: 1,
             };
+        }
+        if self.any(rare) {
+            let rare = store(self.select(rare, one, zero));
+            let (r, dr) = (store(r), store(dr));
+            for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
+                out[k].distance = if i[k] == 0.0 {
+                    distance_to_ball(points[k], fractal.bailout)
+                } else {
+                    as_distance(half_r_ln_r_over(r[k], dr[k]))
+                };
+            }
         }
     }
 
     /// The register's state, lane by lane in memory.
+    #[cfg(test)]
     #[inline(always)]
     fn ends(&self) -> Ends {
         let store = Self::store;
@@ -1187,6 +1229,7 @@ impl<S: pulp::Simd> Register<S> {
 }
 
 /// A register's finished orbits, lane by lane (`Register::ends`).
+#[cfg(test)]
 struct Ends {
     z: [Stored; 3],
     planes: [Stored; 3],
@@ -1197,6 +1240,7 @@ struct Ends {
     i: Stored,
 }
 
+#[cfg(test)]
 impl Ends {
     /// Lane `k`'s orbit, ended as the scalar loop ends it (`Orbit::ended`).
     #[inline(always)]
@@ -1507,6 +1551,17 @@ mod tests {
             de: DeMethod::Potential,
             ..Fractal::default()
         });
+        // Radii that escape outside the logarithm's range, which lanes
+        // finish one at a time: to +∞ past a huge bailout (the points at
+        // |p| ≈ 4.1 below: 4.1⁸ ≈ 10⁴·⁹, then 10³⁹·², then overflow; some
+        // 400 lanes of this test end so); and a tiny bailout, outside which
+        // most points start.
+        for bailout in [1e40, 0.3] {
+            fractals.push(Fractal {
+                bailout,
+                ..Fractal::default()
+            });
+        }
         let mut pts = points(400, 0.0..2.5, 5);
         // Lanes that take the trigonometric form (on and beside every
         // convention's pole axis, the origin) or never iterate (far out,
@@ -1519,6 +1574,9 @@ mod tests {
             DVec3::ZERO,
             DVec3::new(40.0, -3.0, 2.0),
             IDLE_POINT,
+            DVec3::new(4.1, 0.3, -0.2),
+            DVec3::new(-0.2, 4.05, 0.4),
+            DVec3::new(0.1, 0.05, -0.2),
         ]
         .into_iter()
         .enumerate()
