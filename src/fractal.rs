@@ -834,8 +834,8 @@ impl std::ops::DerefMut for Stored {
 /// written out as the vector instruction it is, so the speed does not rest
 /// on the compiler vectorising; Rust never fuses a multiply and an add
 /// unasked, so every version rounds exactly as the scalar `orbit` does.
-/// `Kernel<Orbit<f64>>` writes the orbits into its output, `Kernel<Estimate>`
-/// the analytic estimates, finished in the registers. Only the first
+/// `Kernel<Estimate>` writes the analytic estimates, finished in the
+/// registers; `Kernel<Orbit<f64>>`, for the tests, the orbits. Only the first
 /// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
 /// register of nothing but padding is loaded but neither iterated nor
 /// finished, its results left as they were (`Finished::IDLE` from
@@ -1070,10 +1070,16 @@ impl<S: pulp::Simd> Register<S> {
     #[inline(always)]
     fn check(&mut self, fractal: &Fractal) -> bool {
         let simd = self.simd;
-        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
-        let outside = simd.greater_than_f64s(self.r2.1, bailout2.1);
+        let outside = self.outside(fractal);
         self.running = simd.and_m64s(self.running, simd.not_m64s(outside));
         self.any(self.running)
+    }
+
+    /// The lanes past the bailout (`OrbitState::outside`).
+    #[inline(always)]
+    fn outside(&self, fractal: &Fractal) -> S::m64s {
+        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
+        self.simd.greater_than_f64s(self.r2.1, bailout2.1)
     }
 
     /// `OrbitState::step` on the running lanes.
@@ -1132,9 +1138,16 @@ impl<S: pulp::Simd> Register<S> {
     #[cfg(test)]
     #[inline(always)]
     fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
-        let ends = self.ends();
+        let store = Self::store;
+        let (z, planes) = (self.z.map(store), self.planes.map(store));
+        let [origin, r2, r, dr, i] = [self.origin, self.r2, self.r, self.dr, self.i].map(store);
         for (k, out) in out.iter_mut().enumerate() {
-            *out = ends.orbit(k, fractal.bailout);
+            let traps = OrbitTraps {
+                origin: origin[k],
+                planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+            };
+            let end = [z[0][k], z[1][k], z[2][k]];
+            *out = Orbit::ended(end, r2[k], r[k], dr[k], traps, i[k] as u32, fractal.bailout);
         }
     }
 
@@ -1142,8 +1155,8 @@ impl<S: pulp::Simd> Register<S> {
     /// orbits, into `out`: `estimate_from_orbit`'s formula, its logarithm
     /// and division taken in the registers, and so is the choice among its
     /// cases and the traps' ending (`Orbit::ended`), exact as selections;
-    /// the two rare cases (a point outside the bailout from the start, a
-    /// radius outside the logarithm's range) go lane by lane.
+    /// a point outside the bailout from the start, which is rare, goes
+    /// lane by lane.
     #[inline(always)]
     fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
         // The analytic estimator in f64 is the only one finished here
@@ -1152,25 +1165,28 @@ impl<S: pulp::Simd> Register<S> {
         let simd = self.simd;
         let (r, dr) = (self.r, self.dr);
         let (zero, one, infinity) = (self.splat(0.0), self.splat(1.0), self.splat(Real::INFINITY));
-        // `half_r_ln_r_over`, operation for operation; then `as_distance`
-        // (0 unless finite, then at least 0: the sum is never −0 here, as
-        // r > 1 past the bailout and dr ≥ 1).
+        // `half_r_ln_r_over`, operation for operation.
         let raw = self.splat(0.5) * crate::math::ln_in_range(r) * r / dr;
-        let finite = simd.less_than_f64s(simd.abs_f64s(raw.1), infinity.1);
-        let positive = simd.greater_than_f64s(raw.1, zero.1);
-        let distance = self.select(simd.and_m64s(finite, positive), raw, zero);
-        // `OrbitState::outside`, and the cases of `estimate_from_orbit`.
-        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
-        let escaped = simd.greater_than_f64s(self.r2.1, bailout2.1);
+        // The cases of `estimate_from_orbit`. An escaped orbit that took a
+        // step ends with r in `in_ln_range` (at least ½ and finite), or
+        // else its estimate is not above 0 or not finite, which
+        // `as_distance` makes 0 as it does here: so one selection holds
+        // `as_distance` and every case but the rare one.
+        let escaped = self.outside(fractal);
         let stepped = simd.greater_than_or_equal_f64s(self.i.1, one.1);
-        // `in_ln_range`: at least ½ and finite.
         let in_range = simd.and_m64s(
             simd.greater_than_or_equal_f64s(r.1, self.splat(0.5).1),
             simd.less_than_f64s(r.1, infinity.1),
         );
-        let usual = simd.and_m64s(escaped, simd.and_m64s(stepped, in_range));
-        let rare = simd.and_m64s(escaped, simd.not_m64s(usual));
-        let distance = self.select(usual, distance, zero);
+        let usual = simd.and_m64s(
+            simd.and_m64s(escaped, simd.and_m64s(stepped, in_range)),
+            simd.and_m64s(
+                simd.greater_than_f64s(raw.1, zero.1),
+                simd.less_than_f64s(raw.1, infinity.1),
+            ),
+        );
+        let distance = self.select(usual, raw, zero);
+        let rare = simd.and_m64s(escaped, simd.not_m64s(stepped));
         // `OrbitTraps::ended`: an orbit whose origin trap is still +∞ met
         // no trap and takes those of where it ended (its |z|² is `r2`,
         // computed as `length_squared` computes it).
@@ -1200,65 +1216,10 @@ impl<S: pulp::Simd> Register<S> {
         }
         if self.any(rare) {
             let rare = store(self.select(rare, one, zero));
-            let (r, dr) = (store(r), store(dr));
             for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
-                out[k].distance = if i[k] == 0.0 {
-                    distance_to_ball(points[k], fractal.bailout)
-                } else {
-                    as_distance(half_r_ln_r_over(r[k], dr[k]))
-                };
+                out[k].distance = distance_to_ball(points[k], fractal.bailout);
             }
         }
-    }
-
-    /// The register's state, lane by lane in memory.
-    #[cfg(test)]
-    #[inline(always)]
-    fn ends(&self) -> Ends {
-        let store = Self::store;
-        Ends {
-            z: self.z.map(store),
-            planes: self.planes.map(store),
-            origin: store(self.origin),
-            r2: store(self.r2),
-            r: store(self.r),
-            dr: store(self.dr),
-            i: store(self.i),
-        }
-    }
-}
-
-/// A register's finished orbits, lane by lane (`Register::ends`).
-#[cfg(test)]
-struct Ends {
-    z: [Stored; 3],
-    planes: [Stored; 3],
-    origin: Stored,
-    r2: Stored,
-    r: Stored,
-    dr: Stored,
-    i: Stored,
-}
-
-#[cfg(test)]
-impl Ends {
-    /// Lane `k`'s orbit, ended as the scalar loop ends it (`Orbit::ended`).
-    #[inline(always)]
-    fn orbit(&self, k: usize, bailout: Real) -> Orbit<f64> {
-        let traps = OrbitTraps {
-            origin: self.origin[k],
-            planes: DVec3::new(self.planes[0][k], self.planes[1][k], self.planes[2][k]),
-        };
-        let z = [self.z[0][k], self.z[1][k], self.z[2][k]];
-        Orbit::ended(
-            z,
-            self.r2[k],
-            self.r[k],
-            self.dr[k],
-            traps,
-            self.i[k] as u32,
-            bailout,
-        )
     }
 }
 
@@ -1322,11 +1283,12 @@ fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
     as_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
 }
 
-/// An estimate `d` as a distance: 0 where it is negative or not finite.
+/// An estimate `d` as a distance: `d` where it is above 0 and finite, else
+/// +0 (never −0: the vector kernel selects the same, `Register::estimates`).
 #[inline(always)]
 fn as_distance(d: Real) -> Real {
-    if d.is_finite() {
-        d.max(0.0)
+    if d > 0.0 && d.is_finite() {
+        d
     } else {
         0.0
     }
