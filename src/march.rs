@@ -183,8 +183,10 @@ pub fn march_many(
 /// (`ConeWalk`): the stretch where the surface is still far off compared
 /// with the run's width is walked once for the run, and each ray starts
 /// where the cone stopped. The cone's estimates are shared out over the
-/// run's rays. `scratch` is kept by the caller from call to call. Runs of
-/// one ray march every ray alone.
+/// run's rays. `scratch` is kept by the caller from call to call. When
+/// every run is one ray, every ray marches alone; a run of one among
+/// longer ones (a block cut short at a band's edge) still marches its cone
+/// of one first.
 pub fn march_camera_rays(
     rays: &[Ray],
     fractal: &Fractal,

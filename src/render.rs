@@ -50,7 +50,8 @@ impl Film {
     /// This film sized to `width`×`height` with the layers asked for, in
     /// the buffers it already has where they are big enough, for
     /// `finish_pixels` to fill: it writes every element of every buffer,
-    /// so no pass clears them first. A sequence's frames thus reuse pages
+    /// so no pass clears them first (a kept buffer that grows has only its
+    /// new tail zeroed). A sequence's frames thus reuse pages
     /// already mapped, and a new buffer comes zeroed from the allocator:
     /// when it maps fresh memory (glibc does for big blocks, until freeing
     /// one raises its threshold and it clears reused memory instead, on
@@ -625,7 +626,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
         rays.clear();
         rays.extend(order.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
-            let pixel = (y * w + x) as u64;
+            let pixel = (y0 * w + p) as u64;
             let (ox, oy) = subpixel(scene, frame_index, pixel, s, n);
             if camera.has_lens() {
                 let u = sample_1d(scene.seed, frame_index, pixel, s, 2);
@@ -641,10 +642,6 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
         // four to a kernel call); each pixel's cost goes straight to its sum.
         surfaces.clear();
         surfaces.resize(rays.len(), None);
-        for (&p, result) in order.iter().zip(marched.iter()) {
-            stats.primary_evaluations += result.evaluations as u64;
-            spent_row[p] += result.evaluations as u64;
-        }
         let hits = rays
             .iter()
             .zip(marched.iter())
@@ -715,8 +712,10 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
             .zip(surfaces.iter())
             .enumerate()
         {
-            // The pixel's offset in the band.
+            // The pixel's offset in the band; its camera ray's cost first.
             let p = order[i];
+            stats.primary_evaluations += result.evaluations as u64;
+            spent_row[p] += result.evaluations as u64;
             let before = stats.stage_total();
             let c = trace(
                 scene,
