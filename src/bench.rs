@@ -1472,6 +1472,8 @@ mod tests {
             let (sum, flops) = fma_ceiling(rounds);
             assert_eq!(flops, rounds * per_round * lanes);
             assert!([1, 2, 4, 8].contains(&lanes), "{lanes} lanes");
+            // As wide as the peak counts (`Peak::lanes`).
+            assert_eq!(lanes, vector_lanes() as u64);
             // Each lane of chain k: its start k shrunk by mʳ, plus the
             // geometric series 1 + m + … + mʳ⁻¹.
             let m = CEILING_FACTOR;
