@@ -96,6 +96,33 @@ pub fn cone_block(n: u32) -> (usize, usize) {
     (n / rows, rows)
 }
 
+/// The `rows`×`w` pixels of a band (as offsets into its sums, row after
+/// row) into `order` block by block, `block` (columns, rows) at a time:
+/// down the band's groups of block rows, across each group a block after
+/// another, each block's pixels row by row; `runs` gets each block's size
+/// (narrower at the right edge, lower in a short band). A block's camera
+/// rays march one cone (`march_camera_rays`).
+pub fn cone_blocks(
+    w: usize,
+    rows: usize,
+    (bw, bh): (usize, usize),
+    order: &mut Vec<usize>,
+    runs: &mut Vec<u32>,
+) {
+    order.clear();
+    runs.clear();
+    for y in (0..rows).step_by(bh) {
+        let gh = bh.min(rows - y);
+        for x in (0..w).step_by(bw) {
+            let gw = bw.min(w - x);
+            for yy in y..y + gh {
+                order.extend(yy * w + x..yy * w + x + gw);
+            }
+            runs.push((gw * gh) as u32);
+        }
+    }
+}
+
 /// A ray through a pixel: origin, unit direction, and the angle one pixel subtends.
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
@@ -183,10 +210,9 @@ pub fn march_many(
 /// (`ConeWalk`): the stretch where the surface is still far off compared
 /// with the run's width is walked once for the run, and each ray starts
 /// where the cone stopped. The cone's estimates are shared out over the
-/// run's rays. `scratch` is kept by the caller from call to call. When
-/// every run is one ray, every ray marches alone; a run of one among
-/// longer ones (a block cut short at a band's edge) still marches its cone
-/// of one first.
+/// run's rays. `scratch` is kept by the caller from call to call. A run of
+/// one ray (a block cut to one pixel at a band's corner) has no cone: that
+/// ray marches alone, bit for bit as `march` would.
 pub fn march_camera_rays(
     rays: &[Ray],
     fractal: &Fractal,
@@ -206,14 +232,7 @@ pub fn march_camera_rays(
     intervals.clear();
     intervals.extend(rays.iter().map(|ray| settings.interval(ray)));
     let intervals = &*intervals;
-    // Each run's rays.
-    let spans = || {
-        runs.iter().scan(0, |start, &n| {
-            let span = *start..*start + n as usize;
-            *start = span.end;
-            Some(span)
-        })
-    };
+    let spans = || run_spans(runs);
     free.clear();
     free.resize(runs.len(), (0.0, 0));
     let cones = spans().map(|span| ConeWalk::start(&rays[span.clone()], &intervals[span]));
@@ -236,6 +255,15 @@ pub fn march_camera_rays(
     }
 }
 
+/// The indices of each run of `runs` (the lengths of consecutive runs).
+fn run_spans(runs: &[u32]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+    runs.iter().scan(0, |start, &n| {
+        let span = *start..*start + n as usize;
+        *start = span.end;
+        Some(span)
+    })
+}
+
 /// `march_camera_rays`' scratch space: each ray's bounding-sphere interval;
 /// for each run, where its rays may start and what its cone cost.
 #[derive(Default)]
@@ -253,7 +281,7 @@ pub struct ConeScratch {
 /// rays must go on alone), where every ray has left the bounding sphere,
 /// or, a step back, at a point inside the set. The axis runs between the
 /// run's first and last rays, the centre of a block when those are its
-/// opposite corners, as `render::cone_blocks` orders them; any run is safe,
+/// opposite corners, as `cone_blocks` orders them; any run is safe,
 /// since the spread is taken over all its rays.
 #[derive(Clone, Copy)]
 struct ConeWalk {
@@ -274,8 +302,11 @@ impl ConeWalk {
     /// The cone of `run` (rays from nearly one point, in nearly one
     /// direction, with their bounding-sphere `intervals`), from where the
     /// first of them enters the bounding sphere; the walk's output, 0 and
-    /// no estimates, if none does.
+    /// no estimates, if none does or if the run is a single ray.
     fn start(run: &[Ray], intervals: &[Option<(Real, Real)>]) -> Result<ConeWalk, (Real, u32)> {
+        if run.len() == 1 {
+            return Err((0.0, 0)); // a ray alone has no cone to share
+        }
         let (first, last) = (run[0], run[run.len() - 1]);
         let origin = (first.origin + last.origin) * 0.5;
         let dir = normalize_or(first.dir + last.dir, first.dir);
@@ -846,22 +877,34 @@ mod tests {
             .collect()
     }
 
-    /// Bands of camera rays four neighbouring pixels high and `width` wide
-    /// (a multiple of 4), each band's rays block by block, 4×4 pixels to a
-    /// block, as the renderer orders them: runs of 16 are the blocks. The
-    /// bands are far apart.
-    fn camera_blocks(origin: DVec3, bands: usize, width: usize, angle: Real) -> Vec<Vec<Ray>> {
+    /// Bands of camera rays four neighbouring pixels high and `width` wide,
+    /// each band's rays in the renderer's order (`cone_blocks` for the
+    /// default cone of 16 rays, blocks of 4×4 pixels), with its blocks'
+    /// sizes (narrower at the right edge where 4 does not divide `width`).
+    /// The bands are far apart.
+    fn camera_blocks(
+        origin: DVec3,
+        bands: usize,
+        width: usize,
+        angle: Real,
+    ) -> Vec<(Vec<Ray>, Vec<u32>)> {
         let ray = pinhole(origin, angle);
+        let block = cone_block(MarchSettings::default().cone_rays);
         (0..bands)
             .map(|band| {
                 let v0 = (band as Real - bands as Real / 2.0) * 97.0;
-                (0..width / 4)
-                    .flat_map(|block| (0..4).flat_map(move |y| (0..4).map(move |x| (block, y, x))))
-                    .map(|(block, y, x)| {
-                        let u = (4 * block + x) as Real - width as Real / 2.0;
-                        ray(u, v0 + y as Real)
+                let (mut order, mut runs) = (vec![], vec![]);
+                cone_blocks(width, CONE_BLOCK_ROWS, block, &mut order, &mut runs);
+                let rays = order
+                    .iter()
+                    .map(|&p| {
+                        ray(
+                            (p % width) as Real - width as Real / 2.0,
+                            v0 + (p / width) as Real,
+                        )
                     })
-                    .collect()
+                    .collect();
+                (rays, runs)
             })
             .collect()
     }
@@ -895,16 +938,17 @@ mod tests {
         let settings = MarchSettings::default();
         let (mut advanced, mut crossings) = (0, 0);
         let origin = DVec3::new(0.3, -2.6, 0.4);
-        let layouts = [
-            (camera_rows(origin, 6, 32, 2e-3), &[8, 16][..]),
-            (camera_blocks(origin, 3, 32, 2e-3), &[16][..]),
-        ];
+        // Each set of rays with its runs' lengths.
+        let mut layouts: Vec<(Vec<Ray>, Vec<u32>)> = vec![];
+        for rays in camera_rows(origin, 6, 32, 2e-3) {
+            for n in [8, 16] {
+                layouts.push((rays.clone(), vec![n; rays.len() / n as usize]));
+            }
+        }
+        layouts.extend(camera_blocks(origin, 3, 32, 2e-3));
         for f in &cone_test_fractals() {
             for aperture in [0.0, 0.01] {
-                for (rays, run_lengths) in layouts
-                    .iter()
-                    .flat_map(|(groups, runs)| groups.iter().map(move |rays| (rays, *runs)))
-                {
+                for (rays, runs) in &layouts {
                     let rays: Vec<Ray> = rays
                         .iter()
                         .copied()
@@ -926,28 +970,23 @@ mod tests {
                         .iter()
                         .map(|ray| march_by_membership(ray, f, &settings, 0.25, 1e-9, 100_000).0)
                         .collect();
-                    for &run_length in run_lengths {
-                        let runs = rays
-                            .chunks(run_length)
-                            .zip(first_crossings.chunks(run_length));
-                        for (run, first_crossings) in runs {
-                            let (t_free, _) = walk_one(
-                                ConeWalk::start(run, &intervals(run, &settings)),
-                                f,
-                                &settings,
-                            );
-                            for (ray, crossing) in run.iter().zip(first_crossings) {
-                                let enter = settings
-                                    .interval(ray)
-                                    .map_or(Real::INFINITY, |(enter, _)| enter);
-                                if aperture == 0.0 {
-                                    advanced +=
-                                        (t_free > enter + 20.0 * ray.footprint(enter)) as usize;
-                                }
-                                if let Some(t) = *crossing {
-                                    crossings += 1;
-                                    assert!(t_free <= t, "{f:?}: cone to {t_free}, surface at {t}");
-                                }
+                    for span in run_spans(runs) {
+                        let run = &rays[span.clone()];
+                        let (t_free, _) = walk_one(
+                            ConeWalk::start(run, &intervals(run, &settings)),
+                            f,
+                            &settings,
+                        );
+                        for (ray, crossing) in run.iter().zip(&first_crossings[span]) {
+                            let enter = settings
+                                .interval(ray)
+                                .map_or(Real::INFINITY, |(enter, _)| enter);
+                            if aperture == 0.0 {
+                                advanced += (t_free > enter + 20.0 * ray.footprint(enter)) as usize;
+                            }
+                            if let Some(t) = *crossing {
+                                crossings += 1;
+                                assert!(t_free <= t, "{f:?}: cone to {t_free}, surface at {t}");
                             }
                         }
                     }
@@ -990,19 +1029,23 @@ mod tests {
     fn rays_after_a_cone_find_the_surface_they_find_alone() {
         let settings = MarchSettings::default();
         let origin = DVec3::new(-2.2, -1.1, 0.9);
-        // Rows of 64 in runs of 8 and in runs of uneven lengths; bands in
-        // blocks of 4×4 pixels (the default).
-        let uneven = vec![13, 7, 16, 1, 27];
+        // Rows of 64 in runs of 8 and in runs of uneven lengths, one of them
+        // a single ray; bands in blocks of 4×4 pixels (the default), 30
+        // pixels wide, so the last block of each band is 2×4.
+        let rows = |runs: &[u32]| -> Vec<(Vec<Ray>, Vec<u32>)> {
+            let rows = camera_rows(origin, 6, 64, 1.5e-3);
+            rows.into_iter().map(|rays| (rays, runs.to_vec())).collect()
+        };
         let cases = [
-            (camera_rows(origin, 6, 64, 1.5e-3), vec![8; 8]),
-            (camera_rows(origin, 6, 64, 1.5e-3), uneven),
-            (camera_blocks(origin, 3, 32, 1.5e-3), vec![16; 8]),
+            rows(&[8; 8]),
+            rows(&[13, 7, 16, 1, 27]),
+            camera_blocks(origin, 3, 30, 1.5e-3),
         ];
         for f in &cone_test_fractals() {
-            for (case, (groups, runs)) in cases.iter().enumerate() {
+            for (case, groups) in cases.iter().enumerate() {
                 let (mut both, mut near, mut differ, mut rays_seen) = (0, 0, 0, 0);
                 let mut evaluations = [0u64; 2];
-                for rays in groups {
+                for (rays, runs) in groups {
                     let mut marched = [(); 2].map(|_| vec![MarchResult::default(); rays.len()]);
                     let alone_runs = vec![1; rays.len()];
                     for (k, runs) in [&alone_runs, runs].into_iter().enumerate() {
@@ -1014,6 +1057,11 @@ mod tests {
                         rays.iter().map(|ray| march(ray, f, &settings)).collect();
                     // One ray a cone is every ray alone, to the bit.
                     assert_eq!(format!("{alone:?}"), format!("{:?}", marched[0]));
+                    // A run of one among longer runs marches alone too.
+                    for span in run_spans(runs).filter(|span| span.len() == 1) {
+                        let (a, c) = (&alone[span.start], &marched[1][span.start]);
+                        assert_eq!(format!("{a:?}"), format!("{c:?}"), "run of one at {span:?}");
+                    }
                     rays_seen += rays.len();
                     for ((ray, a), c) in rays.iter().zip(&alone).zip(&marched[1]) {
                         match (a.hit, c.hit) {
@@ -1068,6 +1116,44 @@ mod tests {
         );
         assert!(shapes.iter().all(|&(_, rows)| rows <= CONE_BLOCK_ROWS));
         assert_eq!(cone_block(MarchSettings::default().cone_rays), (4, 4));
+    }
+
+    #[test]
+    fn cone_blocks_cover_a_band_in_rectangles() {
+        // Widths that the block divides and that it does not, full and
+        // short bands, and every block shape the renderer uses.
+        for (w, rows) in [(8, 4), (10, 4), (7, 3), (5, 1), (1, 4)] {
+            for n in [1, 2, 4, 8, 12, 16, 32] {
+                let (bw, bh) = cone_block(n);
+                let (mut order, mut runs) = (vec![], vec![]);
+                cone_blocks(w, rows, (bw, bh), &mut order, &mut runs);
+                // Every pixel of the band exactly once.
+                let mut sorted = order.clone();
+                sorted.sort_unstable();
+                assert_eq!(
+                    sorted,
+                    (0..w * rows).collect::<Vec<_>>(),
+                    "{w}x{rows} n={n}"
+                );
+                // Each run is a rectangle of at most bw×bh pixels, row by row.
+                let mut at = 0;
+                for &run in &runs {
+                    let block = &order[at..at + run as usize];
+                    at += run as usize;
+                    let xs = block.iter().map(|p| p % w);
+                    let ys = block.iter().map(|p| p / w);
+                    let (x0, x1) = (xs.clone().min().unwrap(), xs.max().unwrap());
+                    let (y0, y1) = (ys.clone().min().unwrap(), ys.max().unwrap());
+                    assert!(x1 - x0 < bw && y1 - y0 < bh, "{w}x{rows} n={n}: {block:?}");
+                    assert_eq!(block.len(), (x1 - x0 + 1) * (y1 - y0 + 1), "{block:?}");
+                    assert!(block.windows(2).all(|p| p[0] < p[1]), "{block:?}");
+                }
+                assert_eq!(at, order.len());
+                // As few blocks as the band holds, the first a whole one.
+                assert_eq!(runs.len(), w.div_ceil(bw) * rows.div_ceil(bh));
+                assert_eq!(runs[0] as usize, bw.min(w) * bh.min(rows));
+            }
+        }
     }
 
     #[test]

@@ -620,7 +620,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
         // changes (a thread's bands and samples mostly share one).
         let layout = (w, rows, crate::march::cone_block(scene.cone_rays()));
         if *laid_out != Some(layout) {
-            cone_blocks(w, rows, layout.2, order, runs);
+            crate::march::cone_blocks(w, rows, layout.2, order, runs);
             *laid_out = Some(layout);
         }
         rays.clear();
@@ -783,33 +783,6 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
         (frame.on_row)();
     }
     stats
-}
-
-/// The `rows`×`w` pixels of a band (as offsets into its sums, row after
-/// row) into `order` block by block, `block` (columns, rows) at a time:
-/// down the band's groups of block rows, across each group a block after
-/// another, each block's pixels row by row; `runs` gets each block's size
-/// (narrower at the right edge, lower in a short band). A block's camera
-/// rays march one cone.
-fn cone_blocks(
-    w: usize,
-    rows: usize,
-    (bw, bh): (usize, usize),
-    order: &mut Vec<usize>,
-    runs: &mut Vec<u32>,
-) {
-    order.clear();
-    runs.clear();
-    for y in (0..rows).step_by(bh) {
-        let gh = bh.min(rows - y);
-        for x in (0..w).step_by(bw) {
-            let gw = bw.min(w - x);
-            for yy in y..y + gh {
-                order.extend(yy * w + x..yy * w + x + gw);
-            }
-            runs.push((gw * gh) as u32);
-        }
-    }
 }
 
 /// A band's working buffers (see `render_band`).
@@ -1138,44 +1111,6 @@ mod tests {
         assert!(render_frame(&closed, 0, 32, 24, &|| {}).colour == a.colour);
         // The lens costs marching only through its extra rays' paths: same sample count.
         assert_eq!(a.stats.samples, b.stats.samples);
-    }
-
-    #[test]
-    fn cone_blocks_cover_a_band_in_rectangles() {
-        // Widths that the block divides and that it does not, full and
-        // short bands, and every block shape the renderer uses.
-        for (w, rows) in [(8, 4), (10, 4), (7, 3), (5, 1), (1, 4)] {
-            for n in [1, 2, 4, 8, 12, 16, 32] {
-                let (bw, bh) = crate::march::cone_block(n);
-                let (mut order, mut runs) = (vec![], vec![]);
-                cone_blocks(w, rows, (bw, bh), &mut order, &mut runs);
-                // Every pixel of the band exactly once.
-                let mut sorted = order.clone();
-                sorted.sort_unstable();
-                assert_eq!(
-                    sorted,
-                    (0..w * rows).collect::<Vec<_>>(),
-                    "{w}x{rows} n={n}"
-                );
-                // Each run is a rectangle of at most bw×bh pixels, row by row.
-                let mut at = 0;
-                for &run in &runs {
-                    let block = &order[at..at + run as usize];
-                    at += run as usize;
-                    let xs = block.iter().map(|p| p % w);
-                    let ys = block.iter().map(|p| p / w);
-                    let (x0, x1) = (xs.clone().min().unwrap(), xs.max().unwrap());
-                    let (y0, y1) = (ys.clone().min().unwrap(), ys.max().unwrap());
-                    assert!(x1 - x0 < bw && y1 - y0 < bh, "{w}x{rows} n={n}: {block:?}");
-                    assert_eq!(block.len(), (x1 - x0 + 1) * (y1 - y0 + 1), "{block:?}");
-                    assert!(block.windows(2).all(|p| p[0] < p[1]), "{block:?}");
-                }
-                assert_eq!(at, order.len());
-                // As few blocks as the band holds, the first a whole one.
-                assert_eq!(runs.len(), w.div_ceil(bw) * rows.div_ceil(bh));
-                assert_eq!(runs[0] as usize, bw.min(w) * bh.min(rows));
-            }
-        }
     }
 
     #[test]
