@@ -255,6 +255,18 @@ pub struct Work {
     pub frames: u32,
     pub pixels: u64,
     pub stats: FrameStats,
+    /// Floating-point operations counted as they were done (the ceiling
+    /// loop's); where `None`, the DE iterations' (`flops`).
+    pub counted_flops: Option<u64>,
+}
+
+impl Work {
+    /// The floating-point operations done: those counted, or else
+    /// `FLOPS_PER_POWER8_ITERATION` for each DE iteration.
+    pub fn flops(&self) -> u64 {
+        self.counted_flops
+            .unwrap_or(self.stats.de_iterations * FLOPS_PER_POWER8_ITERATION)
+    }
 }
 
 /// Renders every frame of `timeline` at `size` in this process, keeping only the counts.
@@ -271,6 +283,7 @@ pub fn count_work(timeline: &Timeline, size: (u32, u32)) -> Work {
         frames: timeline.frame_count,
         pixels: size.0 as u64 * size.1 as u64 * timeline.frame_count as u64,
         stats,
+        counted_flops: None,
     }
 }
 
@@ -379,17 +392,12 @@ fn timing_row(mut row: Row, runs: &[Measurement], work: Option<&Work>, peak: &Pe
         row.de_evaluations_per_s = w.stats.de_evaluations as f64 / t;
         row.de_iterations = w.stats.de_iterations;
         row.de_iterations_per_s = w.stats.de_iterations as f64 / t;
-        let gflops = row.de_iterations_per_s * FLOPS_PER_POWER8_ITERATION as f64 / 1e9;
-        set_gflops(&mut row, gflops, peak);
+        let gflops = w.flops() as f64 / t / 1e9;
+        row.gflops = gflops;
+        row.peak_gflops = peak.gflops_for(row.threads);
+        row.fraction_of_peak = gflops / row.peak_gflops.max(1e-9);
     }
     row
-}
-
-/// Sets `row`'s GFLOP/s and its share of the nominal peak of its threads.
-fn set_gflops(row: &mut Row, gflops: f64, peak: &Peak) {
-    row.gflops = gflops;
-    row.peak_gflops = peak.gflops_for(row.threads);
-    row.fraction_of_peak = gflops / row.peak_gflops.max(1e-9);
 }
 
 fn mpixels_per_s(pixels: u64, seconds: f64) -> f64 {
@@ -660,6 +668,7 @@ fn render_only_rows(
             frames: 1,
             pixels: w as u64 * h as u64,
             stats,
+            counted_flops: None,
         })
         .collect();
     pool_rows(
@@ -950,9 +959,9 @@ pub fn kernel_rows(
     // their chunks (one fork and join, not one per pass of a millisecond or
     // two, whose wake-ups and ragged ends the kernel's scaling would carry):
     // their orbit iterations.
-    let pass = |pool: &rayon::ThreadPool, passes: usize| {
+    let pass = |pool: &rayon::ThreadPool, passes: u64| {
         pool.install(|| {
-            (0..passes * chunks)
+            (0..passes as usize * chunks)
                 .into_par_iter()
                 .map(|k| {
                     let chunk = &points[(k % chunks) * CHUNK..][..CHUNK];
@@ -979,34 +988,16 @@ pub fn kernel_rows(
                 .sum::<u64>()
         })
     };
-    let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
-        return Vec::new();
-    };
-    // Every pool warmed once (its threads started, the points in cache);
-    // then samples of enough passes to last 0.2 s each on the widest pool
-    // (as a warm pass times them; longer on fewer threads), each sample
-    // one parallel loop.
-    // Each pool's own count of a pass's iterations (the same points, so
-    // the same count: the rows show it).
-    let iterations_per_pass: Vec<u64> = pools.iter().map(|(_, pool)| pass(pool, 1)).collect();
-    let start = Instant::now();
-    pass(widest, 1);
-    let passes = (0.2 / start.elapsed().as_secs_f64().max(1e-6))
-        .ceil()
-        .max(1.0) as usize;
-    let walls = timed_in_process(options.runs, pools.len(), |i| {
-        pass(&pools[i].1, passes);
-    });
-    let works: Vec<Work> = iterations_per_pass
-        .iter()
-        .map(|&iterations| Work {
-            frames: 0,
-            pixels: 0,
+    let (passes, walls, iterations) = sampled_passes(pools, options, (1, 1), pass);
+    let works: Vec<Work> = iterations
+        .into_iter()
+        .map(|iterations| Work {
             stats: FrameStats {
-                de_evaluations: (chunks * CHUNK * passes) as u64,
-                de_iterations: iterations * passes as u64,
+                de_evaluations: (chunks * CHUNK) as u64 * passes,
+                de_iterations: iterations,
                 ..FrameStats::default()
             },
+            ..Work::default()
         })
         .collect();
     pool_rows(KERNEL, pools, walls, &works, &options.peak, base)
@@ -1080,27 +1071,46 @@ pub fn ceiling_rows(
         std::hint::black_box(done.iter().map(|d| d.0).sum::<f64>());
         done.iter().map(|d| d.1).sum()
     };
+    let (_, walls, flops) = sampled_passes(pools, options, (1 << 16, 1 << 22), pass);
+    let works: Vec<Work> = flops
+        .into_iter()
+        .map(|flops| Work {
+            counted_flops: Some(flops),
+            ..Work::default()
+        })
+        .collect();
+    pool_rows(CEILING, pools, walls, &works, &options.peak, base)
+}
+
+/// `pass(pool, amount)` timed on each of `pools`, as the kernel's and the
+/// ceiling's rows time it: `warm` on every pool first (its threads started,
+/// its data in cache); then `trial` on the widest pool, scaled to the
+/// amount that lasts about 0.2 s there (longer on fewer threads); then
+/// `options.runs` samples of that amount on each pool, alternating, each
+/// sample one call of `pass`. The amount, each pool's wall times, and what
+/// its last sample returned.
+fn sampled_passes<R: Default + Clone>(
+    pools: &[(usize, rayon::ThreadPool)],
+    options: &Options,
+    (warm, trial): (u64, u64),
+    pass: impl Fn(&rayon::ThreadPool, u64) -> R,
+) -> (u64, Vec<Vec<f64>>, Vec<R>) {
     let Some((_, widest)) = pools.iter().max_by_key(|(t, _)| *t) else {
-        return Vec::new();
+        return (0, Vec::new(), Vec::new());
     };
     for (_, pool) in pools {
-        pass(pool, 1 << 16);
+        pass(pool, warm);
     }
-    let trial = 1 << 22;
     let start = Instant::now();
     pass(widest, trial);
-    let rounds = (trial as f64 * 0.2 / start.elapsed().as_secs_f64().max(1e-6)).ceil() as u64;
-    let mut flops = vec![0; pools.len()];
+    let amount = (trial as f64 * 0.2 / start.elapsed().as_secs_f64().max(1e-6))
+        .ceil()
+        .max(1.0) as u64;
+    let mut done = vec![R::default(); pools.len()];
     let walls = timed_in_process(options.runs, pools.len(), |i| {
-        flops[i] = pass(&pools[i].1, rounds);
+        done[i] = pass(&pools[i].1, amount);
     });
-    let works = vec![Work::default(); pools.len()];
-    let mut rows = pool_rows(CEILING, pools, walls, &works, &options.peak, base);
-    for (row, flops) in rows.iter_mut().zip(flops) {
-        let gflops = flops as f64 / row.median_s.max(1e-9) / 1e9;
-        set_gflops(row, gflops, &options.peak);
-    }
-    rows
+    (amount, walls, done)
 }
 
 /// The rows as CSV, one header line first.
