@@ -292,8 +292,13 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Bench(args) => bench(args),
         Command::Measure { program, args } => measure(&program, &args),
     };
-    // A reader that went away ends the command quietly (`status` has
-    // already turned it into its exit status).
+    // `status` has already turned a closed output into its exit status.
+    unless_output_closed(result)
+}
+
+/// `result`, except that a reader that went away (`OutputClosed`) ends the
+/// command quietly, as success.
+fn unless_output_closed(result: anyhow::Result<()>) -> anyhow::Result<()> {
     match result {
         Err(error) if error.is::<OutputClosed>() => Ok(()),
         other => other,
@@ -1051,11 +1056,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         }
         Ok(())
     };
-    if let Err(e) = report() {
-        if !e.is::<OutputClosed>() {
-            return Err(e);
-        }
-    }
+    unless_output_closed(report())?;
     if complete == total {
         Ok(())
     } else {

@@ -439,9 +439,11 @@ struct OcclusionWalk {
     footprint: Real,
     radius: Real,
     strength: Real,
-    /// The sample to take next, 1 to `n`.
+    /// The sample to take next, 1 to `n`, and how far along the normal it
+    /// lies (`distance`).
     k: u32,
     n: u32,
+    along: Real,
     blocked: Real,
     weights: Real,
     weight: Real,
@@ -457,7 +459,7 @@ impl OcclusionWalk {
         t: Real,
         footprint: Real,
     ) -> OcclusionWalk {
-        OcclusionWalk {
+        let mut walk = OcclusionWalk {
             index,
             point,
             normal,
@@ -467,11 +469,14 @@ impl OcclusionWalk {
             strength: ao.strength as Real,
             k: 1,
             n: ao.samples.max(1),
+            along: 0.0,
             blocked: 0.0,
             weights: 0.0,
             weight: 1.0,
             spent: 0,
-        }
+        };
+        walk.along = walk.distance();
+        walk
     }
 
     /// How far along the normal sample `k` lies.
@@ -484,7 +489,7 @@ impl crate::march::Walk for OcclusionWalk {
     type Output = (usize, (f32, u64));
 
     fn next_point(&self) -> (DVec3, Real) {
-        (self.point + self.normal * self.distance(), self.footprint)
+        (self.point + self.normal * self.along, self.footprint)
     }
 
     fn advance(
@@ -494,7 +499,7 @@ impl crate::march::Walk for OcclusionWalk {
         _: &Fractal,
         _: &MarchSettings,
     ) -> Option<Self::Output> {
-        let d = self.distance();
+        let d = self.along;
         self.spent += e.orbits as u64;
         // Where the field is nearer than the distance stepped, geometry crowds
         // in. The estimate is about half the true distance near the surface
@@ -504,6 +509,7 @@ impl crate::march::Walk for OcclusionWalk {
         self.weight *= 0.6;
         if self.k < self.n {
             self.k += 1;
+            self.along = self.distance();
             return None;
         }
         let ambient = 1.0 - self.strength * self.blocked / self.weights;
