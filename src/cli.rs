@@ -507,8 +507,7 @@ impl Plan {
     }
 
     fn record(&self) -> anyhow::Result<output::JobRecord> {
-        let text = std::fs::read_to_string(&self.timeline.source)
-            .map_err(|e| Error::io(&self.timeline.source, e))?;
+        let text = crate::timeline::read_text(&self.timeline.source)?;
         Ok(output::JobRecord {
             renderer: format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
             timeline_path: std::fs::canonicalize(&self.timeline.source)
@@ -991,7 +990,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     }
     let total = plan.range.len();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
-    let changed = std::fs::read_to_string(&plan.timeline.source)
+    let changed = crate::timeline::read_text(&plan.timeline.source)
         .ok()
         .zip(output::JobRecord::read(&plan.out_dir).ok())
         .is_some_and(|(now, job)| now != job.timeline_text);

@@ -27,12 +27,13 @@ pub enum Error {
     /// A command-line value is unusable (frame range, size, pixel).
     #[error("{option}: {message}")]
     Usage { option: String, message: String },
-    /// Reading or writing a file failed.
-    #[error("{}: {source}", path.display())]
+    /// Reading or writing a file failed. The system's message is part of
+    /// this one, not a source of its own, so an error chain printed whole
+    /// (`{:#}`) says it once.
+    #[error("{}: {cause}", path.display())]
     Io {
         path: PathBuf,
-        #[source]
-        source: std::io::Error,
+        cause: std::io::Error,
     },
     /// Encoding or decoding an image failed.
     #[error("{}: {message}", path.display())]
@@ -43,7 +44,7 @@ impl Error {
     pub fn io(path: impl Into<PathBuf>, source: std::io::Error) -> Self {
         Error::Io {
             path: path.into(),
-            source,
+            cause: source,
         }
     }
 

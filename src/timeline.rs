@@ -82,8 +82,38 @@ struct TimelineFile {
     size: (u32, u32),
     #[serde(default)]
     scene: Scene,
-    #[serde(default)]
+    #[serde(default, deserialize_with = "tracks_once_each")]
     tracks: BTreeMap<String, TrackSpec>,
+}
+
+/// The tracks by parameter name, refusing a name given twice (a map would
+/// keep the last and drop the other without a word).
+fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
+    deserializer: D,
+) -> std::result::Result<BTreeMap<String, TrackSpec>, D::Error> {
+    struct Tracks;
+    impl<'de> serde::de::Visitor<'de> for Tracks {
+        type Value = BTreeMap<String, TrackSpec>;
+        fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+            f.write_str("a map of tracks by parameter name")
+        }
+        fn visit_map<A: serde::de::MapAccess<'de>>(
+            self,
+            mut map: A,
+        ) -> std::result::Result<Self::Value, A::Error> {
+            let mut tracks = BTreeMap::new();
+            while let Some(name) = map.next_key::<String>()? {
+                if tracks.contains_key(&name) {
+                    return Err(serde::de::Error::custom(format!(
+                        "the track \"{name}\" is given twice; one track per parameter"
+                    )));
+                }
+                tracks.insert(name, map.next_value()?);
+            }
+            Ok(tracks)
+        }
+    }
+    deserializer.deserialize_map(Tracks)
 }
 
 /// Every parameter a track can animate, with its number of components.
@@ -282,10 +312,61 @@ pub struct Timeline {
     pub tracks: Vec<Track>,
 }
 
+/// The longest file read as a timeline: real ones are a few kilobytes, and
+/// a file past this (`/dev/zero`) is refused before it fills the memory.
+const MAX_TIMELINE_BYTES: u64 = 16 << 20;
+
+/// A timeline file's text: at most `MAX_TIMELINE_BYTES`, UTF-8 (a byte that
+/// is not is a syntax error at its line and column), a leading byte-order
+/// mark dropped.
+pub fn read_text(path: &Path) -> Result<String> {
+    use std::io::Read as _;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)
+        .and_then(|file| file.take(MAX_TIMELINE_BYTES + 1).read_to_end(&mut bytes))
+        .map_err(|e| Error::io(path, e))?;
+    let syntax = |line, column, message: String| Error::Syntax {
+        file: path.to_path_buf(),
+        line,
+        column,
+        message,
+    };
+    if bytes.len() as u64 > MAX_TIMELINE_BYTES {
+        let mib = MAX_TIMELINE_BYTES >> 20;
+        return Err(syntax(
+            1,
+            1,
+            format!("longer than {mib} MiB: not a timeline"),
+        ));
+    }
+    let text = String::from_utf8(bytes).map_err(|e| {
+        let before = &e.as_bytes()[..e.utf8_error().valid_up_to()];
+        let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+        let line_start = before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |i| i + 1);
+        // Columns count characters, as RON's do.
+        let column = String::from_utf8_lossy(&before[line_start..])
+            .chars()
+            .count()
+            + 1;
+        syntax(
+            line,
+            column,
+            "not UTF-8 text: save the timeline as UTF-8".into(),
+        )
+    })?;
+    Ok(match text.strip_prefix('\u{feff}') {
+        Some(rest) => rest.to_string(),
+        None => text,
+    })
+}
+
 impl Timeline {
     /// Reads, parses and validates a timeline file.
     pub fn load(path: &Path) -> Result<Timeline> {
-        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        let text = read_text(path)?;
         Timeline::parse(&text, path)
     }
 
@@ -313,10 +394,13 @@ impl Timeline {
             )
         };
 
-        if !(file.fps.is_finite() && file.fps > 0.0) {
+        // Past a thousand frames a second no player or encoder keeps up
+        // (ffmpeg's -framerate among them).
+        const MAX_FPS: Real = 1000.0;
+        if !(file.fps > 0.0 && file.fps <= MAX_FPS) {
             return Err(top(
                 "fps",
-                format!("must be a positive number, got {}", file.fps),
+                format!("must be a number in (0, {MAX_FPS}], got {}", file.fps),
             ));
         }
         let (width, height) = file.size;

@@ -33,6 +33,69 @@ fn syntax_error_points_at_line_and_column() {
 }
 
 #[test]
+fn a_track_given_twice_is_refused_not_dropped() {
+    // A map would keep the second and drop the first without a word.
+    let text = tiny_timeline(2, 6.0).replace(
+        "    },\n)",
+        "        \"fractal.power\": (keys: [(time: 0, value: 3)]),\n    },\n)",
+    );
+    assert_eq!(text.matches("\"fractal.power\"").count(), 2);
+    rejected(
+        &text,
+        &[],
+        3,
+        &["bad.ron:8:", "\"fractal.power\" is given twice"],
+    );
+}
+
+#[test]
+fn a_timeline_that_is_not_utf8_is_a_syntax_error_at_its_place() {
+    // A Latin-1 "é" (byte 0xE9) in a comment at the end of line 2.
+    let text = tiny_timeline(2, 6.0).replacen("fps: 24,", "fps: 24, // caf\u{1}", 1);
+    let bytes: Vec<u8> = text
+        .bytes()
+        .map(|b| if b == 1 { 0xE9 } else { b })
+        .collect();
+    let d = Dir::new();
+    std::fs::write(d.path().join("bad.ron"), &bytes).unwrap();
+    let out = d.run(&["render", "bad.ron"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    let column = "    fps: 24, // caf".len() + 1;
+    assert!(
+        err.contains(&format!("bad.ron:2:{column}: not UTF-8")),
+        "{err}"
+    );
+    assert!(!d.path().join("out").exists());
+    // A byte-order mark before the text is no error.
+    d.write("marked.ron", &format!("\u{feff}{}", tiny_timeline(1, 6.0)));
+    d.ok(&["info", "marked.ron"]);
+}
+
+#[test]
+fn a_missing_file_is_named_with_the_systems_reason_once() {
+    let d = Dir::new();
+    let out = d.run(&["info", "nowhere.ron"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.starts_with("error: nowhere.ron: "), "{err}");
+    // The system's own words for it ("No such file or directory (os
+    // error 2)" on Linux), once.
+    let system = std::fs::File::open(d.path().join("nowhere.ron"))
+        .unwrap_err()
+        .to_string();
+    assert_eq!(err.matches(&system).count(), 1, "{err}");
+}
+
+#[test]
+fn frame_rates_past_a_thousand_are_refused() {
+    for fps in ["1e300", "4294967296", "1000.5"] {
+        let text = tiny_timeline(2, 6.0).replace("fps: 24", &format!("fps: {fps}"));
+        rejected(&text, &[], 3, &["bad.ron:2: fps", "(0, 1000]"]);
+    }
+}
+
+#[test]
 fn unknown_field_is_named() {
     rejected(
         &tiny_timeline(2, 6.0).replace("fractal:", "fractl:"),
