@@ -116,6 +116,12 @@ fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
     deserializer.deserialize_map(Tracks)
 }
 
+/// The largest Julia constant component a scene may have (see `validate`).
+const MAX_JULIA: Real = 1e15;
+
+/// The largest bounding sphere a scene may have (see `validate`).
+const MAX_BOUNDING_RADIUS: Real = 1e6;
+
 /// Every parameter a track can animate, with its number of components.
 pub const PARAMETERS: &[(&str, usize)] = &[
     ("camera.position", 3),
@@ -815,9 +821,14 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         )
     })?;
     if let Some(k) = f.julia {
-        check(finite3(k), "fractal.julia", || {
-            format!("must be finite, got {k}")
-        })?;
+        // Past a bailout plus its power every point escapes at the first
+        // step and the set is empty; far past it |z|² overflows (f32 near
+        // 1e19, f64 near 1e154), which would read as a surface.
+        check(
+            finite3(k) && k.abs().max_element() <= MAX_JULIA,
+            "fractal.julia",
+            || format!("each component must be finite and within ±{MAX_JULIA:e}, got {k}"),
+        )?;
     }
     let q = &s.quality;
     for (field, v) in [
@@ -827,6 +838,18 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     ] {
         positive(v, field)?;
     }
+    // The set lies within the bailout, a few units across; a sphere far
+    // larger leaves rays to run out of steps in empty space.
+    check(
+        q.bounding_radius <= MAX_BOUNDING_RADIUS,
+        "quality.bounding_radius",
+        || {
+            format!(
+                "must be at most {MAX_BOUNDING_RADIUS:e}, got {}",
+                q.bounding_radius
+            )
+        },
+    )?;
     check(
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
         "quality.fudge",

@@ -88,6 +88,33 @@ fn a_missing_file_is_named_with_the_systems_reason_once() {
 }
 
 #[test]
+fn values_that_would_draw_a_surface_where_there_is_none_are_refused() {
+    // A Julia constant whose |z|² overflows, in a scene and through a
+    // track; a bounding sphere rays run out of steps in.
+    let julia = "fractal: (iterations: 8, julia: Some((1e154, 1e154, 1e154)))";
+    rejected(
+        &tiny_timeline(2, 6.0).replace("fractal: (iterations: 8)", julia),
+        &[],
+        3,
+        &["bad.ron:5:", "fractal.julia", "1e15"],
+    );
+    let track = "\"fractal.julia\": (keys: [(time: 0, value: (0.3, 0, 0)), (time: 1, value: (1e20, 0, 0))]),\n    },\n)";
+    rejected(
+        &tiny_timeline(2, 6.0).replace("    },\n)", track),
+        &[],
+        3,
+        &["bad.ron", "frame 1", "fractal.julia"],
+    );
+    let big = "fractal: (iterations: 8), quality: (bounding_radius: 1e100))";
+    rejected(
+        &tiny_timeline(2, 6.0).replace("fractal: (iterations: 8))", big),
+        &[],
+        3,
+        &["bad.ron:5:", "quality.bounding_radius"],
+    );
+}
+
+#[test]
 fn frame_rates_past_a_thousand_are_refused() {
     for fps in ["1e300", "4294967296", "1000.5"] {
         let text = tiny_timeline(2, 6.0).replace("fps: 24", &format!("fps: {fps}"));
