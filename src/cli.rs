@@ -536,7 +536,7 @@ impl Plan {
         } else {
             self.timeline.scenes_for_frame(frame)
         };
-        let hash = output::frame_hash(&scenes, frame, self.width, self.height, &self.aovs);
+        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
         (scenes, hash)
     }
 
@@ -546,9 +546,10 @@ impl Plan {
 
     /// Whether every format of `frame` exists and was made from these inputs.
     fn is_complete(&self, frame: u32, hash: &str) -> bool {
-        self.formats
-            .iter()
-            .all(|&f| output::is_current(&self.path(frame, f), f, hash))
+        self.formats.iter().all(|&f| {
+            let key = output::stored_key(f, hash, &self.aovs);
+            output::is_current(&self.path(frame, f), f, &key)
+        })
     }
 
     /// Renders one frame and writes every format. A frame of one sample per
@@ -690,6 +691,46 @@ pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(
     Ok((index, count))
 }
 
+/// Refuses a render into a folder of frames from another timeline (by file
+/// name) or of another size, by its job record: the render would replace
+/// them, or leave two sequences mixed under one record. An edited timeline
+/// of the same name and size is the same sequence (its changed frames
+/// re-render).
+fn same_sequence(out_dir: &Path, record: &output::JobRecord) -> anyhow::Result<()> {
+    let Ok(old) = output::JobRecord::read(out_dir) else {
+        return Ok(());
+    };
+    let name = |r: &output::JobRecord| r.timeline_path.file_name().map(|n| n.to_os_string());
+    let size = |r: &output::JobRecord| (r.width, r.height);
+    if name(&old) == name(record) && size(&old) == size(record) {
+        return Ok(());
+    }
+    let frames: usize = [Format::Png, Format::Exr]
+        .into_iter()
+        .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
+        .sum();
+    if frames == 0 {
+        return Ok(());
+    }
+    let what = |r: &output::JobRecord| {
+        let name = r.timeline_path.file_name().unwrap_or_default();
+        format!("{} at {}x{}", name.to_string_lossy(), r.width, r.height)
+    };
+    Err(Error::usage(
+        "--out",
+        format!(
+            "{} holds {frames} frame file(s) of {} (by its {}); rendering {} there would \
+             replace them or mix two sequences in one folder: choose another folder with \
+             --out, or pass --force to replace them",
+            out_dir.display(),
+            what(&old),
+            output::JOB_FILE,
+            what(record),
+        ),
+    )
+    .into())
+}
+
 fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Everything is checked before the output folder is touched.
     let plan = Plan::new(&args.timeline, &args.sequence)?;
@@ -701,6 +742,9 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .transpose()?;
     let record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
+    if !args.force {
+        same_sequence(&out_dir, &record)?;
+    }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     record.write(&out_dir)?;
     let stale = output::remove_stale_partials(&out_dir)?;

@@ -64,6 +64,18 @@ pub enum Aov {
     Steps,
 }
 
+impl Aov {
+    /// The layer's name, as `--aov` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Aov::Normal => "normal",
+            Aov::Albedo => "albedo",
+            Aov::Traps => "traps",
+            Aov::Steps => "steps",
+        }
+    }
+}
+
 /// The render layers `aovs` need.
 pub fn layers_for(aovs: &[Aov]) -> crate::render::Layers {
     crate::render::Layers {
@@ -89,14 +101,9 @@ pub fn frame_pattern(format: Format) -> String {
 
 /// Hash of everything that decides a frame's pixels: the effective scenes
 /// (one, or one per sample under motion blur), the frame index (it seeds the
-/// sampler), the size and the renderer's revision.
-pub fn frame_hash(
-    scenes: &[Scene],
-    frame_index: u32,
-    width: u32,
-    height: u32,
-    aovs: &[Aov],
-) -> String {
+/// sampler), the size and the renderer's revision. Not the extra EXR
+/// layers, which add channels but change no pixel (`stored_key`).
+pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
     #[derive(Serialize)]
     struct Inputs<'a> {
         renderer: &'a str,
@@ -105,7 +112,6 @@ pub fn frame_hash(
         width: u32,
         height: u32,
         scenes: &'a [Scene],
-        aovs: &'a [Aov],
     }
     let inputs = Inputs {
         renderer: env!("CARGO_PKG_VERSION"),
@@ -114,7 +120,6 @@ pub fn frame_hash(
         width,
         height,
         scenes,
-        aovs,
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);
@@ -168,9 +173,23 @@ fn png_is_whole(path: &Path) -> bool {
         && tail == IEND
 }
 
-/// Whether `path` holds a finished frame made from inputs with this `hash`.
-pub fn is_current(path: &Path, format: Format, hash: &str) -> bool {
-    stored_hash(path, format).as_deref() == Some(hash)
+/// What a frame file of `format` records of its inputs: the frame's `hash`,
+/// and for an EXR the extra layers it holds too (`hash+normal,steps`), so
+/// asking for other layers re-renders the EXR but not the PNG beside it.
+pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
+    match format {
+        Format::Exr if !aovs.is_empty() => {
+            let names: Vec<&str> = aovs.iter().map(|a| a.name()).collect();
+            format!("{hash}+{}", names.join(","))
+        }
+        _ => hash.to_string(),
+    }
+}
+
+/// Whether `path` holds a finished frame whose recorded inputs are `key`
+/// (`stored_key`).
+pub fn is_current(path: &Path, format: Format, key: &str) -> bool {
+    stored_hash(path, format).as_deref() == Some(key)
 }
 
 /// Writes `film` as `path` in `format`, atomically: the bytes go to a
@@ -188,9 +207,10 @@ pub fn write_frame(
         path: temp.to_path_buf(),
         message,
     };
+    let key = stored_key(format, hash, aovs);
     write_atomic(path, |writer, temp| match format {
-        Format::Png => encode_png(writer, film, hash).map_err(|m| image_error(temp, m)),
-        Format::Exr => encode_exr(writer, film, hash, aovs).map_err(|m| image_error(temp, m)),
+        Format::Png => encode_png(writer, film, &key).map_err(|m| image_error(temp, m)),
+        Format::Exr => encode_exr(writer, film, &key, aovs).map_err(|m| image_error(temp, m)),
     })
 }
 
@@ -1074,19 +1094,23 @@ mod tests {
     #[test]
     fn hash_changes_with_any_input() {
         let s = Scene::default();
-        let h = frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[]);
+        let h = frame_hash(std::slice::from_ref(&s), 0, 4, 3);
         assert_eq!(h.len(), 64);
-        assert_eq!(h, frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[]));
-        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 1, 4, 3, &[]));
-        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 0, 5, 3, &[]));
-        assert_ne!(h, frame_hash(&[s.clone(), s.clone()], 0, 4, 3, &[]));
-        assert_ne!(
-            h,
-            frame_hash(std::slice::from_ref(&s), 0, 4, 3, &[Aov::Normal])
-        );
+        assert_eq!(h, frame_hash(std::slice::from_ref(&s), 0, 4, 3));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 1, 4, 3));
+        assert_ne!(h, frame_hash(std::slice::from_ref(&s), 0, 5, 3));
+        assert_ne!(h, frame_hash(&[s.clone(), s.clone()], 0, 4, 3));
         let mut t = s.clone();
         t.fractal.power = 8.000001;
-        assert_ne!(h, frame_hash(&[t], 0, 4, 3, &[]));
+        assert_ne!(h, frame_hash(&[t], 0, 4, 3));
+        // Extra layers are the EXR's alone: its key names them, in order.
+        let layers = [Aov::Normal, Aov::Steps];
+        assert_eq!(stored_key(Format::Png, &h, &layers), h);
+        assert_eq!(stored_key(Format::Exr, &h, &[]), h);
+        assert_eq!(
+            stored_key(Format::Exr, &h, &layers),
+            format!("{h}+normal,steps")
+        );
     }
 
     #[test]

@@ -1,6 +1,6 @@
 //! PNG and EXR output decode, with the channels and metadata promised.
 
-use crate::util::{tiny_timeline, Dir};
+use crate::util::{stderr, tiny_timeline, Dir};
 
 #[test]
 fn png_and_exr_decode_with_expected_channels() {
@@ -96,4 +96,23 @@ fn extra_layers_are_written_only_when_asked() {
         d.exr("out/t/frame_00000.exr").names(),
         ["A", "B", "G", "R", "Z"]
     );
+}
+
+#[test]
+fn extra_layers_decide_the_exr_but_not_the_png() {
+    // The layers add EXR channels and change no pixel: a PNG rendered
+    // beside an EXR with layers is current without them, and an EXR is
+    // current for the same set of layers in any order, not for another.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    d.ok(&["render", "t.ron", "--format", "exr,png", "--aov", "normal"]);
+    // Whether a render with these options found every frame current.
+    let current = |options: &[&str]| {
+        let out = d.ok(&[&["render", "t.ron"], options].concat());
+        stderr(&out).contains("2 of 2 frames already complete")
+    };
+    assert!(current(&["--format", "png"]));
+    assert!(!current(&["--format", "exr", "--aov", "normal,steps"]));
+    assert!(current(&["--format", "exr", "--aov", "steps,normal"]));
+    assert!(!current(&["--format", "exr"]));
 }

@@ -64,13 +64,52 @@ fn changed_timeline_rerenders_only_what_changed() {
     );
     assert!(d.bytes("out/t/frame_00002.png") != old, "frame unchanged");
     assert!(d.bytes("out/t/frame_00000.png") == frame0, "frame changed");
-    // A different size is a different frame too.
-    let out = d.ok(&["render", "t.ron", "--size", "40x20"]);
+    // A different size is a different sequence: refused, since it would
+    // replace the folder's frames, unless --force asks for that.
+    let before = d.bytes("out/t/frame_00002.png");
+    let out = d.run(&["render", "t.ron", "--size", "40x20"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("3 frame file(s) of t.ron at 48x27"), "{err}");
+    assert!(err.contains("rendering t.ron at 40x20"), "{err}");
+    assert!(d.bytes("out/t/frame_00002.png") == before, "frame replaced");
+    let out = d.ok(&["render", "t.ron", "--size", "40x20", "--force"]);
     assert!(
-        !stderr(&out).contains("already complete"),
+        stderr(&out).contains("3 frames rendered"),
         "{}",
         stderr(&out)
     );
+    assert!(d.bytes("out/t/frame_00002.png") != before, "frame kept");
+}
+
+#[test]
+fn another_timeline_is_not_rendered_over_a_folders_frames() {
+    // `render other.ron --out out/t` over t.ron's finished frames: refused,
+    // nothing touched, the job record still t.ron's; --force replaces them.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    d.write("other.ron", &tiny_timeline(2, 4.0));
+    d.ok(&["render", "t.ron"]);
+    let (frame, record) = (
+        d.bytes("out/t/frame_00001.png"),
+        d.bytes("out/t/mandelreel-job.json"),
+    );
+    let out = d.run(&["render", "other.ron", "--out", "out/t"]);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("of t.ron at 48x27") && err.contains("--force"),
+        "{err}"
+    );
+    assert!(d.bytes("out/t/frame_00001.png") == frame);
+    assert!(d.bytes("out/t/mandelreel-job.json") == record);
+    // An empty folder, or one with only another sequence's record, is free.
+    d.ok(&["render", "other.ron", "--out", "out/o"]);
+    std::fs::remove_file(d.path().join("out/o/frame_00000.png")).unwrap();
+    std::fs::remove_file(d.path().join("out/o/frame_00001.png")).unwrap();
+    d.ok(&["render", "t.ron", "--out", "out/o"]);
+    d.ok(&["render", "other.ron", "--out", "out/t", "--force"]);
+    assert!(d.bytes("out/t/frame_00001.png") != frame);
 }
 
 #[test]
