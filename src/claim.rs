@@ -63,9 +63,14 @@ pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
     serde_json::from_str(&text).ok()
 }
 
-/// Whether a claim's heartbeat is younger than `timeout`.
+/// Whether a claim's worker may still be at work: its heartbeat is younger
+/// than `timeout`, and it is not a process of this machine known to have
+/// ended (a worker stopped by Ctrl-C or `kill -9` leaves its claim behind;
+/// one on this machine is taken over at once, one elsewhere after the
+/// timeout).
 pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
-    now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64
+    let beating = now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64;
+    beating && !(record.host == crate::output::host_name() && crate::output::gone_here(record.pid))
 }
 
 /// Replaces `path` with `record`, atomically (temporary file, then rename).
@@ -396,6 +401,45 @@ mod tests {
             std::fs::read_dir(dir.path()).unwrap().next().is_none(),
             "nothing left behind"
         );
+    }
+
+    #[test]
+    fn a_claim_of_an_ended_process_on_this_machine_is_taken_over_at_once() {
+        // A worker stopped by Ctrl-C leaves a claim with a fresh heartbeat:
+        // on this machine its ended process shows, and the frame is free;
+        // while the process lives, and on any other machine, it is held.
+        if !Path::new("/proc/self").exists() {
+            return; // nothing tells an ended process without /proc
+        }
+        let dir = tempfile::tempdir().unwrap();
+        let timeout = Duration::from_secs(300);
+        let mut worker = std::process::Command::new("sleep")
+            .arg("30")
+            .spawn()
+            .unwrap();
+        let pid = worker.id();
+        let fresh = |host: String| ClaimRecord {
+            host,
+            pid,
+            token: format!("token-{pid}"),
+            heartbeat_ms: now_ms(),
+        };
+        let here = fresh(crate::output::host_name());
+        write_record(&claim_path(dir.path(), 4), &here).unwrap();
+        assert!(matches!(
+            try_claim(dir.path(), 4, timeout).unwrap(),
+            Attempt::Held(_)
+        ));
+        worker.kill().unwrap();
+        worker.wait().unwrap();
+        assert!(!is_live(&here, timeout));
+        assert!(is_live(&fresh("another-machine".into()), timeout));
+        let Attempt::Claimed(claim) = try_claim(dir.path(), 4, timeout).unwrap() else {
+            panic!("the ended worker's claim is taken over");
+        };
+        let ours = read_claim(&claim_path(dir.path(), 4)).unwrap();
+        assert_eq!(ours.pid, std::process::id());
+        drop(claim);
     }
 
     #[test]

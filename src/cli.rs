@@ -880,11 +880,16 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     if args.claim {
         // Take frames one at a time; wait out frames other live workers hold,
         // so a worker that dies has its frame taken over by one that did not.
+        // At most a second: a worker whose last frames others are
+        // finishing sees them done that soon.
         let poll = (args.claim_timeout / 4).clamp(
             std::time::Duration::from_millis(100),
-            std::time::Duration::from_secs(5),
+            std::time::Duration::from_secs(1),
         );
+        // The frames last reported as held by others (said once per change).
+        let mut waiting_for = Vec::new();
         loop {
+            let mut held = Vec::new();
             for (frame, scene, hash) in &todo {
                 if !args.force && plan.is_complete(*frame, hash) {
                     continue;
@@ -898,7 +903,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         drop(claim);
                     }
                     // Another live worker has it: look again next round.
-                    crate::claim::Attempt::Held(_) => {}
+                    crate::claim::Attempt::Held(other) => held.push((*frame, other)),
                 }
             }
             let done = todo
@@ -908,6 +913,21 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             // own fresh frames from old ones, so waiting would re-render them.
             if done || args.force {
                 break;
+            }
+            let frames: Vec<u32> = held.iter().map(|(frame, _)| *frame).collect();
+            if !args.quiet && !frames.is_empty() && frames != waiting_for {
+                let mut workers: Vec<String> = held
+                    .iter()
+                    .map(|(_, c)| format!("{}:{}", c.host, c.pid))
+                    .collect();
+                workers.dedup();
+                say(format!(
+                    "waiting for frame(s) {} claimed by {} (a claim without a heartbeat for {} s is taken over)",
+                    ranges(&frames),
+                    workers.join(", "),
+                    args.claim_timeout.as_secs_f64()
+                ));
+                waiting_for = frames;
             }
             std::thread::sleep(poll);
         }

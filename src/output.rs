@@ -783,11 +783,18 @@ fn writer_is_dead_here(name: &str) -> bool {
     let ours = writer_tag();
     let our_host = ours.split('.').next().unwrap_or_default();
     match (host, pid.and_then(|p| p.parse::<u32>().ok())) {
-        (Some(h), Some(pid)) if h == our_host && Path::new("/proc/self").exists() => {
-            pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists()
-        }
+        (Some(h), Some(pid)) if h == our_host => gone_here(pid),
         _ => false,
     }
+}
+
+/// Whether process `pid` of this machine is known to have ended: Linux's
+/// /proc has no such process (without /proc, nothing is known). A process
+/// of another machine, or one that reused the pid, is never taken for dead.
+pub fn gone_here(pid: u32) -> bool {
+    pid != std::process::id()
+        && Path::new("/proc/self").exists()
+        && !Path::new(&format!("/proc/{pid}")).exists()
 }
 
 /// How long ago `path` was last modified (`None` if that cannot be told).

@@ -236,7 +236,7 @@ fn four_claim_workers_render_every_frame_exactly_once() {
 }
 
 #[test]
-fn a_killed_workers_claim_is_taken_over_after_the_timeout() {
+fn a_killed_workers_claim_is_taken_over_at_once_on_its_machine() {
     let d = Dir::new();
     // Frames slow enough that the kill lands while a claim is held.
     d.write(
@@ -244,16 +244,7 @@ fn a_killed_workers_claim_is_taken_over_after_the_timeout() {
         &tiny_timeline(3, 6.0).replace("size: (48, 27)", "size: (480, 270)"),
     );
     let mut doomed = d.spawn_until(
-        &[
-            "render",
-            "t.ron",
-            "--claim",
-            "--claim-timeout",
-            "1",
-            "--threads",
-            "1",
-            "--quiet",
-        ],
+        &["render", "t.ron", "--claim", "--threads", "1", "--quiet"],
         "out/t",
         ".claim",
     );
@@ -266,22 +257,40 @@ fn a_killed_workers_claim_is_taken_over_after_the_timeout() {
         .collect();
     assert_eq!(held.len(), 1, "the dead worker's claim stays behind");
     let frame: u32 = held[0][7..12].parse().unwrap();
-    // A new worker waits out the dead claim's heartbeat, takes it over, and finishes.
-    let out = d.ok(&[
-        "render",
-        "t.ron",
-        "--claim",
-        "--claim-timeout",
-        "1",
-        "--threads",
-        "2",
-    ]);
-    assert!(
-        rendered_frames(&stderr(&out)).contains(&frame),
-        "{}",
-        stderr(&out)
-    );
+    // Its heartbeat is fresh, but its process has ended on this machine: a
+    // new worker takes the frame at once, not after the 300 s timeout, and
+    // status does not call it in progress.
+    let status = stdout(&d.run(&["status", "out/t"]));
+    assert!(!status.contains("in progress"), "{status}");
+    let out = d.ok(&["render", "t.ron", "--claim", "--threads", "2"]);
+    let err = stderr(&out);
+    assert!(rendered_frames(&err).contains(&frame), "{err}");
+    assert!(!err.contains("waiting for frame"), "{err}");
     d.ok(&["status", "out/t"]);
+}
+
+#[test]
+fn a_worker_says_which_frames_it_waits_for_and_takes_them_after_the_timeout() {
+    // A claim on another machine that stopped beating: the worker renders
+    // the other frames, says it waits for this one and who holds it, and
+    // takes it over once the claim is a timeout old.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
+    let now_ms = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_millis();
+    let claim =
+        format!("{{\"host\":\"node7\",\"pid\":42,\"token\":\"t1\",\"heartbeat_ms\":{now_ms}}}");
+    d.write("out/t/.frame_00001.claim", &claim);
+    let out = d.ok(&["render", "t.ron", "--claim", "--claim-timeout", "2"]);
+    let err = stderr(&out);
+    assert!(
+        err.contains("waiting for frame(s) 1 claimed by node7:42"),
+        "{err}"
+    );
+    assert_eq!(rendered_frames(&err).len(), 2, "{err}");
 }
 
 /// A tiny tmpfs, unmounted when dropped.
