@@ -188,8 +188,8 @@ pub struct SequenceArgs {
     /// Override the timeline's output size (nothing else is scaled).
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
-    /// Output formats, comma-separated.
-    #[arg(long, value_enum, value_delimiter = ',', default_value = "png")]
+    /// Output formats, comma-separated [default: png].
+    #[arg(long, value_enum, value_delimiter = ',')]
     pub format: Vec<Format>,
     /// Quick look: half width and height, one sample per pixel, in <out>/preview.
     #[arg(long)]
@@ -425,7 +425,12 @@ impl Plan {
         let mut aovs = args.aov.clone();
         aovs.sort();
         aovs.dedup();
-        if !aovs.is_empty() && !args.format.contains(&Format::Exr) {
+        let formats = if args.format.is_empty() {
+            vec![Format::Png]
+        } else {
+            args.format.clone()
+        };
+        if !aovs.is_empty() && !formats.contains(&Format::Exr) {
             return Err(
                 Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
             );
@@ -435,7 +440,7 @@ impl Plan {
             args.out.as_deref(),
             args.frames.as_deref(),
             args.size.as_deref(),
-            &args.format,
+            &formats,
             args.preview,
             aovs,
         )
@@ -700,9 +705,7 @@ fn same_sequence(out_dir: &Path, record: &output::JobRecord) -> anyhow::Result<(
     let Ok(old) = output::JobRecord::read(out_dir) else {
         return Ok(());
     };
-    let name = |r: &output::JobRecord| r.timeline_path.file_name().map(|n| n.to_os_string());
-    let size = |r: &output::JobRecord| (r.width, r.height);
-    if name(&old) == name(record) && size(&old) == size(record) {
+    if old.same_sequence(record) {
         return Ok(());
     }
     let frames: usize = [Format::Png, Format::Exr]
@@ -740,10 +743,21 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|s| parse_shard(s, &|k| std::env::var(k).ok()))
         .transpose()?;
-    let record = plan.record()?;
+    let mut record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     if !args.force {
         same_sequence(&out_dir, &record)?;
+    }
+    // The folder is meant to hold every range rendered into it: renders in
+    // pieces (--frames 0..60, then 60..120) leave a record of 0..120, so
+    // `status OUTDIR` counts the gaps between them.
+    if let Ok(old) = output::JobRecord::read(&out_dir) {
+        if old.same_sequence(&record) {
+            record.frames = (
+                old.frames.0.min(record.frames.0),
+                old.frames.1.max(record.frames.1),
+            );
+        }
     }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     record.write(&out_dir)?;
@@ -1023,7 +1037,31 @@ fn ranges(frames: &[u32]) -> String {
 
 fn status(args: StatusArgs) -> anyhow::Result<()> {
     let plan = if args.target.is_dir() {
-        Plan::from_folder(&args.target)?
+        let s = &args.sequence;
+        // The folder records these; only the frames may be narrowed.
+        let given = [
+            ("--out", s.out.is_some()),
+            ("--size", s.size.is_some()),
+            ("--format", !s.format.is_empty()),
+            ("--aov", !s.aov.is_empty()),
+            ("--preview", s.preview),
+        ];
+        if let Some((option, _)) = given.iter().find(|(_, given)| *given) {
+            return Err(Error::usage(
+                option,
+                format!(
+                    "{} is an output folder, which records its own size, formats and layers: \
+                     give the timeline instead (status TIMELINE {option} …) or leave {option} out",
+                    args.target.display()
+                ),
+            )
+            .into());
+        }
+        let mut plan = Plan::from_folder(&args.target)?;
+        if let Some(frames) = &s.frames {
+            plan.range = parse_frames(frames, plan.timeline.frame_count)?;
+        }
+        plan
     } else {
         Plan::new(&args.target, &args.sequence)?
     };
@@ -1054,10 +1092,17 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     }
     let total = plan.range.len();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
-    let changed = crate::timeline::read_text(&plan.timeline.source)
-        .ok()
-        .zip(output::JobRecord::read(&plan.out_dir).ok())
-        .is_some_and(|(now, job)| now != job.timeline_text);
+    let job = output::JobRecord::read(&plan.out_dir).ok();
+    // A folder last rendered from another timeline file (with --force).
+    let other_timeline = job
+        .as_ref()
+        .filter(|job| job.timeline_path.file_name() != plan.timeline.source.file_name())
+        .map(|job| job.timeline_path.clone());
+    let changed = other_timeline.is_none()
+        && crate::timeline::read_text(&plan.timeline.source)
+            .ok()
+            .zip(job)
+            .is_some_and(|(now, job)| now != job.timeline_text);
     // The exit status says whether the sequence is complete even when the
     // report's reader has gone (`status out/zoom | head -1`).
     let report = || -> anyhow::Result<()> {
@@ -1072,6 +1117,9 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
                 workers: Vec<String>,
                 timeline_changed_since_render: bool,
+                /// The timeline the folder was last rendered from, where that
+                /// is another file.
+                folder_rendered_from: Option<&'a Path>,
             }
             out!(
                 "{}",
@@ -1084,6 +1132,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
                     workers: workers.iter().cloned().collect(),
                     timeline_changed_since_render: changed,
+                    folder_rendered_from: other_timeline.as_deref(),
                 })?
             );
         } else {
@@ -1113,6 +1162,13 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             if changed {
                 out!(
                     "  note: {} has changed since this folder's last render started",
+                    plan.timeline.source.display()
+                );
+            }
+            if let Some(other) = &other_timeline {
+                out!(
+                    "  note: this folder was last rendered from {}, not {}",
+                    other.display(),
                     plan.timeline.source.display()
                 );
             }

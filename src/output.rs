@@ -596,6 +596,13 @@ impl JobRecord {
         })
     }
 
+    /// Whether `other` renders the same sequence: the same timeline file
+    /// name (its text may have been edited) at the same size.
+    pub fn same_sequence(&self, other: &JobRecord) -> bool {
+        self.timeline_path.file_name() == other.timeline_path.file_name()
+            && (self.width, self.height) == (other.width, other.height)
+    }
+
     pub fn read(dir: &Path) -> Result<JobRecord> {
         let path = dir.join(JOB_FILE);
         let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;

@@ -140,6 +140,45 @@ fn status_reports_complete_stale_missing_and_in_progress() {
 }
 
 #[test]
+fn status_of_a_folder_counts_every_range_rendered_into_it() {
+    // Renders in pieces: the folder's record covers 0..6, so the gap shows.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(8, 6.0));
+    d.ok(&["render", "t.ron", "--frames", "0..2", "--quiet"]);
+    d.ok(&["render", "t.ron", "--frames", "4..6", "--quiet"]);
+    let out = d.run(&["status", "out/t", "--json"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    assert_eq!(v["frames"], serde_json::json!([0, 6]));
+    assert_eq!(v["states"]["missing"], serde_json::json!([2, 3]));
+    // --frames narrows a folder's range; what the folder records is not
+    // overridden from the command line.
+    assert!(stdout(&d.ok(&["status", "out/t", "--frames", "4..6"])).contains("2 of 2"));
+    for option in [
+        &["--size", "8x6"][..],
+        &["--format", "exr"],
+        &["--out", "x"],
+        &["--preview"],
+    ] {
+        let out = d.run(&[&["status", "out/t"], option].concat());
+        assert_eq!(out.status.code(), Some(2), "{option:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(option[0]), "{}", stderr(&out));
+    }
+    // Another timeline rendered over it with --force: status of the first
+    // names the other, and does not call the first changed.
+    d.write("u.ron", &tiny_timeline(8, 5.0));
+    d.ok(&[
+        "render", "u.ron", "--out", "out/t", "--frames", "0..1", "--force", "--quiet",
+    ]);
+    let out = stdout(&d.run(&["status", "t.ron"]));
+    assert!(
+        out.contains("last rendered from") && out.contains("u.ron"),
+        "{out}"
+    );
+    assert!(!out.contains("has changed"), "{out}");
+}
+
+#[test]
 fn shards_split_frames_by_index_and_from_the_scheduler() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(7, 6.0));
