@@ -511,6 +511,38 @@ impl Plan {
         })
     }
 
+    /// Refuses a size whose frame would need more memory than this machine
+    /// (or this process's address-space limit) has to give, before anything
+    /// is written: a frame too large would otherwise fail part-way, or be
+    /// killed with the machine short of memory.
+    fn check_memory(&self, size_given: bool) -> anyhow::Result<()> {
+        let many_samples = self
+            .range
+            .clone()
+            .any(|frame| !self.preview && self.timeline.scene_at(frame).samples_per_pixel > 1);
+        let need = crate::render::frame_bytes(self.width, self.height, self.layers(), many_samples);
+        let Some(have) = memory_available() else {
+            return Ok(());
+        };
+        if need <= have {
+            return Ok(());
+        }
+        let gib = |bytes: u64| bytes as f64 / (1u64 << 30) as f64;
+        let option = if size_given { "--size" } else { "size" };
+        Err(Error::usage(
+            option,
+            format!(
+                "{}x{} needs about {:.1} GiB for a frame's buffers, and this machine has {:.1} GiB \
+                 to give: render it smaller, or on a machine with more memory",
+                self.width,
+                self.height,
+                gib(need),
+                gib(have)
+            ),
+        )
+        .into())
+    }
+
     fn record(&self) -> anyhow::Result<output::JobRecord> {
         let text = crate::timeline::read_text(&self.timeline.source)?;
         Ok(output::JobRecord {
@@ -622,6 +654,38 @@ impl Plan {
         let _ = std::fs::remove_file(output::checkpoint_path(&self.out_dir, frame));
         Ok(film.stats)
     }
+}
+
+/// Memory this process can still have, where Linux tells: what the
+/// machine has available (memory and swap, /proc/meminfo), or the
+/// process's address-space limit (`ulimit -v`, /proc/self/limits) if lower.
+fn memory_available() -> Option<u64> {
+    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib = |key: &str| -> Option<u64> {
+        let line = meminfo.lines().find(|l| l.starts_with(key))?;
+        line.split_whitespace().nth(1)?.parse::<u64>().ok()
+    };
+    let machine = (kib("MemAvailable:")? + kib("SwapFree:").unwrap_or(0)) * 1024;
+    // "Max address space  <soft> <hard> bytes": "unlimited" parses as none;
+    // what the process has mapped already (VmSize) is spoken for.
+    let limit = std::fs::read_to_string("/proc/self/limits")
+        .ok()
+        .and_then(|limits| {
+            let line = limits
+                .lines()
+                .find(|l| l.starts_with("Max address space"))?;
+            line.split_whitespace().nth(3)?.parse::<u64>().ok()
+        })
+        .map(|limit| {
+            let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+            let mapped = status
+                .lines()
+                .find(|l| l.starts_with("VmSize:"))
+                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
+                .unwrap_or(0);
+            limit.saturating_sub(mapped * 1024)
+        });
+    Some(limit.map_or(machine, |limit| limit.min(machine)))
 }
 
 /// A positive number of seconds (`--claim-timeout`).
@@ -745,6 +809,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .transpose()?;
     let mut record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
+    plan.check_memory(args.sequence.size.is_some())?;
     if !args.force {
         same_sequence(&out_dir, &record)?;
     }
@@ -1559,16 +1624,30 @@ fn sheet(args: SheetArgs) -> anyhow::Result<()> {
     if args.count == 0 || args.columns == 0 || args.thumb_width == 0 {
         return Err(Error::usage("--count/--columns/--thumb-width", "must be at least 1").into());
     }
+    let out = args.out.unwrap_or_else(|| args.dir.join("sheet.png"));
+    if !out
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("png"))
+    {
+        let message = format!("the sheet is a PNG: name it .png, not {}", out.display());
+        return Err(Error::usage("--out", message).into());
+    }
     let frames = output::frame_files(&args.dir, Format::Png)?;
     if frames.is_empty() {
+        // A --preview render's frames are a folder further down.
+        let preview = args.dir.join("preview");
+        let hint = if output::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
+            format!(" (a preview's are in {})", preview.display())
+        } else {
+            String::new()
+        };
         return Err(Error::usage(
-            "DIR",
-            format!("no frame_NNNNN.png files in {}", args.dir.display()),
+            &args.dir.display().to_string(),
+            format!("no frame_NNNNN.png files in this folder{hint}"),
         )
         .into());
     }
     let shown = output::evenly_spaced(&frames, args.count);
-    let out = args.out.unwrap_or_else(|| args.dir.join("sheet.png"));
     output::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
     out!(
         "{} frames of {} tiled into {}",

@@ -915,10 +915,19 @@ pub fn write_contact_sheet(
     let columns = columns.min(frames.len() as u32);
     let rows = (frames.len() as u32).div_ceil(columns);
     let gap = 2;
-    let mut sheet = RgbImage::new(
-        columns * (thumb_width + gap) - gap,
-        rows * (thumb_height + gap) - gap,
+    let (w, h) = (
+        columns as u64 * (thumb_width + gap) as u64 - gap as u64,
+        rows as u64 * (thumb_height + gap) as u64 - gap as u64,
     );
+    // As large as a frame may be, and no larger.
+    const MAX_SIDE: u64 = 32_768;
+    if w > MAX_SIDE || h > MAX_SIDE {
+        return Err(Error::usage(
+            "--thumb-width/--columns/--count",
+            format!("the sheet would be {w}x{h} pixels; it may be at most {MAX_SIDE} a side"),
+        ));
+    }
+    let mut sheet = RgbImage::new(w as u32, h as u32);
     for (i, path) in frames.iter().enumerate() {
         let frame = decode(path)?;
         let thumb = imageops::resize(

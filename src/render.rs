@@ -95,6 +95,30 @@ pub struct Layers {
     pub traps: bool,
 }
 
+impl Layers {
+    /// Bytes a pixel of these layers takes in a film (the normal and the
+    /// albedo three f32 each, the traps four).
+    fn bytes_per_pixel(self) -> u64 {
+        12 * (self.normal as u64 + self.albedo as u64) + 16 * self.traps as u64
+    }
+}
+
+/// About the most memory rendering and writing one frame of `width`×
+/// `height` takes (upwards of it): the film (colour, alpha, depth and
+/// estimates, 24 bytes a pixel, and the layers), as much again for encoding
+/// it, and for a frame of several samples per pixel the running sums
+/// (colour in f64, hits, depth and estimates spent, 40 bytes a pixel, and
+/// the layers). What a size can be checked against before it is rendered.
+pub fn frame_bytes(width: u32, height: u32, layers: Layers, many_samples: bool) -> u64 {
+    let film = 24 + layers.bytes_per_pixel();
+    let sums = if many_samples {
+        40 + layers.bytes_per_pixel()
+    } else {
+        0
+    };
+    width as u64 * height as u64 * (2 * film + sums)
+}
+
 /// Work counted while rendering one frame.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct FrameStats {

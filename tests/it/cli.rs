@@ -295,3 +295,59 @@ fn example_timelines_are_valid() {
     let decades: f64 = before.rsplit(' ').next().unwrap().parse().unwrap();
     assert!(decades >= 4.0, "{zoom}");
 }
+
+#[test]
+fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    d.ok(&["render", "t.ron", "--quiet"]);
+    // Three 48×27 frames as 24-pixel thumbnails (13 high), two a row, 2 apart.
+    let out = d.ok(&[
+        "sheet",
+        "out/t",
+        "--count",
+        "3",
+        "--columns",
+        "2",
+        "--thumb-width",
+        "24",
+    ]);
+    assert!(
+        stdout(&out).contains("3 frames of 3 tiled into"),
+        "{}",
+        stdout(&out)
+    );
+    let sheet = image::open(d.path().join("out/t/sheet.png")).unwrap();
+    assert_eq!((sheet.width(), sheet.height()), (2 * 26 - 2, 2 * 15 - 2));
+    // Too large, a name that is not .png, a folder without frames: exit 2,
+    // nothing written.
+    let refused = [
+        (
+            &[
+                "sheet",
+                "out/t",
+                "--thumb-width",
+                "100000",
+                "--out",
+                "big.png",
+            ][..],
+            "at most 32768",
+        ),
+        (&["sheet", "out/t", "--out", "sheet.jpg"], "name it .png"),
+        (&["sheet", "."], "no frame_NNNNN.png files"),
+    ];
+    for (args, says) in refused {
+        let out = d.run(args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+    }
+    assert!(!d.path().join("big.png").exists() && !d.path().join("sheet.jpg").exists());
+    // A preview's frames are pointed at.
+    d.ok(&["render", "t.ron", "--preview", "--out", "p", "--quiet"]);
+    let out = d.run(&["sheet", "p"]);
+    assert!(
+        stderr(&out).contains("a preview's are in p/preview"),
+        "{}",
+        stderr(&out)
+    );
+}

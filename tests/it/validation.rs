@@ -115,6 +115,36 @@ fn values_that_would_draw_a_surface_where_there_is_none_are_refused() {
 }
 
 #[test]
+fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
+    // Under a 2 GB address-space limit an 8000×8000 frame (about 2.9 GiB
+    // of buffers) cannot be had: refused up front with exit 2, no folder
+    // made. 1000×1000 still renders.
+    if !std::path::Path::new("/proc/self/limits").exists() {
+        return; // only Linux tells the limit
+    }
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 6.0));
+    let limited = |size: &str| {
+        std::process::Command::new("sh")
+            .current_dir(d.path())
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 2000000 && exec \"$0\" render t.ron --size {size} --out o{size} -q"
+            ))
+            .arg(env!("CARGO_BIN_EXE_mandelreel"))
+            .output()
+            .unwrap()
+    };
+    let out = limited("8000x8000");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--size: 8000x8000 needs about"), "{err}");
+    assert!(!d.path().join("o8000x8000").exists());
+    let out = limited("1000x1000");
+    assert!(out.status.success(), "{}", stderr(&out));
+}
+
+#[test]
 fn frame_rates_past_a_thousand_are_refused() {
     for fps in ["1e300", "4294967296", "1000.5"] {
         let text = tiny_timeline(2, 6.0).replace("fps: 24", &format!("fps: {fps}"));
