@@ -182,7 +182,7 @@ pub struct SequenceArgs {
     /// Output folder [default: out/<timeline name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Frames, half-open like a Rust range: 0..4 is frames 0 to 3; also A.., ..B, or N.
+    /// Frames, as a Rust range: 0..4 is frames 0 to 3, 0..=4 frames 0 to 4; also A.., ..B, or N.
     #[arg(long, value_name = "A..B")]
     pub frames: Option<String>,
     /// Override the timeline's output size (nothing else is scaled).
@@ -211,7 +211,7 @@ pub struct RenderArgs {
     /// Render every frame even if a current one exists.
     #[arg(long)]
     pub force: bool,
-    /// No progress bars or summary; errors still go to stderr.
+    /// No progress bars or summary; errors (and --stats, if asked) still go to stderr.
     #[arg(long, short)]
     pub quiet: bool,
     /// Print distance-estimator evaluations per frame and in total.
@@ -349,6 +349,14 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
         }
     };
     let range = match text.split_once("..") {
+        // A..=B, as Rust writes an inclusive range: frames A to B.
+        Some((a, b)) if b.starts_with('=') => {
+            let last = b[1..].trim();
+            if last.is_empty() {
+                return Err(bad(format!("{text:?} needs a last frame after ..=")));
+            }
+            number(a, 0)?..number(last, 0)?.saturating_add(1)
+        }
         Some((a, b)) => number(a, 0)?..number(b, count)?,
         None => {
             let n = number(text, 0)?;
@@ -492,6 +500,19 @@ impl Plan {
 
     /// The plan an output folder records (see `output::JobRecord`).
     fn from_folder(dir: &Path) -> anyhow::Result<Plan> {
+        if !dir.join(output::JOB_FILE).exists() {
+            let preview = dir.join("preview");
+            let hint = if preview.join(output::JOB_FILE).exists() {
+                format!("; a preview's is in {}", preview.display())
+            } else {
+                String::new()
+            };
+            let message = format!(
+                "not a mandelreel output folder (no {}){hint}",
+                output::JOB_FILE
+            );
+            return Err(Error::usage(&dir.display().to_string(), message).into());
+        }
         let job = output::JobRecord::read(dir)?;
         let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
         let formats = job
@@ -824,6 +845,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             );
         }
     }
+    if out_dir.exists() && !out_dir.is_dir() {
+        let message = format!("{} is a file, not a folder", out_dir.display());
+        return Err(Error::usage("--out", message).into());
+    }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     record.write(&out_dir)?;
     let stale = output::remove_stale_partials(&out_dir)?;
@@ -932,7 +957,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         rendered += 1;
         overall.inc(1);
         let seconds = t0.elapsed().as_secs_f64();
-        if args.stats && !args.quiet {
+        // Asked for, so printed even with --quiet.
+        if args.stats {
             say(format!(
                 "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit, {} repaired",
                 stats.de_evaluations,
@@ -1025,13 +1051,13 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
-        if args.stats {
-            eprintln!(
-                "total DE evaluations: {}, repaired (NaN/inf) samples: {}",
-                totals.de_evaluations, totals.repaired_samples
-            );
-        }
         eprintln!("encode the video with:");
+    }
+    if args.stats {
+        eprintln!(
+            "total DE evaluations: {}, repaired (NaN/inf) samples: {}",
+            totals.de_evaluations, totals.repaired_samples
+        );
     }
     // On stdout even with --quiet: scripts can run it.
     let video_format = if plan.formats.contains(&Format::Png) {
@@ -1560,8 +1586,15 @@ fn check_frame(t: &Timeline, frame: u32) -> Result<()> {
 /// Sizes rayon's pool to `--threads` when given.
 fn set_threads(threads: Option<usize>) -> Result<()> {
     if let Some(n) = threads {
-        if n == 0 {
-            return Err(Error::usage("--threads", "must be at least 1"));
+        // A frame's bands are its units of work (one per four rows): past a
+        // thousand threads there is nothing for more to do, only their
+        // start-up (10 000 took 44 s for a 64×36 frame).
+        const MAX_THREADS: usize = 1024;
+        if !(1..=MAX_THREADS).contains(&n) {
+            return Err(Error::usage(
+                "--threads",
+                format!("must be 1..={MAX_THREADS}, got {n}"),
+            ));
         }
         rayon::ThreadPoolBuilder::new()
             .num_threads(n)
@@ -1734,8 +1767,13 @@ mod tests {
     use super::*;
 
     #[test]
-    fn frame_ranges_are_half_open() {
+    fn frame_ranges_are_read_as_rust_writes_them() {
         assert_eq!(parse_frames("0..4", 10).unwrap(), 0..4);
+        assert_eq!(parse_frames("0..=3", 10).unwrap(), 0..4);
+        assert_eq!(parse_frames("..=9", 10).unwrap(), 0..10);
+        assert!(parse_frames("0..=10", 10).is_err());
+        assert!(parse_frames("3..=", 10).is_err());
+        assert!(parse_frames("4..=3", 10).is_err());
         assert_eq!(parse_frames("3..", 10).unwrap(), 3..10);
         assert_eq!(parse_frames("..2", 10).unwrap(), 0..2);
         assert_eq!(parse_frames("7", 10).unwrap(), 7..8);

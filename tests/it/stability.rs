@@ -38,7 +38,8 @@ fn camera_inside_the_bulb_renders_with_a_warning() {
 fn julia_frame(c: &str) -> (Vec<f32>, f64) {
     let d = Dir::new();
     d.write("t.ron", &scene(&format!("fractal: (julia: {c})")));
-    let out = d.ok(&["render", "t.ron", "--format", "exr", "--stats"]);
+    // --stats is printed even with --quiet: it was asked for.
+    let out = d.ok(&["render", "t.ron", "--format", "exr", "--stats", "--quiet"]);
     let (alpha, _) = finite_channels(&d, "out/t/frame_00000.exr");
     let err = stderr(&out);
     let per_sample: f64 = err

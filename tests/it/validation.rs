@@ -244,6 +244,28 @@ fn bad_flags_exit_with_usage_code_and_write_nothing() {
     );
     rejected(&tiny_timeline(2, 6.0), &["--size", "0x10"], 2, &["--size"]);
     rejected(&tiny_timeline(2, 6.0), &["--format", "jpg"], 2, &["jpg"]);
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    d.write("afile", "not a folder");
+    let out = d.run(&["render", "t.ron", "--out", "afile"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("--out: afile is a file, not a folder"),
+        "{}",
+        stderr(&out)
+    );
+    std::fs::create_dir(d.path().join("empty")).unwrap();
+    let out = d.run(&["status", "empty"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    assert!(
+        stderr(&out).contains("empty: not a mandelreel output folder"),
+        "{}",
+        stderr(&out)
+    );
+    for threads in ["0", "10000"] {
+        let args = ["--threads", threads];
+        rejected(&tiny_timeline(2, 6.0), &args, 2, &["--threads", "1..=1024"]);
+    }
     for bad in ["0", "-1", "inf", "soon", "1e30"] {
         let flag = format!("--claim-timeout={bad}");
         rejected(
