@@ -913,6 +913,30 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             inside[0]
         ));
     }
+    // Effects that need several samples a pixel, declared with too few:
+    // not an error (a test render may want it), but not what they look like.
+    if let Some((frame, scenes, _)) = todo.first().filter(|_| !plan.preview) {
+        let scene = &scenes[0];
+        let n = scene.samples_per_pixel;
+        let mut short = Vec::new();
+        if scene.camera.frame().has_lens() && n < crate::scene::LENS_SAMPLES {
+            short.push(format!(
+                "depth of field needs samples_per_pixel of {} or more to be smooth",
+                crate::scene::LENS_SAMPLES
+            ));
+        }
+        if scene.effects.motion_blur.is_some() && n < crate::scene::MOTION_BLUR_SAMPLES {
+            short.push(format!(
+                "motion blur needs samples_per_pixel of {} or more to blur rather than ghost",
+                crate::scene::MOTION_BLUR_SAMPLES
+            ));
+        }
+        for why in short {
+            say(format!(
+                "warning: frame {frame} has {n} sample(s) per pixel; {why}"
+            ));
+        }
+    }
     if !args.quiet && stale > 0 {
         say(format!(
             "removed {stale} temporary file(s) left by an interrupted render"
@@ -1416,8 +1440,8 @@ fn info(path: &Path) -> anyhow::Result<()> {
     let lens = base.camera.frame();
     if lens.has_lens() {
         out!(
-            "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel > 1)",
-            lens.aperture_radius, lens.focus_distance
+            "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel of {} or more)",
+            lens.aperture_radius, lens.focus_distance, crate::scene::LENS_SAMPLES
         );
     }
     out!(

@@ -9,6 +9,14 @@ use crate::march::{MarchSettings, Ray};
 use crate::math::{normalize_or, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
+/// The fewest samples a pixel for a smooth depth of field (each sample
+/// leaves from its own point on the lens); fewer render, with a warning.
+pub const LENS_SAMPLES: u32 = 4;
+
+/// The fewest samples a pixel for motion blur to blur rather than show its
+/// separate instants; fewer render, with a warning.
+pub const MOTION_BLUR_SAMPLES: u32 = 8;
+
 /// A camera: a pinhole, or a thin lens when its aperture is open.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]

@@ -351,3 +351,39 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
         stderr(&out)
     );
 }
+
+#[test]
+fn effects_declared_with_too_few_samples_render_with_a_warning() {
+    // A lens with 1 sample a pixel, motion blur with 4: rendered, but each
+    // says what it needs; with enough samples, or as a preview (one sample
+    // by design), nothing is said.
+    let d = Dir::new();
+    let scene = |spp: u32| {
+        tiny_timeline(1, 6.0).replace(
+            "scene: (camera: (position: (0, 0.5, 3.0)),",
+            &format!(
+                "scene: (samples_per_pixel: {spp}, effects: (motion_blur: (shutter: 0.5)), \
+                 camera: (position: (0, 0.5, 3.0), aperture_radius: 0.01),"
+            ),
+        )
+    };
+    d.write("few.ron", &scene(1));
+    let err = stderr(&d.ok(&["render", "few.ron", "--size", "16x9"]));
+    assert!(
+        err.contains("depth of field needs samples_per_pixel of 4"),
+        "{err}"
+    );
+    assert!(
+        err.contains("motion blur needs samples_per_pixel of 8"),
+        "{err}"
+    );
+    d.write("some.ron", &scene(4));
+    let err = stderr(&d.ok(&["render", "some.ron", "--size", "16x9"]));
+    assert!(!err.contains("depth of field needs"), "{err}");
+    assert!(err.contains("motion blur needs"), "{err}");
+    d.write("enough.ron", &scene(8));
+    let err = stderr(&d.ok(&["render", "enough.ron", "--size", "16x9"]));
+    assert!(!err.contains("warning"), "{err}");
+    let err = stderr(&d.ok(&["render", "few.ron", "--preview"]));
+    assert!(!err.contains("warning"), "{err}");
+}
