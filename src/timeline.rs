@@ -475,9 +475,12 @@ impl Timeline {
             *map_path = resolved;
         }
         if let Err((field, message)) = validate_scene(&file.scene) {
+            // The field's own name, without an index (`extra_lights[0]` is
+            // on the line of `extra_lights:`).
+            let last = field.rsplit('.').next().unwrap_or("");
             let line = line_of(
                 text,
-                &format!("{}:", field.rsplit('.').next().unwrap_or("")),
+                &format!("{}:", last.split('[').next().unwrap_or("")),
                 0,
             );
             return Err(invalid(line, format!("scene.{field}"), message));
@@ -620,20 +623,32 @@ impl Timeline {
                 times.insert(0, timeline.time_of(frame));
             }
             let failure = times.into_iter().find_map(|time| {
-                validate_scene(&timeline.scene_at_time(time))
+                timeline
+                    .zoom_direction_at(time)
+                    .and_then(|_| validate_scene(&timeline.scene_at_time(time)))
                     .err()
                     .map(|e| (time, e))
             });
             if let Some((time, (field, message))) = failure {
-                let animated = timeline
+                // The tracks that set the field; else those of its group
+                // (a camera.position track can make the target coincide).
+                let group = field.split('.').next().unwrap_or("");
+                let setting = |t: &&Track| {
+                    field.starts_with(t.name.as_str())
+                        || (t.name == ZOOM_TRACK && field.starts_with("camera"))
+                };
+                let in_group = |t: &&Track| t.name.split('.').next() == Some(group);
+                let mut animated: Vec<String> = timeline
                     .tracks
                     .iter()
-                    .filter(|t| {
-                        field.starts_with(t.name.as_str())
-                            || (t.name == ZOOM_TRACK && field.starts_with("camera"))
-                    })
+                    .filter(setting)
                     .map(|t| format!("\"{}\"", t.name))
-                    .collect::<Vec<_>>();
+                    .collect();
+                if animated.is_empty() {
+                    animated = (timeline.tracks.iter().filter(in_group))
+                        .map(|t| format!("\"{}\"", t.name))
+                        .collect();
+                }
                 return Err(invalid(
                     animated.first().and_then(|n| line_of(text, n, 0)),
                     format!("frame {frame} (t = {time:.4} s): scene.{field}"),
@@ -664,6 +679,28 @@ impl Timeline {
     /// The scene of frame `frame_index`: the base scene with every track applied.
     pub fn scene_at(&self, frame_index: u32) -> Scene {
         self.scene_at_time(self.time_of(frame_index))
+    }
+
+    /// Where a zoom track is: checks that the camera's position and target
+    /// before it, at `time_seconds`, differ, since `camera.distance` places
+    /// the camera along the line between them.
+    fn zoom_direction_at(&self, time_seconds: Real) -> std::result::Result<(), (String, String)> {
+        if !self.tracks.iter().any(|t| t.name == ZOOM_TRACK) {
+            return Ok(());
+        }
+        let mut scene = self.base.clone();
+        for track in self.tracks.iter().filter(|t| t.name != ZOOM_TRACK) {
+            apply(&mut scene, &track.name, &track.sample(time_seconds));
+        }
+        let c = &scene.camera;
+        let away = c.position - c.target;
+        if away.length() > 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
+            return Ok(());
+        }
+        Err((
+            "camera.position".into(),
+            "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
+        ))
     }
 
     /// The scene at any time in seconds, between frames too.
@@ -1419,5 +1456,32 @@ mod tests {
                 "{name} is not in the README's table"
             );
         }
+    }
+
+    #[test]
+    fn a_camera_track_onto_the_target_is_refused_at_its_line() {
+        // The position track sets the camera onto the target at frame 0:
+        // alone, the scene's own check catches it; with a zoom track, which
+        // would otherwise pick a direction of its own, the zoom's does. Both
+        // name the frame, the track and its line.
+        let position = "\"camera.position\": (keys: [(time: 0, value: (0, 0, 0)), (time: 1, value: (0, 0, 2))])";
+        let zoom = "\"camera.distance\": (keys: [(time: 0, value: 3), (time: 1, value: 2)])";
+        for tracks in [position.to_string(), format!("\n{zoom},\n{position}")] {
+            let text = with_track(&tracks).replace("size: (8, 6),", "size: (8, 6),\n");
+            let line = line_of(&text, "\"camera.position\"", 0).unwrap();
+            let e = parse(&text).unwrap_err().to_string();
+            assert!(e.starts_with(&format!("test.ron:{line}: frame 0 ")), "{e}");
+            assert!(
+                e.contains("coincide") && e.contains("\"camera.position\""),
+                "{e}"
+            );
+        }
+        // A light's error inside a list is found at the list's line.
+        let text = "(fps: 10, frames: 2, size: (8, 6),\n scene: (look: (\n extra_lights: [(direction: (1, 1, 1), colour: (1, 1, 1), intensity: -1)])))";
+        let e = parse(text).unwrap_err().to_string();
+        assert!(
+            e.starts_with("test.ron:3: scene.look.extra_lights[0]"),
+            "{e}"
+        );
     }
 }
