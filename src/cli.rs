@@ -1492,8 +1492,9 @@ struct PickReport {
     point: Option<[f64; 3]>,
     distance: Option<f64>,
     normal: Option<[f64; 3]>,
-    /// Width of the pixel's cone at the hit (or at the far side of the bounding sphere).
-    pixel_footprint: f64,
+    /// Width of the pixel's cone at the hit, or at the far side of the
+    /// bounding sphere; none where the ray misses the sphere.
+    pixel_footprint: Option<f64>,
     fractal: PickFractal,
 }
 
@@ -1545,15 +1546,10 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
         point: hit.map(|(h, _)| arr(h.point)),
         distance: hit.map(|(h, _)| h.t),
         normal: hit.map(|(_, n)| arr(n)),
-        pixel_footprint: ray.footprint(
-            hit.map(|(h, _)| h.t).unwrap_or(
-                scene
-                    .quality
-                    .interval(&ray)
-                    .map(|(_, far)| far)
-                    .unwrap_or(0.0),
-            ),
-        ),
+        pixel_footprint: hit
+            .map(|(h, _)| h.t)
+            .or_else(|| scene.quality.interval(&ray).map(|(_, far)| far))
+            .map(|t| ray.footprint(t)),
         fractal: PickFractal {
             formula: scene.fractal.formula.name(),
             power: scene.fractal.power,
@@ -1579,7 +1575,7 @@ fn pick(args: PickArgs) -> anyhow::Result<()> {
             out!("normal:    ({:.4}, {:.4}, {:.4})", n.x, n.y, n.z);
             out!(
                 "footprint: {:.3e} (one pixel's width there)",
-                report.pixel_footprint
+                ray.footprint(h.t)
             );
             out!(
                 "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",

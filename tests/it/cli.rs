@@ -238,6 +238,8 @@ fn pick_json_hits_the_bulb_in_the_centre_and_misses_in_the_corner() {
     .unwrap();
     assert_eq!(corner["hit"], false);
     assert!(corner["point"].is_null());
+    // The corner's ray misses the bounding sphere too: no footprint to give.
+    assert!(corner["pixel_footprint"].is_null(), "{corner}");
 }
 
 #[test]
