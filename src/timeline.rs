@@ -116,6 +116,9 @@ fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
     deserializer.deserialize_map(Tracks)
 }
 
+/// The largest camera position or target component a scene may have.
+const MAX_COORDINATE: Real = 1e15;
+
 /// The largest Julia constant component a scene may have (see `validate`).
 const MAX_JULIA: Real = 1e15;
 
@@ -778,13 +781,21 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     }
     let finite3 = |v: DVec3| v.is_finite();
     let c = &s.camera;
-    for (field, v) in [
-        ("camera.position", c.position),
-        ("camera.target", c.target),
-        ("camera.up", c.up),
-    ] {
-        check(finite3(v), field, || format!("must be finite, got {v}"))?;
+    for (field, v) in [("camera.position", c.position), ("camera.target", c.target)] {
+        // The bulb is a unit across: from farther than this it is below a
+        // pixel of any field of view, and the view's length would overflow.
+        check(
+            finite3(v) && v.abs().max_element() <= MAX_COORDINATE,
+            field,
+            || {
+                let (x, y, z) = (v.x, v.y, v.z);
+                format!("each component must be finite and within ±{MAX_COORDINATE:e}, got ({x:e}, {y:e}, {z:e})")
+            },
+        )?;
     }
+    check(finite3(c.up), "camera.up", || {
+        format!("must be finite, got {}", c.up)
+    })?;
     check(c.roll_degrees.is_finite(), "camera.roll_degrees", || {
         format!("must be finite, got {}", c.roll_degrees)
     })?;
@@ -864,7 +875,10 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             finite3(k) && k.abs().max_element() <= MAX_JULIA,
             "fractal.julia",
-            || format!("each component must be finite and within ±{MAX_JULIA:e}, got {k}"),
+            || {
+                let (x, y, z) = (k.x, k.y, k.z);
+                format!("each component must be finite and within ±{MAX_JULIA:e}, got ({x:e}, {y:e}, {z:e})")
+            },
         )?;
     }
     let q = &s.quality;
@@ -1481,6 +1495,27 @@ mod tests {
         let e = parse(text).unwrap_err().to_string();
         assert!(
             e.starts_with("test.ron:3: scene.look.extra_lights[0]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_camera_too_far_to_see_anything_is_refused_by_name() {
+        // 1e300 away the view's length overflows: before, the error blamed
+        // the up vector. Directly, and through a zoom track.
+        let far =
+            "(fps: 10, frames: 2, size: (8, 6), scene: (camera: (position: (0, 0.6, 1e300))))";
+        let e = parse(far).unwrap_err().to_string();
+        assert!(
+            e.contains("scene.camera.position") && e.contains("1e15, got (0e0, 6e-1, 1e300)"),
+            "{e}"
+        );
+        let zoom = with_track(
+            "\"camera.distance\": (keys: [(time: 0, value: 3), (time: 1, value: 1e300)])",
+        );
+        let e = parse(&zoom).unwrap_err().to_string();
+        assert!(
+            e.contains("scene.camera.position") && e.contains("camera.distance"),
             "{e}"
         );
     }
