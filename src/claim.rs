@@ -32,6 +32,10 @@ pub struct ClaimRecord {
     pub token: String,
     /// Last sign of life, milliseconds since the Unix epoch.
     pub heartbeat_ms: u64,
+    /// Where `pid` means this process (`output::pid_space`); a claim
+    /// without it is only ever taken over after its timeout.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pid_space: Option<String>,
 }
 
 /// `.frame_00042.claim` for frame 42.
@@ -66,11 +70,14 @@ pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
 /// Whether a claim's worker may still be at work: its heartbeat is younger
 /// than `timeout`, and it is not a process of this machine known to have
 /// ended (a worker stopped by Ctrl-C or `kill -9` leaves its claim behind;
-/// one on this machine is taken over at once, one elsewhere after the
-/// timeout).
+/// one whose pids this process sees, the same host, boot and pid
+/// namespace, is taken over at once, any other after the timeout).
 pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
     let beating = now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64;
-    beating && !(record.host == crate::output::host_name() && crate::output::gone_here(record.pid))
+    let seen_from_here = record.host == crate::output::host_name()
+        && record.pid_space.is_some()
+        && record.pid_space == crate::output::pid_space();
+    beating && !(seen_from_here && crate::output::gone_here(record.pid))
 }
 
 /// Replaces `path` with `record`, atomically (temporary file, then rename).
@@ -174,6 +181,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                 .unwrap_or(0)
         ),
         heartbeat_ms: now_ms(),
+        pid_space: crate::output::pid_space(),
     };
     let interval = timeout / 4;
     for _ in 0..3 {
@@ -210,6 +218,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                         pid: 0,
                         token: format!("unreadable-{modified}"),
                         heartbeat_ms: modified,
+                        pid_space: None,
                     },
                     None => {
                         // Vanished: look again.
@@ -299,6 +308,7 @@ mod tests {
             pid: 1,
             token: "dead-token".into(),
             heartbeat_ms: now_ms() - 120_000,
+            pid_space: None,
         };
         write_record(&claim_path(dir, frame_index), &dead).unwrap();
         dead
@@ -408,7 +418,7 @@ mod tests {
         // A worker stopped by Ctrl-C leaves a claim with a fresh heartbeat:
         // on this machine its ended process shows, and the frame is free;
         // while the process lives, and on any other machine, it is held.
-        if !Path::new("/proc/self").exists() {
+        if crate::output::pid_space().is_none() || !Path::new("/proc/1").exists() {
             return; // nothing tells an ended process without /proc
         }
         let dir = tempfile::tempdir().unwrap();
@@ -418,13 +428,14 @@ mod tests {
             .spawn()
             .unwrap();
         let pid = worker.id();
-        let fresh = |host: String| ClaimRecord {
+        let fresh = |host: String, pid_space: Option<String>| ClaimRecord {
             host,
             pid,
             token: format!("token-{pid}"),
             heartbeat_ms: now_ms(),
+            pid_space,
         };
-        let here = fresh(crate::output::host_name());
+        let here = fresh(crate::output::host_name(), crate::output::pid_space());
         write_record(&claim_path(dir.path(), 4), &here).unwrap();
         assert!(matches!(
             try_claim(dir.path(), 4, timeout).unwrap(),
@@ -433,7 +444,16 @@ mod tests {
         worker.kill().unwrap();
         worker.wait().unwrap();
         assert!(!is_live(&here, timeout));
-        assert!(is_live(&fresh("another-machine".into()), timeout));
+        // Another machine; this host name in another pid namespace (a
+        // container sharing it), or a claim that does not say: alive.
+        let space = crate::output::pid_space();
+        assert!(is_live(&fresh("another-machine".into(), space), timeout));
+        let elsewhere = Some("another-boot/pid:[1]".to_string());
+        assert!(is_live(
+            &fresh(crate::output::host_name(), elsewhere),
+            timeout
+        ));
+        assert!(is_live(&fresh(crate::output::host_name(), None), timeout));
         let Attempt::Claimed(claim) = try_claim(dir.path(), 4, timeout).unwrap() else {
             panic!("the ended worker's claim is taken over");
         };

@@ -208,9 +208,13 @@ pub struct RenderArgs {
     /// Worker threads [default: all cores]. The image does not depend on it.
     #[arg(long)]
     pub threads: Option<usize>,
-    /// Render every frame even if a current one exists.
+    /// Render every frame even if a current one exists (implies --replace).
     #[arg(long)]
     pub force: bool,
+    /// Render into a folder that holds another timeline's (by file name) or
+    /// another size's frames, replacing them; without it that is refused.
+    #[arg(long)]
+    pub replace: bool,
     /// No progress bars or summary; errors (and --stats, if asked) still go to stderr.
     #[arg(long, short)]
     pub quiet: bool,
@@ -336,7 +340,7 @@ pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
     Ok((w, h))
 }
 
-/// Parses a half-open frame range (`A..B`, `A..`, `..B` or `N`) against `count` frames.
+/// Parses a frame range (`A..B`, `A..=B`, `A..`, `..B`, `..=B` or `N`) against `count` frames.
 pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
     let bad = |why: String| Error::usage("--frames", why);
     let number = |s: &str, default: u32| -> Result<u32> {
@@ -365,7 +369,7 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
     };
     if range.start >= range.end {
         return Err(bad(format!(
-            "{text:?} is empty (the range is half-open: 0..4 is frames 0 to 3)"
+            "{text:?} is empty (0..4 is frames 0 to 3, 0..=4 frames 0 to 4)"
         )));
     }
     if range.end > count {
@@ -541,8 +545,10 @@ impl Plan {
             .range
             .clone()
             .any(|frame| !self.preview && self.timeline.scene_at(frame).samples_per_pixel > 1);
-        let need = crate::render::frame_bytes(self.width, self.height, self.layers(), many_samples);
-        let Some(have) = memory_available() else {
+        let exr = self.formats.contains(&Format::Exr);
+        let (w, h) = (self.width, self.height);
+        let need = crate::render::frame_bytes(w, h, self.layers(), exr, many_samples);
+        let Some((have, whose)) = memory_available() else {
             return Ok(());
         };
         if need <= have {
@@ -553,10 +559,8 @@ impl Plan {
         Err(Error::usage(
             option,
             format!(
-                "{}x{} needs about {:.1} GiB for a frame's buffers, and this machine has {:.1} GiB \
-                 to give: render it smaller, or on a machine with more memory",
-                self.width,
-                self.height,
+                "{w}x{h} needs about {:.1} GiB for a frame's buffers, and {whose} {:.1} GiB \
+                 to give: render it smaller, or with more memory",
                 gib(need),
                 gib(have)
             ),
@@ -677,36 +681,45 @@ impl Plan {
     }
 }
 
-/// Memory this process can still have, where Linux tells: what the
-/// machine has available (memory and swap, /proc/meminfo), or the
-/// process's address-space limit (`ulimit -v`, /proc/self/limits) if lower.
-fn memory_available() -> Option<u64> {
-    let meminfo = std::fs::read_to_string("/proc/meminfo").ok()?;
-    let kib = |key: &str| -> Option<u64> {
-        let line = meminfo.lines().find(|l| l.starts_with(key))?;
-        line.split_whitespace().nth(1)?.parse::<u64>().ok()
+/// Memory this process can still have, where Linux tells, and whose limit
+/// that is: the least of what the machine has available (memory and swap,
+/// /proc/meminfo), what its control group may still use (cgroup v2's
+/// memory.max, or v1's limit, less what it uses: a container's limit),
+/// and the process's address-space limit (`ulimit -v`, /proc/self/limits,
+/// less what it has mapped).
+fn memory_available() -> Option<(u64, &'static str)> {
+    let read = |path: &str| std::fs::read_to_string(path).ok();
+    let number = |text: Option<String>| text?.trim().parse::<u64>().ok();
+    // "Key:  <n> kB" lines of /proc/meminfo and /proc/self/status, in bytes.
+    let field = |text: &str, key: &str| -> Option<u64> {
+        let line = text.lines().find(|l| l.starts_with(key))?;
+        Some(line.split_whitespace().nth(1)?.parse::<u64>().ok()? * 1024)
     };
-    let machine = (kib("MemAvailable:")? + kib("SwapFree:").unwrap_or(0)) * 1024;
-    // "Max address space  <soft> <hard> bytes": "unlimited" parses as none;
-    // what the process has mapped already (VmSize) is spoken for.
-    let limit = std::fs::read_to_string("/proc/self/limits")
-        .ok()
-        .and_then(|limits| {
-            let line = limits
-                .lines()
-                .find(|l| l.starts_with("Max address space"))?;
-            line.split_whitespace().nth(3)?.parse::<u64>().ok()
-        })
-        .map(|limit| {
-            let status = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
-            let mapped = status
-                .lines()
-                .find(|l| l.starts_with("VmSize:"))
-                .and_then(|l| l.split_whitespace().nth(1)?.parse::<u64>().ok())
-                .unwrap_or(0);
-            limit.saturating_sub(mapped * 1024)
+    let meminfo = read("/proc/meminfo")?;
+    let machine = field(&meminfo, "MemAvailable:")? + field(&meminfo, "SwapFree:").unwrap_or(0);
+    let mut limits = vec![(machine, "this machine has")];
+    // A limit of "max" (v2) parses as none; v1's unlimited is a huge number.
+    let group = number(read("/sys/fs/cgroup/memory.max"))
+        .zip(number(read("/sys/fs/cgroup/memory.current")))
+        .or_else(|| {
+            number(read("/sys/fs/cgroup/memory/memory.limit_in_bytes"))
+                .zip(number(read("/sys/fs/cgroup/memory/memory.usage_in_bytes")))
         });
-    Some(limit.map_or(machine, |limit| limit.min(machine)))
+    if let Some((max, used)) = group {
+        limits.push((max.saturating_sub(used), "this control group has"));
+    }
+    // "Max address space  <soft> <hard> bytes": "unlimited" parses as none.
+    let address_space = read("/proc/self/limits").and_then(|text| {
+        let line = text.lines().find(|l| l.starts_with("Max address space"))?;
+        line.split_whitespace().nth(3)?.parse::<u64>().ok()
+    });
+    if let Some(limit) = address_space {
+        let mapped = read("/proc/self/status")
+            .and_then(|s| field(&s, "VmSize:"))
+            .unwrap_or(0);
+        limits.push((limit.saturating_sub(mapped), "this process may map"));
+    }
+    limits.into_iter().min_by_key(|(bytes, _)| *bytes)
 }
 
 /// A positive number of seconds (`--claim-timeout`).
@@ -809,7 +822,7 @@ fn same_sequence(out_dir: &Path, record: &output::JobRecord) -> anyhow::Result<(
         format!(
             "{} holds {frames} frame file(s) of {} (by its {}); rendering {} there would \
              replace them or mix two sequences in one folder: choose another folder with \
-             --out, or pass --force to replace them",
+             --out, or pass --replace to replace them",
             out_dir.display(),
             what(&old),
             output::JOB_FILE,
@@ -831,7 +844,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let mut record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     plan.check_memory(args.sequence.size.is_some())?;
-    if !args.force {
+    if !args.force && !args.replace {
         same_sequence(&out_dir, &record)?;
     }
     // The folder is meant to hold every range rendered into it: renders in
@@ -915,26 +928,40 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     }
     // Effects that need several samples a pixel, declared with too few:
     // not an error (a test render may want it), but not what they look like.
-    if let Some((frame, scenes, _)) = todo.first().filter(|_| !plan.preview) {
-        let scene = &scenes[0];
-        let n = scene.samples_per_pixel;
-        let mut short = Vec::new();
-        if scene.camera.frame().has_lens() && n < crate::scene::LENS_SAMPLES {
-            short.push(format!(
-                "depth of field needs samples_per_pixel of {} or more to be smooth",
-                crate::scene::LENS_SAMPLES
-            ));
-        }
-        if scene.effects.motion_blur.is_some() && n < crate::scene::MOTION_BLUR_SAMPLES {
-            short.push(format!(
-                "motion blur needs samples_per_pixel of {} or more to blur rather than ghost",
-                crate::scene::MOTION_BLUR_SAMPLES
-            ));
-        }
-        for why in short {
-            say(format!(
-                "warning: frame {frame} has {n} sample(s) per pixel; {why}"
-            ));
+    if !plan.preview {
+        let short = |needs: &dyn Fn(&crate::scene::Scene) -> bool| -> Vec<u32> {
+            let frames = todo.iter().filter(|(_, scenes, _)| needs(&scenes[0]));
+            frames.map(|(frame, _, _)| *frame).collect()
+        };
+        let lens = short(&|s| {
+            s.camera.frame().has_lens() && s.samples_per_pixel < crate::scene::LENS_SAMPLES
+        });
+        let blur = short(&|s| {
+            s.effects.motion_blur.is_some()
+                && s.samples_per_pixel < crate::scene::MOTION_BLUR_SAMPLES
+        });
+        let needs = [
+            (
+                lens,
+                "depth of field",
+                crate::scene::LENS_SAMPLES,
+                "to be smooth",
+            ),
+            (
+                blur,
+                "motion blur",
+                crate::scene::MOTION_BLUR_SAMPLES,
+                "to blur rather than ghost",
+            ),
+        ];
+        for (frames, effect, n, why) in needs {
+            if !frames.is_empty() {
+                say(format!(
+                    "warning: {effect} needs samples_per_pixel of {n} or more {why}; \
+                     frame(s) {} have fewer",
+                    ranges(&frames)
+                ));
+            }
         }
     }
     if !args.quiet && stale > 0 {
@@ -1049,6 +1076,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                     .iter()
                     .map(|(_, c)| format!("{}:{}", c.host, c.pid))
                     .collect();
+                workers.sort();
                 workers.dedup();
                 say(format!(
                     "waiting for frame(s) {} claimed by {} (a claim without a heartbeat for {} s is taken over)",
@@ -1606,9 +1634,8 @@ fn check_frame(t: &Timeline, frame: u32) -> Result<()> {
 /// Sizes rayon's pool to `--threads` when given.
 fn set_threads(threads: Option<usize>) -> Result<()> {
     if let Some(n) = threads {
-        // A frame's bands are its units of work (one per four rows): past a
-        // thousand threads there is nothing for more to do, only their
-        // start-up (10 000 took 44 s for a 64×36 frame).
+        // More threads than cores only cost their start-up (10 000 took
+        // 44 s for a 64×36 frame): a thousand is past any machine's cores.
         const MAX_THREADS: usize = 1024;
         if !(1..=MAX_THREADS).contains(&n) {
             return Err(Error::usage(

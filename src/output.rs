@@ -796,12 +796,24 @@ fn writer_is_dead_here(name: &str) -> bool {
 }
 
 /// Whether process `pid` of this machine is known to have ended: Linux's
-/// /proc has no such process (without /proc, nothing is known). A process
-/// of another machine, or one that reused the pid, is never taken for dead.
+/// /proc has no such process (without /proc, nothing is known; nor where
+/// /proc hides other users' processes, `hidepid`, which shows as no
+/// process 1). A process that reused the pid is taken for alive.
 pub fn gone_here(pid: u32) -> bool {
     pid != std::process::id()
         && Path::new("/proc/self").exists()
+        && Path::new("/proc/1").exists()
         && !Path::new(&format!("/proc/{pid}")).exists()
+}
+
+/// This boot of this machine's kernel and this process's pid namespace
+/// (`<boot id>/<namespace>`), where Linux tells: two processes with the same
+/// host name see each other's pids only if these match (containers that
+/// share a host name, cloned machines that kept one, do not).
+pub fn pid_space() -> Option<String> {
+    let boot = std::fs::read_to_string("/proc/sys/kernel/random/boot_id").ok()?;
+    let namespace = std::fs::read_link("/proc/self/ns/pid").ok()?;
+    Some(format!("{}/{}", boot.trim(), namespace.display()))
 }
 
 /// How long ago `path` was last modified (`None` if that cannot be told).
@@ -909,6 +921,14 @@ pub fn write_contact_sheet(
                 message: e.to_string(),
             })
     };
+    // As large as a frame may be, and no larger.
+    const MAX_SIDE: u64 = 32_768;
+    if thumb_width as u64 > MAX_SIDE {
+        return Err(Error::usage(
+            "--thumb-width",
+            format!("may be at most {MAX_SIDE}, got {thumb_width}"),
+        ));
+    }
     let first = decode(&frames[0])?;
     let thumb_height =
         ((thumb_width as u64 * first.height() as u64) / first.width().max(1) as u64).max(1) as u32;
@@ -916,11 +936,9 @@ pub fn write_contact_sheet(
     let rows = (frames.len() as u32).div_ceil(columns);
     let gap = 2;
     let (w, h) = (
-        columns as u64 * (thumb_width + gap) as u64 - gap as u64,
-        rows as u64 * (thumb_height + gap) as u64 - gap as u64,
+        columns as u64 * (thumb_width as u64 + gap as u64) - gap as u64,
+        rows as u64 * (thumb_height as u64 + gap as u64) - gap as u64,
     );
-    // As large as a frame may be, and no larger.
-    const MAX_SIDE: u64 = 32_768;
     if w > MAX_SIDE || h > MAX_SIDE {
         return Err(Error::usage(
             "--thumb-width/--columns/--count",

@@ -105,18 +105,21 @@ impl Layers {
 
 /// About the most memory rendering and writing one frame of `width`×
 /// `height` takes (upwards of it): the film (colour, alpha, depth and
-/// estimates, 24 bytes a pixel, and the layers), as much again for encoding
-/// it, and for a frame of several samples per pixel the running sums
-/// (colour in f64, hits, depth and estimates spent, 40 bytes a pixel, and
-/// the layers). What a size can be checked against before it is rendered.
-pub fn frame_bytes(width: u32, height: u32, layers: Layers, many_samples: bool) -> u64 {
+/// estimates, 24 bytes a pixel, and the layers); for an EXR as much again
+/// for its blocks, for a PNG its 3 bytes of sRGB codes and a byte of
+/// compressed data; and for a frame of several samples per pixel the
+/// running sums (colour in f64, hits, depth and estimates spent, 40 bytes a
+/// pixel, and the layers). What a size can be checked against before it is
+/// rendered.
+pub fn frame_bytes(width: u32, height: u32, layers: Layers, exr: bool, many_samples: bool) -> u64 {
     let film = 24 + layers.bytes_per_pixel();
+    let encoding = if exr { film } else { 4 };
     let sums = if many_samples {
         40 + layers.bytes_per_pixel()
     } else {
         0
     };
-    width as u64 * height as u64 * (2 * film + sums)
+    width as u64 * height as u64 * (film + encoding + sums)
 }
 
 /// Work counted while rendering one frame.

@@ -116,6 +116,16 @@ fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
     deserializer.deserialize_map(Tracks)
 }
 
+/// A number as a message shows it: as written for everyday sizes, in
+/// exponent form past a million (1e300 rather than its 301 digits).
+fn readable(x: Real) -> String {
+    if x.abs() >= 1e6 {
+        format!("{x:e}")
+    } else {
+        format!("{x}")
+    }
+}
+
 /// The largest camera position or target component a scene may have.
 const MAX_COORDINATE: Real = 1e15;
 
@@ -478,14 +488,11 @@ impl Timeline {
             *map_path = resolved;
         }
         if let Err((field, message)) = validate_scene(&file.scene) {
-            // The field's own name, without an index (`extra_lights[0]` is
-            // on the line of `extra_lights:`).
-            let last = field.rsplit('.').next().unwrap_or("");
-            let line = line_of(
-                text,
-                &format!("{}:", last.split('[').next().unwrap_or("")),
-                0,
-            );
+            // The field's own name; inside a list, the list's
+            // (`extra_lights[0].direction` is on the line of `extra_lights:`).
+            let listed = field.split_once('[').map(|(list, _)| list);
+            let name = listed.unwrap_or(&field).rsplit('.').next().unwrap_or("");
+            let line = line_of(text, &format!("{name}:"), 0);
             return Err(invalid(line, format!("scene.{field}"), message));
         }
 
@@ -788,8 +795,8 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             finite3(v) && v.abs().max_element() <= MAX_COORDINATE,
             field,
             || {
-                let (x, y, z) = (v.x, v.y, v.z);
-                format!("each component must be finite and within ±{MAX_COORDINATE:e}, got ({x:e}, {y:e}, {z:e})")
+                let v = [v.x, v.y, v.z].map(readable);
+                format!("each component must be finite and within ±{MAX_COORDINATE:e}, got ({}, {}, {})", v[0], v[1], v[2])
             },
         )?;
     }
@@ -876,8 +883,11 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             finite3(k) && k.abs().max_element() <= MAX_JULIA,
             "fractal.julia",
             || {
-                let (x, y, z) = (k.x, k.y, k.z);
-                format!("each component must be finite and within ±{MAX_JULIA:e}, got ({x:e}, {y:e}, {z:e})")
+                let k = [k.x, k.y, k.z].map(readable);
+                format!(
+                    "each component must be finite and within ±{MAX_JULIA:e}, got ({}, {}, {})",
+                    k[0], k[1], k[2]
+                )
             },
         )?;
     }
@@ -1507,7 +1517,7 @@ mod tests {
             "(fps: 10, frames: 2, size: (8, 6), scene: (camera: (position: (0, 0.6, 1e300))))";
         let e = parse(far).unwrap_err().to_string();
         assert!(
-            e.contains("scene.camera.position") && e.contains("1e15, got (0e0, 6e-1, 1e300)"),
+            e.contains("scene.camera.position") && e.contains("1e15, got (0, 0.6, 1e300)"),
             "{e}"
         );
         let zoom = with_track(

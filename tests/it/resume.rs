@@ -98,7 +98,7 @@ fn another_timeline_is_not_rendered_over_a_folders_frames() {
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("of t.ron at 48x27") && err.contains("--force"),
+        err.contains("of t.ron at 48x27") && err.contains("--replace"),
         "{err}"
     );
     assert!(d.bytes("out/t/frame_00001.png") == frame);
@@ -108,8 +108,21 @@ fn another_timeline_is_not_rendered_over_a_folders_frames() {
     std::fs::remove_file(d.path().join("out/o/frame_00000.png")).unwrap();
     std::fs::remove_file(d.path().join("out/o/frame_00001.png")).unwrap();
     d.ok(&["render", "t.ron", "--out", "out/o"]);
-    d.ok(&["render", "other.ron", "--out", "out/t", "--force"]);
+    // --replace renders what is not current for other.ron: frame 1 (both
+    // timelines' frame 0 is the power-8 bulb, current as it stands).
+    let out = d.ok(&["render", "other.ron", "--out", "out/t", "--replace"]);
+    assert!(
+        stderr(&out).contains("1 of 2 frames already complete"),
+        "{}",
+        stderr(&out)
+    );
     assert!(d.bytes("out/t/frame_00001.png") != frame);
+    let out = d.ok(&["render", "other.ron", "--out", "out/t", "--replace"]);
+    assert!(
+        stderr(&out).contains("2 of 2 frames already complete"),
+        "{}",
+        stderr(&out)
+    );
 }
 
 #[test]

@@ -116,9 +116,9 @@ fn values_that_would_draw_a_surface_where_there_is_none_are_refused() {
 
 #[test]
 fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
-    // Under a 2 GB address-space limit an 8000×8000 frame (about 2.9 GiB
-    // of buffers) cannot be had: refused up front with exit 2, no folder
-    // made. 1000×1000 still renders.
+    // Under a 2 GB address-space limit a 10000×10000 PNG frame (about
+    // 2.6 GiB of buffers) cannot be had: refused up front with exit 2, no
+    // folder made. 1000×1000 still renders.
     if !std::path::Path::new("/proc/self/limits").exists() {
         return; // only Linux tells the limit
     }
@@ -135,11 +135,12 @@ fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
             .output()
             .unwrap()
     };
-    let out = limited("8000x8000");
+    let out = limited("10000x10000");
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
-    assert!(err.contains("--size: 8000x8000 needs about"), "{err}");
-    assert!(!d.path().join("o8000x8000").exists());
+    assert!(err.contains("--size: 10000x10000 needs about"), "{err}");
+    assert!(err.contains("this process may map"), "{err}");
+    assert!(!d.path().join("o10000x10000").exists());
     let out = limited("1000x1000");
     assert!(out.status.success(), "{}", stderr(&out));
 }
