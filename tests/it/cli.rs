@@ -1,7 +1,7 @@
 //! Rendering through the command line: numbered frames, ranges, sizes, the
 //! ffmpeg command, thread-count determinism, `info` and `pick`.
 
-use crate::util::{stderr, stdout, tiny_timeline, Dir};
+use crate::util::{says, stderr, stdout, tiny_timeline, Dir};
 
 #[test]
 fn render_writes_numbered_frames_and_prints_the_ffmpeg_command() {
@@ -347,11 +347,7 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
     // A preview's frames are pointed at.
     d.ok(&["render", "t.ron", "--preview", "--out", "p", "--quiet"]);
     let out = d.run(&["sheet", "p"]);
-    assert!(
-        stderr(&out).contains("a preview's are in p/preview"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "a preview's are in p/preview");
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! Never losing a night's work, and sharing it out: crash-and-resume under
 //! repeated SIGKILL, `status`, `--shard`, `--claim` workers, a full disk.
 
-use crate::util::{stderr, stdout, tiny_timeline, Dir};
+use crate::util::{says, stderr, stdout, tiny_timeline, Dir};
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -162,7 +162,7 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
     ] {
         let out = d.run(&[&["status", "out/t"], option].concat());
         assert_eq!(out.status.code(), Some(2), "{option:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(option[0]), "{}", stderr(&out));
+        says(&out, option[0]);
     }
     // Another timeline rendered over it with --force: status of the first
     // names the other, and does not call the first changed.

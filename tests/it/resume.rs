@@ -1,7 +1,7 @@
 //! Resume: complete frames are skipped, stale or partial ones re-rendered, and a
 //! render killed mid-way leaves no damaged frame and finishes identically.
 
-use crate::util::{stderr, tiny_timeline, Dir};
+use crate::util::{says, stderr, tiny_timeline, Dir};
 use std::time::{Duration, Instant};
 
 fn mtimes(d: &Dir, sub: &str) -> Vec<std::time::SystemTime> {
@@ -26,11 +26,7 @@ fn second_run_skips_complete_frames() {
     let first = d.bytes("out/t/frame_00001.png");
     std::thread::sleep(Duration::from_millis(20));
     let out = d.ok(&["render", "t.ron"]);
-    assert!(
-        stderr(&out).contains("3 of 3 frames already complete"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "3 of 3 frames already complete");
     assert_eq!(
         mtimes(&d, "out/t"),
         before,
@@ -38,11 +34,7 @@ fn second_run_skips_complete_frames() {
     );
     // --force renders them again, to the same bytes.
     let out = d.ok(&["render", "t.ron", "--force"]);
-    assert!(
-        stderr(&out).contains("3 frames rendered"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "3 frames rendered");
     assert_ne!(mtimes(&d, "out/t"), before);
     assert!(d.bytes("out/t/frame_00001.png") == first, "frame changed");
 }
@@ -57,11 +49,7 @@ fn changed_timeline_rerenders_only_what_changed() {
     // Frame 0 sits on the first key (power 8) either way; frames 1 and 2 change.
     d.write("t.ron", &tiny_timeline(3, 4.0));
     let out = d.ok(&["render", "t.ron"]);
-    assert!(
-        stderr(&out).contains("1 of 3 frames already complete"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "1 of 3 frames already complete");
     assert!(d.bytes("out/t/frame_00002.png") != old, "frame unchanged");
     assert!(d.bytes("out/t/frame_00000.png") == frame0, "frame changed");
     // A different size is a different sequence: refused, since it would
@@ -74,11 +62,7 @@ fn changed_timeline_rerenders_only_what_changed() {
     assert!(err.contains("rendering t.ron at 40x20"), "{err}");
     assert!(d.bytes("out/t/frame_00002.png") == before, "frame replaced");
     let out = d.ok(&["render", "t.ron", "--size", "40x20", "--force"]);
-    assert!(
-        stderr(&out).contains("3 frames rendered"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "3 frames rendered");
     assert!(d.bytes("out/t/frame_00002.png") != before, "frame kept");
 }
 
@@ -111,18 +95,10 @@ fn another_timeline_is_not_rendered_over_a_folders_frames() {
     // --replace renders what is not current for other.ron: frame 1 (both
     // timelines' frame 0 is the power-8 bulb, current as it stands).
     let out = d.ok(&["render", "other.ron", "--out", "out/t", "--replace"]);
-    assert!(
-        stderr(&out).contains("1 of 2 frames already complete"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "1 of 2 frames already complete");
     assert!(d.bytes("out/t/frame_00001.png") != frame);
     let out = d.ok(&["render", "other.ron", "--out", "out/t", "--replace"]);
-    assert!(
-        stderr(&out).contains("2 of 2 frames already complete"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "2 of 2 frames already complete");
 }
 
 #[test]
@@ -205,10 +181,9 @@ fn killed_render_resumes_to_identical_frames() {
         "the render finished before it could be killed"
     );
     let out = d.ok(&["render", "t.ron"]);
-    assert!(
-        stderr(&out).contains(&format!("{done_before} of 12 frames already complete")),
-        "{}",
-        stderr(&out)
+    says(
+        &out,
+        &format!("{done_before} of 12 frames already complete"),
     );
     let finals: Vec<String> = d
         .files("out/t")
@@ -259,11 +234,7 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
         "killed before the end"
     );
     let out = d.ok(&["render", "t.ron"]);
-    assert!(
-        stderr(&out).contains("resumed from a checkpoint at"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "resumed from a checkpoint at");
     assert!(
         d.bytes("out/t/frame_00000.png") == d.bytes("clean/frame_00000.png"),
         "the resumed frame differs from the uninterrupted one"

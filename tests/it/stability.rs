@@ -1,7 +1,7 @@
 //! Hard cases through the binary: whole frames that must come out finite,
 //! quickly, and with a clear message where the scene is odd.
 
-use crate::util::{stderr, Dir};
+use crate::util::{says, stderr, Dir};
 
 /// Every channel of an EXR frame, checked finite; returns (alpha, depth).
 fn finite_channels(d: &Dir, rel: &str) -> (Vec<f32>, Vec<f32>) {
@@ -24,11 +24,7 @@ fn camera_inside_the_bulb_renders_with_a_warning() {
         &scene("camera: (position: (0, 0.1, 0), target: (0, 0, 1))"),
     );
     let out = d.ok(&["render", "t.ron", "--format", "exr"]);
-    assert!(
-        stderr(&out).contains("camera is inside the fractal"),
-        "{}",
-        stderr(&out)
-    );
+    says(&out, "camera is inside the fractal");
     let (alpha, depth) = finite_channels(&d, "out/t/frame_00000.exr");
     assert!(alpha.iter().all(|&a| a == 1.0));
     assert!(depth.iter().all(|&z| z == 0.0));
@@ -181,6 +177,6 @@ fn environment_map_lights_a_path_traced_frame_deterministically() {
     d.write("missing.ron", &text.replace("sky.exr", "nope.exr"));
     let out = d.run(&["render", "missing.ron", "--out", "never"]);
     assert_eq!(out.status.code(), Some(3));
-    assert!(stderr(&out).contains("nope.exr"), "{}", stderr(&out));
+    says(&out, "nope.exr");
     assert!(!d.path().join("never").exists());
 }

@@ -162,3 +162,9 @@ pub fn stdout(o: &Output) -> String {
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
 }
+
+/// Asserts that the run's stderr contains `what`, showing it if not.
+pub fn says(out: &Output, what: &str) {
+    let err = stderr(out);
+    assert!(err.contains(what), "missing {what:?} in: {err}");
+}
