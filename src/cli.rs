@@ -794,18 +794,15 @@ pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(
     Ok((index, count))
 }
 
-/// Refuses a render into a folder of frames from another timeline (by file
-/// name) or of another size, by its job record: the render would replace
-/// them, or leave two sequences mixed under one record. An edited timeline
-/// of the same name and size is the same sequence (its changed frames
-/// re-render).
-fn same_sequence(out_dir: &Path, record: &output::JobRecord) -> anyhow::Result<()> {
-    let Ok(old) = output::JobRecord::read(out_dir) else {
-        return Ok(());
-    };
-    if old.same_sequence(record) {
-        return Ok(());
-    }
+/// Refuses a render (`record`) into a folder whose job record (`old`) is
+/// another sequence's (`JobRecord::same_sequence`), if the folder has
+/// frames: the render would replace them, or leave two sequences mixed
+/// under one record.
+fn refuse_other_sequence(
+    out_dir: &Path,
+    old: &output::JobRecord,
+    record: &output::JobRecord,
+) -> anyhow::Result<()> {
     let frames: usize = [Format::Png, Format::Exr]
         .into_iter()
         .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
@@ -824,7 +821,7 @@ fn same_sequence(out_dir: &Path, record: &output::JobRecord) -> anyhow::Result<(
              replace them or mix two sequences in one folder: choose another folder with \
              --out, or pass --replace to replace them",
             out_dir.display(),
-            what(&old),
+            what(old),
             output::JOB_FILE,
             what(record),
         ),
@@ -844,18 +841,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let mut record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     plan.check_memory(args.sequence.size.is_some())?;
-    if !args.force && !args.replace {
-        same_sequence(&out_dir, &record)?;
-    }
-    // The folder is meant to hold every range rendered into it: renders in
-    // pieces (--frames 0..60, then 60..120) leave a record of 0..120, so
-    // `status OUTDIR` counts the gaps between them.
     if let Ok(old) = output::JobRecord::read(&out_dir) {
         if old.same_sequence(&record) {
+            // The folder is meant to hold every range rendered into it:
+            // renders in pieces (--frames 0..60, then 60..120) leave a
+            // record of 0..120, so `status OUTDIR` counts the gaps.
             record.frames = (
                 old.frames.0.min(record.frames.0),
                 old.frames.1.max(record.frames.1),
             );
+        } else if !args.force && !args.replace {
+            refuse_other_sequence(&out_dir, &old, &record)?;
         }
     }
     if out_dir.exists() && !out_dir.is_dir() {
@@ -1239,7 +1235,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     // A folder last rendered from another timeline file (with --force).
     let other_timeline = job
         .as_ref()
-        .filter(|job| job.timeline_path.file_name() != plan.timeline.source.file_name())
+        .filter(|job| !job.of_timeline(&plan.timeline.source))
         .map(|job| job.timeline_path.clone());
     let changed = other_timeline.is_none()
         && crate::timeline::read_text(&plan.timeline.source)

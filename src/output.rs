@@ -596,10 +596,17 @@ impl JobRecord {
         })
     }
 
-    /// Whether `other` renders the same sequence: the same timeline file
-    /// name (its text may have been edited) at the same size.
+    /// Whether the folder was rendered from the timeline at `path`, by file
+    /// name (its text may have been edited since, and the folder mounted
+    /// at another path).
+    pub fn of_timeline(&self, path: &Path) -> bool {
+        self.timeline_path.file_name() == path.file_name()
+    }
+
+    /// Whether `other` renders the same sequence: the same timeline
+    /// (`of_timeline`) at the same size.
     pub fn same_sequence(&self, other: &JobRecord) -> bool {
-        self.timeline_path.file_name() == other.timeline_path.file_name()
+        self.of_timeline(&other.timeline_path)
             && (self.width, self.height) == (other.width, other.height)
     }
 

@@ -698,10 +698,7 @@ impl Timeline {
         if !self.tracks.iter().any(|t| t.name == ZOOM_TRACK) {
             return Ok(());
         }
-        let mut scene = self.base.clone();
-        for track in self.tracks.iter().filter(|t| t.name != ZOOM_TRACK) {
-            apply(&mut scene, &track.name, &track.sample(time_seconds));
-        }
+        let scene = self.scene_from(time_seconds, |t| t.name != ZOOM_TRACK);
         let c = &scene.camera;
         let away = c.position - c.target;
         if away.length() > 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
@@ -715,8 +712,13 @@ impl Timeline {
 
     /// The scene at any time in seconds, between frames too.
     pub fn scene_at_time(&self, time_seconds: Real) -> Scene {
+        self.scene_from(time_seconds, |_| true)
+    }
+
+    /// The base scene with the tracks `which` keeps applied at a time.
+    fn scene_from(&self, time_seconds: Real, which: impl Fn(&Track) -> bool) -> Scene {
         let mut scene = self.base.clone();
-        for track in &self.tracks {
+        for track in self.tracks.iter().filter(|t| which(t)) {
             apply(&mut scene, &track.name, &track.sample(time_seconds));
         }
         scene
