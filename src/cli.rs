@@ -400,7 +400,10 @@ pub fn ffmpeg_command(
     range: &std::ops::Range<u32>,
     format: Format,
 ) -> String {
-    let input = dir.join(output::frame_pattern(format));
+    // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
+    // own `%` is written `%%`.
+    let input =
+        Path::new(&dir.to_string_lossy().replace('%', "%%")).join(output::frame_pattern(format));
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
     let trc = if format == Format::Exr {
@@ -620,7 +623,11 @@ impl Plan {
     /// their accumulation every `checkpoint_every` and continuing from a
     /// saved one for the same inputs; the result is bit-identical either way.
     /// A one-sample frame renders into `film`, whose buffers the frames of a
-    /// run share. Returns the stats and the samples resumed from.
+    /// run share. `say` gets a line when the frame resumes from a checkpoint
+    /// and a warning when one cannot be saved: the frame goes on without
+    /// (a full disk should not end a night's render whose frames still fit),
+    /// keeping any checkpoint saved before. Returns the stats.
+    #[allow(clippy::too_many_arguments)]
     fn render_frame(
         &self,
         film: &mut crate::render::Film,
@@ -629,7 +636,8 @@ impl Plan {
         hash: &str,
         checkpoint_every: std::time::Duration,
         on_row: &(dyn Fn() + Sync),
-    ) -> anyhow::Result<(FrameStats, u32)> {
+        say: &dyn Fn(Said),
+    ) -> anyhow::Result<FrameStats> {
         let n = scenes[0].samples_per_pixel.max(1);
         let layers = self.layers();
         if n == 1 {
@@ -643,7 +651,7 @@ impl Plan {
                 layers,
                 on_row,
             );
-            return self.write_film(frame, film, hash).map(|stats| (stats, 0));
+            return self.write_film(frame, film, hash);
         }
         let checkpoint = output::checkpoint_path(&self.out_dir, frame);
         let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
@@ -651,19 +659,28 @@ impl Plan {
         let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
-        let resumed = acc.samples_done;
+        if acc.samples_done > 0 {
+            say(Said::Resumed {
+                frame,
+                samples: acc.samples_done,
+                of: n,
+            });
+        }
         let mut saved = Instant::now();
+        let mut saving = true;
         while acc.samples_done < n {
             let until = (acc.samples_done + wave).min(n);
             crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
-            if until < n && saved.elapsed() >= checkpoint_every {
-                output::write_checkpoint(&checkpoint, &acc, hash)?;
+            if saving && until < n && saved.elapsed() >= checkpoint_every {
+                if let Err(e) = output::write_checkpoint(&checkpoint, &acc, hash) {
+                    say(Said::CheckpointFailed { frame, error: e });
+                    saving = false;
+                }
                 saved = Instant::now();
             }
         }
         let film = acc.finish(n);
         self.write_film(frame, &film, hash)
-            .map(|stats| (stats, resumed))
     }
 
     /// Writes every format of a finished frame and drops its checkpoint.
@@ -987,19 +1004,24 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let n = scene[0].samples_per_pixel.max(1);
         current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
-        let (stats, resumed) = plan.render_frame(
+        let stats = plan.render_frame(
             &mut film,
             frame,
             scene,
             hash,
             args.checkpoint_seconds,
             &|| current.inc(1),
+            &|said| match said {
+                Said::Resumed { frame, samples, of } if !args.quiet => say(format!(
+                    "frame {frame}: resuming from a checkpoint at {samples} of {of} samples per pixel"
+                )),
+                Said::Resumed { .. } => {}
+                Said::CheckpointFailed { frame, error } => say(format!(
+                    "warning: frame {frame}: could not save a checkpoint ({error}); \
+                     going on without one for this frame"
+                )),
+            },
         )?;
-        if resumed > 0 && !args.quiet {
-            say(format!(
-                "frame {frame}: resumed from a checkpoint at {resumed} of {n} samples per pixel"
-            ));
-        }
         totals = totals + stats;
         rendered += 1;
         overall.inc(1);
@@ -1040,10 +1062,18 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         );
         // The frames last reported as held by others (said once per change).
         let mut waiting_for = Vec::new();
+        // Frames seen finished, here or by others, are not read again: a
+        // frame is checked whole (every byte), and a worker waiting on a
+        // farm's shared storage would otherwise read them all every round.
+        let mut finished = vec![false; todo.len()];
         loop {
             let mut held = Vec::new();
-            for (frame, scene, hash) in &todo {
+            for (k, (frame, scene, hash)) in todo.iter().enumerate() {
+                if finished[k] {
+                    continue;
+                }
                 if !args.force && plan.is_complete(*frame, hash) {
+                    finished[k] = true;
                     continue;
                 }
                 match crate::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
@@ -1052,21 +1082,28 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         if args.force || !plan.is_complete(*frame, hash) {
                             render_one(*frame, scene, hash)?;
                         }
+                        finished[k] = true;
                         drop(claim);
                     }
                     // Another live worker has it: look again next round.
-                    crate::claim::Attempt::Held(other) => held.push((*frame, other)),
+                    crate::claim::Attempt::Held(other) => held.push((k, other)),
                 }
             }
-            let done = todo
-                .iter()
-                .all(|(frame, _, hash)| plan.is_complete(*frame, hash));
             // With --force a worker makes one pass: "complete" cannot tell its
             // own fresh frames from old ones, so waiting would re-render them.
-            if done || args.force {
+            if args.force {
                 break;
             }
-            let frames: Vec<u32> = held.iter().map(|(frame, _)| *frame).collect();
+            // Frames held when this pass came to them may be done by now.
+            held.retain(|(k, _)| {
+                let (frame, _, hash) = &todo[*k];
+                finished[*k] = plan.is_complete(*frame, hash);
+                !finished[*k]
+            });
+            if held.is_empty() {
+                break;
+            }
+            let frames: Vec<u32> = held.iter().map(|(k, _)| todo[*k].0).collect();
             if !args.quiet && !frames.is_empty() && frames != waiting_for {
                 let mut workers: Vec<String> = held
                     .iter()
@@ -1099,7 +1136,12 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
-        eprintln!("encode the video with:");
+        // A shard's frames are part of the sequence: the others' may still be coming.
+        if shard.is_some_and(|(_, n)| n > 1) {
+            eprintln!("encode the video, once every shard has finished, with:");
+        } else {
+            eprintln!("encode the video with:");
+        }
     }
     if args.stats {
         eprintln!(
@@ -1126,6 +1168,14 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// What `Plan::render_frame` has to say while a frame renders.
+pub enum Said {
+    /// It goes on from a checkpoint holding `samples` of its `of` samples a pixel.
+    Resumed { frame: u32, samples: u32, of: u32 },
+    /// A checkpoint could not be saved; the frame goes on without.
+    CheckpointFailed { frame: u32, error: Error },
+}
+
 /// The state of one frame in an output folder.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum FrameState {
@@ -1138,6 +1188,9 @@ pub enum FrameState {
     Resumable,
     /// A file exists but was made from other inputs (the timeline changed).
     Stale,
+    /// A file exists but cannot be read, or is not whole (cut short by a
+    /// copy or a full disk, or damaged): a render writes it again.
+    Damaged,
     /// Nothing of it yet.
     Missing,
 }
@@ -1148,6 +1201,7 @@ impl FrameState {
         match self {
             FrameState::Complete => "complete",
             FrameState::Stale => "stale",
+            FrameState::Damaged => "damaged",
             FrameState::InProgress => "in_progress",
             FrameState::Resumable => "resumable",
             FrameState::Missing => "missing",
@@ -1220,8 +1274,19 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             FrameState::InProgress
         } else if writing.contains(&frame) {
             FrameState::InProgress
-        } else if output::checkpoint_path(&plan.out_dir, frame).exists() {
+        } else if output::checkpoint_is_for(
+            &output::checkpoint_path(&plan.out_dir, frame),
+            &hash,
+            plan.width,
+            plan.height,
+            plan.layers(),
+        ) {
             FrameState::Resumable
+        } else if plan.formats.iter().any(|&f| {
+            let path = plan.path(frame, f);
+            path.exists() && output::stored_hash(&path, f).is_none()
+        }) {
+            FrameState::Damaged
         } else if plan.formats.iter().any(|&f| plan.path(frame, f).exists()) {
             FrameState::Stale
         } else {
@@ -1847,6 +1912,12 @@ mod tests {
         assert!(
             spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),
             "{spaced}"
+        );
+        let percent = ffmpeg_command(Path::new("take 100%"), "z", 24.0, &(0..5), Format::Png);
+        assert!(
+            percent.contains("-i 'take 100%%/frame_%05d.png'")
+                && percent.ends_with("'take 100%/z.mp4'"),
+            "{percent}"
         );
     }
 }

@@ -126,17 +126,19 @@ pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// The hash stored in an existing frame file, if it has one and can be read.
+/// The hash stored in an existing frame file, if it has one, can be read,
+/// and is whole: every byte of it is checked (`png_is_whole`, and for an
+/// EXR every chunk its offset tables promise, read whole, with nothing
+/// after them), so a frame cut short or damaged by a copy, a full disk or
+/// bit rot is rendered again rather than taken as done.
 pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
+    let file = std::io::BufReader::new(File::open(path).ok()?);
     match format {
         Format::Png => {
             if !png_is_whole(path) {
                 return None;
             }
-            let file = File::open(path).ok()?;
-            let reader = png::Decoder::new(std::io::BufReader::new(file))
-                .read_info()
-                .ok()?;
+            let reader = png::Decoder::new(file).read_info().ok()?;
             let info = reader.info();
             info.uncompressed_latin1_text
                 .iter()
@@ -144,33 +146,64 @@ pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
                 .map(|t| t.text.clone())
         }
         Format::Exr => {
-            let meta = exr::meta::MetaData::read_from_file(path, false).ok()?;
-            let header = meta.headers.first()?;
-            match header
+            let reader = exr::block::read(file, true).ok()?;
+            let header = reader.meta_data().headers.first()?;
+            let hash = match header
                 .own_attributes
                 .other
                 .get(&exr::prelude::Text::from(HASH_KEY))?
             {
-                exr::meta::attribute::AttributeValue::Text(t) => Some(t.to_string()),
-                _ => None,
+                exr::meta::attribute::AttributeValue::Text(t) => t.to_string(),
+                _ => return None,
+            };
+            // The chunks' bytes, not decompressed: a file cut short fails
+            // to read one, and pedantic reading refuses bytes after them.
+            for chunk in reader.all_chunks(true).ok()? {
+                chunk.ok()?;
             }
+            Some(hash)
         }
     }
 }
 
-/// Whether a PNG file ends with its IEND chunk: a cheap check that a file
-/// copied or damaged outside mandelreel was not cut short.
+/// Whether a PNG file is whole: its signature, then chunks whose CRCs all
+/// match their bytes, up to the IEND chunk at the very end. Catches a file
+/// cut short and any damaged byte, without decompressing the image.
 fn png_is_whole(path: &Path) -> bool {
-    use std::io::{Read, Seek, SeekFrom};
-    const IEND: [u8; 12] = [0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xAE, 0x42, 0x60, 0x82];
-    let mut tail = [0u8; 12];
-    File::open(path)
-        .and_then(|mut f| {
-            f.seek(SeekFrom::End(-12))?;
-            f.read_exact(&mut tail)
-        })
-        .is_ok()
-        && tail == IEND
+    use std::io::Read;
+    const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
+    let walk = || -> std::io::Result<bool> {
+        let mut file = std::io::BufReader::with_capacity(1 << 16, File::open(path)?);
+        let mut signature = [0u8; 8];
+        file.read_exact(&mut signature)?;
+        if signature != SIGNATURE {
+            return Ok(false);
+        }
+        let mut buffer = vec![0u8; 1 << 16];
+        loop {
+            // Length (4 bytes, big-endian), type (4), data, CRC of type and data (4).
+            let mut head = [0u8; 8];
+            file.read_exact(&mut head)?;
+            let mut left = u32::from_be_bytes([head[0], head[1], head[2], head[3]]) as usize;
+            let mut crc = crc32fast::Hasher::new();
+            crc.update(&head[4..]);
+            while left > 0 {
+                let piece = &mut buffer[..left.min(1 << 16)];
+                file.read_exact(piece)?;
+                crc.update(piece);
+                left -= piece.len();
+            }
+            let mut stored = [0u8; 4];
+            file.read_exact(&mut stored)?;
+            if crc.finalize() != u32::from_be_bytes(stored) {
+                return Ok(false);
+            }
+            if &head[4..] == b"IEND" {
+                return Ok(file.read(&mut [0u8; 1])? == 0);
+            }
+        }
+    };
+    walk().unwrap_or(false)
 }
 
 /// What a frame file of `format` records of its inputs: the frame's `hash`,
@@ -221,7 +254,7 @@ pub fn write_frame(
 /// any error the temporary file is deleted. Files are readable by all.
 pub fn write_atomic(
     path: &Path,
-    write: impl FnOnce(&mut BufWriter<tempfile::NamedTempFile>, &Path) -> Result<()>,
+    write: impl FnOnce(&mut BufWriter<&File>, &Path) -> Result<()>,
 ) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
@@ -242,12 +275,13 @@ pub fn write_atomic(
     }
     let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
     let temp_path = temp.path().to_path_buf();
-    let mut writer = BufWriter::new(temp);
+    // Written through the plain file: the temporary file's own writer
+    // would add its path to every error, which `Error::io` names already.
+    let mut writer = BufWriter::new(temp.as_file());
     write(&mut writer, &temp_path)?;
-    let temp = writer
+    writer
         .into_inner()
-        .map_err(|e| Error::io(&temp_path, e.into_error()))?;
-    temp.as_file()
+        .map_err(|e| Error::io(&temp_path, e.into_error()))?
         .sync_all()
         .map_err(|e| Error::io(&temp_path, e))?;
     temp.persist(path).map_err(|e| Error::io(path, e.error))?;
@@ -690,6 +724,45 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
     })
 }
 
+/// Whether the checkpoint at `path` was saved for a frame with this
+/// `hash`, size and layers (by its header: what `status` calls resumable).
+pub fn checkpoint_is_for(
+    path: &Path,
+    hash: &str,
+    width: u32,
+    height: u32,
+    layers: crate::render::Layers,
+) -> bool {
+    checkpoint_header(path, hash, width, height, layers).is_some()
+}
+
+/// The checkpoint's header, if it was saved for a frame with this `hash`,
+/// size and layers, and the file positioned at its arrays.
+fn checkpoint_header(
+    path: &Path,
+    hash: &str,
+    width: u32,
+    height: u32,
+    layers: crate::render::Layers,
+) -> Option<(std::io::BufReader<File>, CheckpointHeader)> {
+    use std::io::{BufRead, Read};
+    let mut file = std::io::BufReader::new(File::open(path).ok()?);
+    let mut magic = vec![0; CHECKPOINT_MAGIC.len()];
+    file.read_exact(&mut magic).ok()?;
+    if magic != CHECKPOINT_MAGIC {
+        return None;
+    }
+    let mut line = Vec::new();
+    file.read_until(b'\n', &mut line).ok()?;
+    let header: CheckpointHeader = serde_json::from_slice(line.strip_suffix(b"\n")?).ok()?;
+    let wanted = [layers.normal, layers.albedo, layers.traps];
+    let fits = header.hash == hash
+        && header.width == width
+        && header.height == height
+        && header.layers == wanted;
+    fits.then_some((file, header))
+}
+
 /// The saved accumulation at `path`, if it is whole and belongs to a frame
 /// with this `hash`, size and layers.
 pub fn read_checkpoint(
@@ -701,24 +774,8 @@ pub fn read_checkpoint(
 ) -> Option<crate::render::Accumulation> {
     // Read as it is parsed, so resuming holds the accumulation once, not
     // also the file's bytes.
-    use std::io::{BufRead, Read};
-    let mut file = std::io::BufReader::new(std::fs::File::open(path).ok()?);
-    let mut magic = vec![0; CHECKPOINT_MAGIC.len()];
-    file.read_exact(&mut magic).ok()?;
-    if magic != CHECKPOINT_MAGIC {
-        return None;
-    }
-    let mut line = Vec::new();
-    file.read_until(b'\n', &mut line).ok()?;
-    let header: CheckpointHeader = serde_json::from_slice(line.strip_suffix(b"\n")?).ok()?;
-    let wanted = [layers.normal, layers.albedo, layers.traps];
-    if header.hash != hash
-        || header.width != width
-        || header.height != height
-        || header.layers != wanted
-    {
-        return None;
-    }
+    use std::io::Read;
+    let (mut file, header) = checkpoint_header(path, hash, width, height, layers)?;
     let mut acc = crate::render::Accumulation::new(width, height, layers);
     fn take<const N: usize>(file: &mut impl Read) -> Option<[u8; N]> {
         let mut bytes = [0; N];

@@ -118,11 +118,71 @@ fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
 
 /// A number as a message shows it: as written for everyday sizes, in
 /// exponent form past a million (1e300 rather than its 301 digits).
-fn readable(x: Real) -> String {
-    if x.abs() >= 1e6 {
-        format!("{x:e}")
-    } else {
-        format!("{x}")
+/// The number written at `line`:`column` (1-based), where a parse error
+/// stopped, if it stopped at the fraction or exponent of a number: a field
+/// that counts (iterations, frames, a size) given `10.5` or `1e3`, which
+/// RON reports as a missing comma.
+fn fraction_at(text: &str, line: usize, column: usize) -> Option<String> {
+    let row = text.lines().nth(line.checked_sub(1)?)?;
+    let at = row.char_indices().nth(column.checked_sub(1)?)?.0;
+    let (before, after) = row.split_at(at);
+    let number = |c: char| c.is_ascii_digit() || "+-.eE_".contains(c);
+    let digits = before.trim_end_matches(|c: char| c.is_ascii_digit() || c == '_');
+    let whole = &before[digits.len()..];
+    if whole.is_empty() || !after.starts_with(['.', 'e', 'E']) {
+        return None;
+    }
+    let sign = if digits.ends_with('-') { "-" } else { "" };
+    let rest: String = after.chars().take_while(|&c| number(c)).collect();
+    Some(format!("{sign}{whole}{rest}"))
+}
+
+/// A value as messages show it: numbers as written at ordinary
+/// magnitudes, in e-notation from a million up and below 1e-4 (not 309
+/// digits of 1e308), and an infinity said to be what a number too large
+/// for its field became when read (an f32 field given 1e300).
+trait Shown {
+    fn shown(&self) -> String;
+}
+
+macro_rules! shown_number {
+    ($t:ty) => {
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                let x = *self;
+                if x.is_infinite() {
+                    format!("{x} (or a number too large to hold)")
+                } else if x != 0.0 && (x.abs() >= 1e6 || x.abs() < 1e-4) {
+                    format!("{x:e}")
+                } else {
+                    format!("{x}")
+                }
+            }
+        }
+    };
+}
+shown_number!(f64);
+shown_number!(f32);
+
+impl Shown for DVec3 {
+    fn shown(&self) -> String {
+        format!(
+            "({}, {}, {})",
+            self.x.shown(),
+            self.y.shown(),
+            self.z.shown()
+        )
+    }
+}
+
+impl Shown for Vec3 {
+    fn shown(&self) -> String {
+        format!(
+            "({}, {}, {})",
+            self.x.shown(),
+            self.y.shown(),
+            self.z.shown()
+        )
     }
 }
 
@@ -397,7 +457,10 @@ impl Timeline {
             file: path.to_path_buf(),
             line: e.span.start.line,
             column: e.span.start.col,
-            message: e.code.to_string(),
+            message: match fraction_at(text, e.span.start.line, e.span.start.col) {
+                Some(number) => format!("expected a whole number here, got {number}"),
+                None => e.code.to_string(),
+            },
         })?;
         let invalid = |line: Option<usize>, field: String, message: String| Error::Invalid {
             file: path.to_path_buf(),
@@ -419,7 +482,10 @@ impl Timeline {
         if !(file.fps > 0.0 && file.fps <= MAX_FPS) {
             return Err(top(
                 "fps",
-                format!("must be a number in (0, {MAX_FPS}], got {}", file.fps),
+                format!(
+                    "must be a number in (0, {MAX_FPS}], got {}",
+                    file.fps.shown()
+                ),
             ));
         }
         let (width, height) = file.size;
@@ -442,10 +508,25 @@ impl Timeline {
             (Some(n), None) => n,
             (None, Some(d)) => {
                 let n = d * file.fps;
-                if !(d.is_finite() && d > 0.0 && n >= 0.5 && n < u32::MAX as Real) {
+                if !(d.is_finite() && d > 0.0 && n >= 0.5) {
                     return Err(top(
                         "duration_seconds",
-                        format!("must give at least one frame at {} fps, got {d}", file.fps),
+                        format!(
+                            "must give at least one frame at {} fps, got {}",
+                            file.fps,
+                            d.shown()
+                        ),
+                    ));
+                }
+                if n.round() > u32::MAX as Real {
+                    return Err(top(
+                        "duration_seconds",
+                        format!(
+                            "gives {} frames at {} fps, more than the {} a timeline may have",
+                            n.round().shown(),
+                            file.fps,
+                            u32::MAX
+                        ),
                     ));
                 }
                 n.round() as u32
@@ -543,7 +624,10 @@ impl Timeline {
                     return Err(at(
                         format!(".keys[{k}].time"),
                         Some(k),
-                        format!("must be a finite number of seconds, got {}", key.time),
+                        format!(
+                            "must be a finite number of seconds, got {}",
+                            key.time.shown()
+                        ),
                     ));
                 }
                 if let Some(&prev) = times.last() {
@@ -575,14 +659,17 @@ impl Timeline {
                     return Err(at(
                         format!(".keys[{k}].value"),
                         Some(k),
-                        format!("values must be finite, got {bad}"),
+                        format!("values must be finite, got {}", bad.shown()),
                     ));
                 }
                 if log_space && values[0] <= 0.0 {
                     return Err(at(
                         format!(".keys[{k}].value"),
                         Some(k),
-                        format!("a camera distance must be positive, got {}", values[0]),
+                        format!(
+                            "a camera distance must be positive, got {}",
+                            values[0].shown()
+                        ),
                     ));
                 }
                 for (column, v) in columns.iter_mut().zip(values) {
@@ -765,27 +852,24 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         }
     }
     // The three checks most fields need, each with one wording.
-    fn positive<T: Into<f64> + Copy + std::fmt::Display>(
-        v: T,
-        field: &str,
-    ) -> Result<(), (String, String)> {
+    fn positive<T: Into<f64> + Copy + Shown>(v: T, field: &str) -> Result<(), (String, String)> {
         let x: f64 = v.into();
         check(x.is_finite() && x > 0.0, field, || {
-            format!("must be positive, got {v}")
+            format!("must be positive, got {}", v.shown())
         })
     }
-    fn non_negative<T: Into<f64> + Copy + std::fmt::Display>(
+    fn non_negative<T: Into<f64> + Copy + Shown>(
         v: T,
         field: &str,
     ) -> Result<(), (String, String)> {
         let x: f64 = v.into();
         check(x.is_finite() && x >= 0.0, field, || {
-            format!("must be non-negative, got {v}")
+            format!("must be non-negative, got {}", v.shown())
         })
     }
     fn colour(c: Vec3, field: &str) -> Result<(), (String, String)> {
         check(c.is_finite() && c.min_element() >= 0.0, field, || {
-            format!("colours must be finite and non-negative, got {c}")
+            format!("colours must be finite and non-negative, got {}", c.shown())
         })
     }
     let finite3 = |v: DVec3| v.is_finite();
@@ -797,21 +881,28 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             finite3(v) && v.abs().max_element() <= MAX_COORDINATE,
             field,
             || {
-                let v = [v.x, v.y, v.z].map(readable);
-                format!("each component must be finite and within ±{MAX_COORDINATE:e}, got ({}, {}, {})", v[0], v[1], v[2])
+                format!(
+                    "each component must be finite and within ±{MAX_COORDINATE:e}, got {}",
+                    v.shown()
+                )
             },
         )?;
     }
     check(finite3(c.up), "camera.up", || {
-        format!("must be finite, got {}", c.up)
+        format!("must be finite, got {}", c.up.shown())
     })?;
     check(c.roll_degrees.is_finite(), "camera.roll_degrees", || {
-        format!("must be finite, got {}", c.roll_degrees)
+        format!("must be finite, got {}", c.roll_degrees.shown())
     })?;
     check(
         c.fov_degrees.is_finite() && c.fov_degrees > 0.0 && c.fov_degrees < 179.0,
         "camera.fov_degrees",
-        || format!("must be between 0 and 179 degrees, got {}", c.fov_degrees),
+        || {
+            format!(
+                "must be between 0 and 179 degrees, got {}",
+                c.fov_degrees.shown()
+            )
+        },
     )?;
     check(
         c.aperture_radius.is_finite() && c.aperture_radius >= 0.0,
@@ -819,7 +910,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         || {
             format!(
                 "must be 0 (a pinhole) or positive, got {}",
-                c.aperture_radius
+                c.aperture_radius.shown()
             )
         },
     )?;
@@ -850,7 +941,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         || {
             format!(
                 "must not be zero or parallel to the view direction, got {}",
-                c.up
+                c.up.shown()
             )
         },
     )?;
@@ -858,7 +949,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         f.power.is_finite() && f.power >= 1.0 && f.power <= 64.0,
         "fractal.power",
-        || format!("must be between 1 and 64, got {}", f.power),
+        || format!("must be between 1 and 64, got {}", f.power.shown()),
     )?;
     check(
         (1..=10_000).contains(&f.iterations),
@@ -868,13 +959,14 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         f.bailout.is_finite() && f.bailout > 1.0,
         "fractal.bailout",
-        || format!("must be a finite number above 1, got {}", f.bailout),
+        || format!("must be a finite number above 1, got {}", f.bailout.shown()),
     )?;
     // An orbit at the bailout is raised to the power once more: keep that finite.
     check(f.power * f.bailout.ln() < 600.0, "fractal.bailout", || {
         format!(
             "bailout^power must stay below e^600 (f64 overflows near e^709), got {}^{}",
-            f.bailout, f.power
+            f.bailout.shown(),
+            f.power.shown()
         )
     })?;
     if let Some(k) = f.julia {
@@ -885,10 +977,9 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             finite3(k) && k.abs().max_element() <= MAX_JULIA,
             "fractal.julia",
             || {
-                let k = [k.x, k.y, k.z].map(readable);
                 format!(
-                    "each component must be finite and within ±{MAX_JULIA:e}, got ({}, {}, {})",
-                    k[0], k[1], k[2]
+                    "each component must be finite and within ±{MAX_JULIA:e}, got {}",
+                    k.shown()
                 )
             },
         )?;
@@ -909,19 +1000,19 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         || {
             format!(
                 "must be at most {MAX_BOUNDING_RADIUS:e}, got {}",
-                q.bounding_radius
+                q.bounding_radius.shown()
             )
         },
     )?;
     check(
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
         "quality.fudge",
-        || format!("must be in (0, 1], got {}", q.fudge),
+        || format!("must be in (0, 1], got {}", q.fudge.shown()),
     )?;
     check(
         q.over_relaxation.is_finite() && (1.0..2.0).contains(&q.over_relaxation),
         "quality.over_relaxation",
-        || format!("must be in [1, 2), got {}", q.over_relaxation),
+        || format!("must be in [1, 2), got {}", q.over_relaxation.shown()),
     )?;
     check(
         (1..=1_000_000).contains(&q.max_steps),
@@ -945,7 +1036,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         || {
             format!(
                 "must be a finite non-zero vector, got {}",
-                l.light_direction
+                l.light_direction.shown()
             )
         },
     )?;
@@ -964,7 +1055,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     check(
         l.trap_occlusion.is_finite() && (0.0..=1.0).contains(&l.trap_occlusion),
         "look.trap_occlusion",
-        || format!("must be in [0, 1], got {}", l.trap_occlusion),
+        || format!("must be in [0, 1], got {}", l.trap_occlusion.shown()),
     )?;
     check(
         l.extra_lights.len() < crate::shade::MAX_LIGHTS,
@@ -981,7 +1072,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             light.direction.is_finite() && light.direction.length() > 0.0,
             &format!("look.extra_lights[{i}].direction"),
-            || format!("must be a finite non-zero vector, got {}", light.direction),
+            || {
+                format!(
+                    "must be a finite non-zero vector, got {}",
+                    light.direction.shown()
+                )
+            },
         )?;
         check(
             light.colour.is_finite()
@@ -992,7 +1088,8 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             || {
                 format!(
                     "colour and intensity must be finite and non-negative, got {} × {}",
-                    light.colour, light.intensity
+                    light.colour.shown(),
+                    light.intensity.shown()
                 )
             },
         )?;
@@ -1002,7 +1099,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             sh.softness.is_finite() && sh.softness >= 0.0,
             "effects.shadows.softness",
-            || format!("must be 0 (hard) or positive, got {}", sh.softness),
+            || format!("must be 0 (hard) or positive, got {}", sh.softness.shown()),
         )?;
         check(
             (1..=100_000).contains(&sh.max_steps),
@@ -1020,7 +1117,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             ao.strength.is_finite() && (0.0..=1.0).contains(&ao.strength),
             "effects.ambient_occlusion.strength",
-            || format!("must be in [0, 1], got {}", ao.strength),
+            || format!("must be in [0, 1], got {}", ao.strength.shown()),
         )?;
     }
     if let Some(sp) = &e.specular {
@@ -1047,7 +1144,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             pt.sun_angle_degrees.is_finite() && (0.0..=30.0).contains(&pt.sun_angle_degrees),
             "effects.path_tracing.sun_angle_degrees",
-            || format!("must be 0..=30, got {}", pt.sun_angle_degrees),
+            || format!("must be 0..=30, got {}", pt.sun_angle_degrees.shown()),
         )?;
         non_negative(pt.sky_intensity, "effects.path_tracing.sky_intensity")?;
         match pt.sky {
@@ -1055,7 +1152,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             crate::shade::Sky::Preetham { turbidity } => check(
                 turbidity.is_finite() && (1.7..=12.0).contains(&turbidity),
                 "effects.path_tracing.sky",
-                || format!("Preetham turbidity must be 1.7..=12, got {turbidity}"),
+                || {
+                    format!(
+                        "Preetham turbidity must be 1.7..=12, got {}",
+                        turbidity.shown()
+                    )
+                },
             )?,
             crate::shade::Sky::Gradient | crate::shade::Sky::Environment { .. } => {}
         }
@@ -1064,7 +1166,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         check(
             m.shutter.is_finite() && m.shutter > 0.0 && m.shutter <= 1.0,
             "effects.motion_blur.shutter",
-            || format!("must be in (0, 1] of the frame interval, got {}", m.shutter),
+            || {
+                format!(
+                    "must be in (0, 1] of the frame interval, got {}",
+                    m.shutter.shown()
+                )
+            },
         )?;
     }
     if let Some(g) = &e.glow {
@@ -1507,6 +1614,41 @@ mod tests {
         let e = parse(text).unwrap_err().to_string();
         assert!(
             e.starts_with("test.ron:3: scene.look.extra_lights[0]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn messages_name_fractions_and_show_extreme_numbers_readably() {
+        // A fraction where a count is wanted: RON alone says "Expected comma".
+        let e = parse("(fps: 10, frames: 2,\n size: (320.5, 180))")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "test.ron:2:12: expected a whole number here, got 320.5");
+        let e = parse("(fps: 10, frames: 2.5, size: (8, 6))")
+            .unwrap_err()
+            .to_string();
+        assert!(e.ends_with("expected a whole number here, got 2.5"), "{e}");
+        // Other syntax errors keep RON's words.
+        let e = parse("(fps: 10, frames: 2 size: (8, 6))")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("Expected comma"), "{e}");
+        // 1e308 in e-notation, not 309 digits; an f32 field's overflow named.
+        let fov = "(fps: 10, frames: 2, size: (8, 6), scene: (camera: (fov_degrees: 1e308)))";
+        let e = parse(fov).unwrap_err().to_string();
+        assert!(e.ends_with("got 1e308"), "{e}");
+        let colour = "(fps: 10, frames: 2, size: (8, 6), scene: (look: (ambient: (1e300, 0, 0))))";
+        let e = parse(colour).unwrap_err().to_string();
+        assert!(
+            e.contains("got (inf (or a number too large to hold), 0, 0)"),
+            "{e}"
+        );
+        // A duration of too many frames says so (it said "at least one frame").
+        let long = parse("(fps: 24, duration_seconds: 1e300, size: (8, 6))");
+        let e = long.unwrap_err().to_string();
+        assert!(
+            e.contains("gives 2.4e301 frames at 24 fps, more than"),
             "{e}"
         );
     }

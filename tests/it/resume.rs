@@ -233,8 +233,23 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
         !d.files("out/t").contains(&"frame_00000.png".to_string()),
         "killed before the end"
     );
+    // `status` counts the frame resumable, but not against other inputs,
+    // for which the checkpoint is no use.
+    let status = |timeline: &str| -> serde_json::Value {
+        let out = d.run(&["status", timeline, "--out", "out/t", "--json"]);
+        serde_json::from_str(&crate::util::stdout(&out)).unwrap()
+    };
+    assert_eq!(
+        status("t.ron")["states"]["resumable"],
+        serde_json::json!([0])
+    );
+    d.write("t2.ron", &text.replace("iterations: 8", "iterations: 7"));
+    assert_eq!(
+        status("t2.ron")["states"]["missing"],
+        serde_json::json!([0])
+    );
     let out = d.ok(&["render", "t.ron"]);
-    says(&out, "resumed from a checkpoint at");
+    says(&out, "resuming from a checkpoint at");
     assert!(
         d.bytes("out/t/frame_00000.png") == d.bytes("clean/frame_00000.png"),
         "the resumed frame differs from the uninterrupted one"
@@ -243,4 +258,63 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
         !d.files("out/t").iter().any(|f| f.ends_with(".ckpt")),
         "checkpoint left behind"
     );
+}
+
+#[test]
+fn frames_cut_short_or_damaged_are_rendered_again() {
+    // A frame file whose bytes are not all there or not all right (a copy
+    // cut short, a full disk, bit rot) is not taken for a finished frame,
+    // even though its header carries the current hash.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    let args = ["render", "t.ron", "--format", "png,exr", "--quiet"];
+    d.ok(&args);
+    let clean = |f: &str| d.bytes(&format!("out/t/{f}"));
+    let (exr, png) = (clean("frame_00001.exr"), clean("frame_00002.png"));
+    // The EXR cut to half its length; one byte flipped in the PNG's image data.
+    d.write_bytes("out/t/frame_00001.exr", &exr[..exr.len() / 2]);
+    let mut flipped = png.clone();
+    flipped[png.len() / 2] ^= 0x10;
+    d.write_bytes("out/t/frame_00002.png", &flipped);
+    let out = d.run(&["status", "out/t", "--json"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+    let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
+    assert_eq!(v["states"]["damaged"], serde_json::json!([1, 2]), "{v}");
+    let out = d.ok(&["render", "t.ron", "--format", "png,exr"]);
+    says(&out, "1 of 3 frames already complete");
+    assert!(clean("frame_00001.exr") == exr, "EXR not rendered again");
+    assert!(clean("frame_00002.png") == png, "PNG not rendered again");
+    // Bytes after a whole file's end are damage too.
+    let mut longer = exr.clone();
+    longer.extend_from_slice(b"tail");
+    d.write_bytes("out/t/frame_00001.exr", &longer);
+    let mut longer = png.clone();
+    longer.extend_from_slice(b"tail");
+    d.write_bytes("out/t/frame_00002.png", &longer);
+    let out = d.run(&["status", "out/t", "--json"]);
+    let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
+    assert_eq!(v["states"]["damaged"], serde_json::json!([1, 2]), "{v}");
+}
+
+#[test]
+fn a_checkpoint_that_cannot_be_saved_warns_and_the_frame_goes_on() {
+    // A full disk (here, a folder in the checkpoint's place) must not end a
+    // render whose frames still fit.
+    let d = Dir::new();
+    let text = tiny_timeline(1, 8.0).replace(
+        "fractal: (iterations: 8)",
+        "fractal: (iterations: 8), samples_per_pixel: 16",
+    );
+    d.write("t.ron", &text);
+    d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
+    std::fs::create_dir_all(d.path().join("out/t/.frame_00000.ckpt")).unwrap();
+    let out = d.ok(&["render", "t.ron", "--checkpoint-seconds", "0", "--quiet"]);
+    says(&out, "warning: frame 0: could not save a checkpoint");
+    assert_eq!(
+        stderr(&out).matches("could not save").count(),
+        1,
+        "one warning a frame: {}",
+        stderr(&out)
+    );
+    assert!(d.bytes("out/t/frame_00000.png") == d.bytes("clean/frame_00000.png"));
 }
