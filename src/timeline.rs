@@ -164,27 +164,18 @@ macro_rules! shown_number {
 shown_number!(f64);
 shown_number!(f32);
 
-impl Shown for DVec3 {
-    fn shown(&self) -> String {
-        format!(
-            "({}, {}, {})",
-            self.x.shown(),
-            self.y.shown(),
-            self.z.shown()
-        )
-    }
+macro_rules! shown_vector {
+    ($t:ty) => {
+        impl Shown for $t {
+            fn shown(&self) -> String {
+                let [x, y, z] = [self.x.shown(), self.y.shown(), self.z.shown()];
+                format!("({x}, {y}, {z})")
+            }
+        }
+    };
 }
-
-impl Shown for Vec3 {
-    fn shown(&self) -> String {
-        format!(
-            "({}, {}, {})",
-            self.x.shown(),
-            self.y.shown(),
-            self.z.shown()
-        )
-    }
-}
+shown_vector!(DVec3);
+shown_vector!(Vec3);
 
 /// The largest camera position or target component a scene may have.
 const MAX_COORDINATE: Real = 1e15;
