@@ -146,6 +146,9 @@ pub struct AccuracyArgs {
     /// Size to measure at [default: the timeline's aspect, 160 pixels wide at most].
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
+    /// Override the timeline's samples_per_pixel for the scene measured.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub samples: Option<u32>,
     /// Folder for accuracy.csv, accuracy.md and accuracy.png [default: out/<timeline name>].
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -194,6 +197,11 @@ pub struct SequenceArgs {
     /// Quick look: half width and height, one sample per pixel, in <out>/preview.
     #[arg(long)]
     pub preview: bool,
+    /// Override the timeline's samples_per_pixel: anti-aliasing for a final
+    /// (4 or 9 takes the flicker out of fine detail; time grows with it).
+    #[arg(long, value_name = "N", conflicts_with = "preview",
+          value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub samples: Option<u32>,
     /// Extra EXR layers, comma-separated (needs --format exr): normal, albedo, traps, steps.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<output::Aov>,
@@ -431,6 +439,8 @@ struct Plan {
     out_dir: PathBuf,
     preview: bool,
     aovs: Vec<output::Aov>,
+    /// `--samples`, applied to the timeline's scene (and recorded).
+    samples: Option<u32>,
 }
 
 impl Plan {
@@ -450,40 +460,26 @@ impl Plan {
                 Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
             );
         }
-        Plan::for_timeline(
-            timeline,
-            args.out.as_deref(),
-            args.frames.as_deref(),
-            args.size.as_deref(),
-            &formats,
-            args.preview,
-            aovs,
-        )
-    }
-
-    fn for_timeline(
-        timeline: Timeline,
-        out: Option<&Path>,
-        frames: Option<&str>,
-        size: Option<&str>,
-        formats: &[Format],
-        preview: bool,
-        aovs: Vec<output::Aov>,
-    ) -> anyhow::Result<Plan> {
-        let (mut width, mut height) = match size {
+        let mut timeline = timeline;
+        if let Some(n) = args.samples {
+            timeline.base.samples_per_pixel = n;
+        }
+        let (mut width, mut height) = match &args.size {
             Some(s) => parse_size("--size", s)?,
             None => (timeline.width, timeline.height),
         };
-        let range = match frames {
+        let range = match &args.frames {
             Some(f) => parse_frames(f, timeline.frame_count)?,
             None => 0..timeline.frame_count,
         };
-        let mut formats = formats.to_vec();
+        let mut formats = formats;
         formats.sort_by_key(|f| f.extension());
         formats.dedup();
-        let mut out_dir = out
-            .map(Path::to_path_buf)
+        let mut out_dir = args
+            .out
+            .clone()
             .unwrap_or_else(|| Path::new("out").join(&timeline.name));
+        let preview = args.preview;
         if preview {
             width = (width / 2).max(1);
             height = (height / 2).max(1);
@@ -498,6 +494,7 @@ impl Plan {
             out_dir,
             preview,
             aovs,
+            samples: args.samples,
         })
     }
 
@@ -521,7 +518,10 @@ impl Plan {
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
         let job = output::JobRecord::read(dir)?;
-        let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        let mut timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        if let Some(n) = job.samples {
+            timeline.base.samples_per_pixel = n;
+        }
         let formats = job
             .formats
             .iter()
@@ -535,6 +535,7 @@ impl Plan {
             out_dir: dir.to_path_buf(),
             preview: job.preview,
             aovs: job.aovs,
+            samples: job.samples,
             timeline,
         })
     }
@@ -588,6 +589,7 @@ impl Plan {
             frames: (self.range.start, self.range.end),
             preview: self.preview,
             aovs: self.aovs.clone(),
+            samples: self.samples,
         })
     }
 
@@ -1238,6 +1240,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             ("--format", !s.format.is_empty()),
             ("--aov", !s.aov.is_empty()),
             ("--preview", s.preview),
+            ("--samples", s.samples.is_some()),
         ];
         if let Some((option, _)) = given.iter().find(|(_, given)| *given) {
             return Err(Error::usage(
@@ -1713,7 +1716,10 @@ fn set_threads(threads: Option<usize>) -> Result<()> {
 }
 
 fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
-    let t = Timeline::load(&args.timeline)?;
+    let mut t = Timeline::load(&args.timeline)?;
+    if let Some(n) = args.samples {
+        t.base.samples_per_pixel = n;
+    }
     let (width, height) = match &args.size {
         Some(s) => parse_size("--size", s)?,
         None => {

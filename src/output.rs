@@ -618,6 +618,10 @@ pub struct JobRecord {
     pub preview: bool,
     #[serde(default)]
     pub aovs: Vec<Aov>,
+    /// `--samples`, where given: the samples per pixel that replaced the
+    /// timeline's.
+    #[serde(default)]
+    pub samples: Option<u32>,
 }
 
 impl JobRecord {

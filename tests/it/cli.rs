@@ -47,6 +47,40 @@ fn frame_range_is_half_open_and_size_overrides() {
 }
 
 #[test]
+fn samples_on_the_command_line_render_what_the_timeline_would() {
+    // `--samples 4` gives the very frames of a timeline that says
+    // samples_per_pixel: 4, and the folder records it for `status`.
+    let d = Dir::new();
+    let text = tiny_timeline(2, 6.0);
+    d.write("t.ron", &text);
+    let four = text.replace(
+        "fractal: (iterations: 8)",
+        "fractal: (iterations: 8), samples_per_pixel: 4",
+    );
+    d.write("t4.ron", &four);
+    d.ok(&["render", "t4.ron", "--quiet"]);
+    d.ok(&["render", "t.ron", "--samples", "4", "--quiet"]);
+    d.ok(&["render", "t.ron", "--out", "one", "--quiet"]);
+    for f in ["frame_00000.png", "frame_00001.png"] {
+        let given = d.bytes(&format!("out/t/{f}"));
+        assert!(given == d.bytes(&format!("out/t4/{f}")), "{f} differs");
+        assert!(given != d.bytes(&format!("one/{f}")), "{f} is one sample's");
+    }
+    assert!(stdout(&d.ok(&["status", "out/t"])).contains("2 of 2 frames complete"));
+    let out = d.run(&["status", "t.ron"]);
+    assert_eq!(
+        out.status.code(),
+        Some(4),
+        "one sample's frames are not these"
+    );
+    d.ok(&["status", "t.ron", "--samples", "4"]);
+    for bad in [&["--samples", "0"][..], &["--samples", "4", "--preview"]] {
+        let out = d.run(&[&["render", "t.ron"][..], bad].concat());
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
+    }
+}
+
+#[test]
 fn preview_renders_half_size_into_its_own_folder() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(1, 8.0));
