@@ -1319,6 +1319,8 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 folder: &'a Path,
                 timeline: &'a Path,
                 frames: (u32, u32),
+                /// The timeline's own frame count (`frames` may be fewer).
+                timeline_frames: u32,
                 total: usize,
                 complete: usize,
                 states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
@@ -1334,6 +1336,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     folder: &plan.out_dir,
                     timeline: &plan.timeline.source,
                     frames: (plan.range.start, plan.range.end),
+                    timeline_frames: plan.timeline.frame_count,
                     total,
                     complete,
                     states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
@@ -1364,6 +1367,18 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 out!(
                     "  workers: {}",
                     workers.iter().cloned().collect::<Vec<_>>().join(", ")
+                );
+            }
+            let all = plan.timeline.frame_count;
+            if plan.range != (0..all) {
+                out!(
+                    "  note: {} has {all} frames; these are the ones counted{}",
+                    plan.timeline.source.display(),
+                    if args.target.is_dir() && args.sequence.frames.is_none() {
+                        format!(" (the ranges rendered into this folder; --frames 0..{all} counts them all)")
+                    } else {
+                        String::new()
+                    }
                 );
             }
             if changed {

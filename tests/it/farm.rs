@@ -153,6 +153,13 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
     let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
     assert_eq!(v["frames"], serde_json::json!([0, 6]));
     assert_eq!(v["states"]["missing"], serde_json::json!([2, 3]));
+    assert_eq!(v["timeline_frames"], 8);
+    // The text says the timeline has more, and how to count them all.
+    let text = stdout(&d.run(&["status", "out/t"]));
+    assert!(
+        text.contains("t.ron has 8 frames") && text.contains("--frames 0..8 counts them all"),
+        "{text}"
+    );
     // --frames narrows a folder's range; what the folder records is not
     // overridden from the command line.
     assert!(stdout(&d.ok(&["status", "out/t", "--frames", "4..6"])).contains("2 of 2"));
@@ -161,6 +168,7 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
         &["--format", "exr"],
         &["--out", "x"],
         &["--preview"],
+        &["--samples", "4"],
     ] {
         let out = d.run(&[&["status", "out/t"], option].concat());
         assert_eq!(out.status.code(), Some(2), "{option:?}: {}", stderr(&out));
