@@ -38,6 +38,68 @@ pub struct ClaimRecord {
     pub pid_space: Option<String>,
 }
 
+impl ClaimRecord {
+    /// A record for this process, with a fresh token and heartbeat.
+    fn mine() -> ClaimRecord {
+        ClaimRecord {
+            host: crate::output::host_name(),
+            pid: std::process::id(),
+            token: format!(
+                "{}-{}-{}",
+                crate::output::host_name(),
+                std::process::id(),
+                SystemTime::now()
+                    .duration_since(UNIX_EPOCH)
+                    .map(|d| d.as_nanos())
+                    .unwrap_or(0)
+            ),
+            heartbeat_ms: now_ms(),
+            pid_space: crate::output::pid_space(),
+        }
+    }
+}
+
+/// The prefix of run records' file names (`announce_run`).
+const RUN_PREFIX: &str = ".mandelreel-run-";
+
+/// Says that a render runs in `dir`, until the guard is dropped: a record
+/// like a claim's (`.mandelreel-run-<token>`), its heartbeat refreshed every
+/// quarter `timeout`, so `status` can tell a running render from a dead
+/// one whatever its kind (plain, shard or claim worker). Records of renders
+/// that are gone (`is_live`) are removed first.
+pub fn announce_run(dir: &Path, timeout: Duration) -> Result<Claim> {
+    for (path, record) in runs(dir) {
+        if !is_live(&record, timeout) {
+            let _ = std::fs::remove_file(path);
+        }
+    }
+    let record = ClaimRecord::mine();
+    let path = dir.join(format!("{RUN_PREFIX}{}", record.token));
+    write_record(&path, &record)?;
+    Ok(Claim::start(path, record, timeout / 4, Vec::new()))
+}
+
+/// The renders running in `dir` (`announce_run`), by their records.
+pub fn live_runs(dir: &Path, timeout: Duration) -> Vec<ClaimRecord> {
+    runs(dir)
+        .into_iter()
+        .map(|(_, record)| record)
+        .filter(|record| is_live(record, timeout))
+        .collect()
+}
+
+/// Every run record in `dir`, live or not, that can be read.
+fn runs(dir: &Path) -> Vec<(PathBuf, ClaimRecord)> {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return Vec::new();
+    };
+    entries
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with(RUN_PREFIX))
+        .filter_map(|e| Some((e.path(), read_claim(&e.path())?)))
+        .collect()
+}
+
 /// `.frame_00042.claim` for frame 42.
 pub fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
     dir.join(format!(
@@ -110,13 +172,11 @@ pub struct Claim {
 
 impl Claim {
     fn start(
-        dir: &Path,
-        frame_index: u32,
+        path: PathBuf,
         record: ClaimRecord,
         interval: Duration,
         markers: Vec<PathBuf>,
     ) -> Claim {
-        let path = claim_path(dir, frame_index);
         let stop = Arc::new(AtomicBool::new(false));
         let heartbeat = {
             let (path, stop, mut record) = (path.clone(), stop.clone(), record.clone());
@@ -168,21 +228,7 @@ impl Drop for Claim {
 /// taken over; the heartbeat is refreshed every quarter timeout.
 pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Attempt> {
     let path = claim_path(dir, frame_index);
-    let record = ClaimRecord {
-        host: crate::output::host_name(),
-        pid: std::process::id(),
-        token: format!(
-            "{}-{}-{}",
-            crate::output::host_name(),
-            std::process::id(),
-            SystemTime::now()
-                .duration_since(UNIX_EPOCH)
-                .map(|d| d.as_nanos())
-                .unwrap_or(0)
-        ),
-        heartbeat_ms: now_ms(),
-        pid_space: crate::output::pid_space(),
-    };
+    let record = ClaimRecord::mine();
     let interval = timeout / 4;
     for _ in 0..3 {
         match OpenOptions::new().write(true).create_new(true).open(&path) {
@@ -191,8 +237,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                 file.write_all(json.as_bytes())
                     .map_err(|e| Error::io(&path, e))?;
                 return Ok(Attempt::Claimed(Claim::start(
-                    dir,
-                    frame_index,
+                    claim_path(dir, frame_index),
                     record,
                     interval,
                     Vec::new(),
@@ -265,8 +310,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             .map(|g| takeover_path(dir, frame_index, &held.token, g))
             .collect();
         return Ok(Attempt::Claimed(Claim::start(
-            dir,
-            frame_index,
+            claim_path(dir, frame_index),
             record,
             interval,
             markers,

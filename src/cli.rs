@@ -880,6 +880,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
     record.write(&out_dir)?;
     let stale = output::remove_stale_partials(&out_dir)?;
+    // Until this render ends, `status` lists it as running.
+    let _running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
 
     let mine: Vec<u32> = plan
         .range
@@ -1264,7 +1266,13 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
-    let mut workers = std::collections::BTreeSet::new();
+    // Renders running on the folder (`claim::announce_run`), and below, any
+    // other worker holding a claim.
+    let mut workers: std::collections::BTreeSet<String> =
+        crate::claim::live_runs(&plan.out_dir, args.claim_timeout)
+            .iter()
+            .map(|run| format!("{}:{}", run.host, run.pid))
+            .collect();
     for frame in plan.range.clone() {
         let (_, hash) = plan.frame(frame);
         let state = if plan.is_complete(frame, &hash) {
@@ -1365,7 +1373,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             }
             if !workers.is_empty() {
                 out!(
-                    "  workers: {}",
+                    "  running: {}",
                     workers.iter().cloned().collect::<Vec<_>>().join(", ")
                 );
             }

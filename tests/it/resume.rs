@@ -201,32 +201,39 @@ fn killed_render_resumes_to_identical_frames() {
     }
 }
 
-#[test]
-fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
-    let d = Dir::new();
-    // One path-traced frame of 64 samples per pixel: 16 waves of 4, a
-    // checkpoint after every wave.
-    let text = tiny_timeline(1, 8.0)
+/// One path-traced frame of 64 samples per pixel: 16 waves of 4, long
+/// enough on one thread to be caught mid-way.
+fn long_frame() -> String {
+    tiny_timeline(1, 8.0)
         .replace("size: (48, 27)", "size: (120, 68)")
         .replace(
             "fractal: (iterations: 8)",
             "fractal: (iterations: 8), samples_per_pixel: 64, effects: (path_tracing: ())",
-        );
+        )
+}
+
+/// Starts rendering `t.ron` into out/t on one thread, saving a checkpoint
+/// after every wave, and returns once the first is saved: mid-frame.
+fn render_until_a_checkpoint(d: &Dir) -> std::process::Child {
+    let args = [
+        "render",
+        "t.ron",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+        "--quiet",
+    ];
+    d.spawn_until(&args, "out/t", ".ckpt")
+}
+
+#[test]
+fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
+    let d = Dir::new();
+    let text = long_frame();
     d.write("t.ron", &text);
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
-    let mut child = d.spawn_until(
-        &[
-            "render",
-            "t.ron",
-            "--checkpoint-seconds",
-            "0",
-            "--threads",
-            "1",
-            "--quiet",
-        ],
-        "out/t",
-        ".ckpt",
-    );
+    let mut child = render_until_a_checkpoint(&d);
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(
@@ -317,4 +324,38 @@ fn a_checkpoint_that_cannot_be_saved_warns_and_the_frame_goes_on() {
         stderr(&out)
     );
     assert!(d.bytes("out/t/frame_00000.png") == d.bytes("clean/frame_00000.png"));
+}
+
+#[test]
+fn status_lists_a_running_render_and_forgets_a_killed_one() {
+    // A plain render (no claims) is listed as running while it runs, and
+    // not once it has been killed; the next render clears its record.
+    let d = Dir::new();
+    d.write("t.ron", &long_frame());
+    let running = |d: &Dir| -> Vec<String> {
+        let out = d.run(&["status", "t.ron", "--json"]);
+        let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
+        serde_json::from_value(v["workers"].clone()).unwrap()
+    };
+    let mut child = render_until_a_checkpoint(&d);
+    let me = format!(":{}", child.id());
+    let seen = running(&d);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(seen.iter().any(|w| w.ends_with(&me)), "{seen:?} lacks {me}");
+    assert!(running(&d).is_empty(), "a killed render is not running");
+    let records = |d: &Dir| {
+        let files = d.files("out/t");
+        files
+            .into_iter()
+            .filter(|f| f.starts_with(".mandelreel-run-"))
+            .count()
+    };
+    assert_eq!(
+        records(&d),
+        1,
+        "the killed render's record stays until the next"
+    );
+    d.ok(&["render", "t.ron", "--quiet"]);
+    assert_eq!(records(&d), 0, "the next render clears it, and its own");
 }
