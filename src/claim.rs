@@ -76,7 +76,7 @@ pub fn announce_run(dir: &Path, timeout: Duration) -> Result<Claim> {
     let record = ClaimRecord::mine();
     let path = dir.join(format!("{RUN_PREFIX}{}", record.token));
     write_record(&path, &record)?;
-    Ok(Claim::start(path, record, timeout / 4, Vec::new()))
+    Ok(Claim::start(path, record, timeout / 4, Vec::new(), false))
 }
 
 /// The renders running in `dir` (`announce_run`), by their records.
@@ -95,7 +95,11 @@ fn runs(dir: &Path) -> Vec<(PathBuf, ClaimRecord)> {
     };
     entries
         .filter_map(|e| e.ok())
-        .filter(|e| e.file_name().to_string_lossy().starts_with(RUN_PREFIX))
+        .filter(|e| {
+            // Not the temporaries a record is written through.
+            let name = e.file_name().to_string_lossy().into_owned();
+            name.starts_with(RUN_PREFIX) && !name.ends_with(".partial")
+        })
         .filter_map(|e| Some((e.path(), read_claim(&e.path())?)))
         .collect()
 }
@@ -171,11 +175,18 @@ pub struct Claim {
 }
 
 impl Claim {
+    /// A claim on `path` whose heartbeat a thread refreshes every
+    /// `interval`. A `contested` path (a frame's claim, which a worker may
+    /// take over) is refreshed only while it still holds this record; a
+    /// path only this process writes (a run record) is written again
+    /// even if another render removed it as dead while this one was
+    /// stopped (SIGSTOP, a stalled file system).
     fn start(
         path: PathBuf,
         record: ClaimRecord,
         interval: Duration,
         markers: Vec<PathBuf>,
+        contested: bool,
     ) -> Claim {
         let stop = Arc::new(AtomicBool::new(false));
         let heartbeat = {
@@ -188,8 +199,8 @@ impl Claim {
                     waited += tick;
                     if waited >= interval {
                         waited = Duration::ZERO;
-                        // Only refresh a claim that is still ours.
-                        if read_claim(&path).is_some_and(|r| r.token == record.token) {
+                        let ours = || read_claim(&path).is_some_and(|r| r.token == record.token);
+                        if !contested || ours() {
                             record.heartbeat_ms = now_ms();
                             let _ = write_record(&path, &record);
                         }
@@ -237,10 +248,11 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                 file.write_all(json.as_bytes())
                     .map_err(|e| Error::io(&path, e))?;
                 return Ok(Attempt::Claimed(Claim::start(
-                    claim_path(dir, frame_index),
+                    path,
                     record,
                     interval,
                     Vec::new(),
+                    true,
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
@@ -310,10 +322,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             .map(|g| takeover_path(dir, frame_index, &held.token, g))
             .collect();
         return Ok(Attempt::Claimed(Claim::start(
-            claim_path(dir, frame_index),
-            record,
-            interval,
-            markers,
+            path, record, interval, markers, true,
         )));
     }
     // The claim kept vanishing and reappearing: treat it as held this round.
@@ -323,6 +332,24 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_run_record_comes_back_after_another_render_removed_it() {
+        // A render stopped past the timeout (SIGSTOP) has its record removed
+        // as dead by the next render; once it beats again, it is back.
+        let dir = tempfile::tempdir().unwrap();
+        let timeout = Duration::from_millis(200);
+        let run = announce_run(dir.path(), timeout).unwrap();
+        let records = || runs(dir.path());
+        assert_eq!(records().len(), 1);
+        std::fs::remove_file(&records()[0].0).unwrap();
+        assert!(records().is_empty());
+        std::thread::sleep(Duration::from_millis(400));
+        assert_eq!(records().len(), 1, "the heartbeat wrote it again");
+        assert_eq!(live_runs(dir.path(), timeout).len(), 1);
+        drop(run);
+        assert!(records().is_empty(), "removed when the render ends");
+    }
 
     #[test]
     fn one_claim_at_a_time_released_on_drop() {

@@ -242,6 +242,10 @@ pub struct RenderArgs {
     /// Seconds without a heartbeat after which another worker takes a claimed frame over.
     #[arg(long, default_value = "300", value_name = "SECONDS", value_parser = positive_seconds)]
     pub claim_timeout: std::time::Duration,
+    /// Read every byte of each finished frame before skipping it (as `status
+    /// --verify`); frames found damaged are rendered again.
+    #[arg(long)]
+    pub verify: bool,
     /// Frames of several sample waves save their progress this often, so a killed
     /// render resumes them mid-frame (0 = after every wave).
     #[arg(long, default_value = "60", value_name = "SECONDS", value_parser = any_seconds)]
@@ -261,6 +265,11 @@ pub struct StatusArgs {
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,
+    /// Read every byte of each finished frame (every PNG chunk's CRC, every
+    /// EXR chunk), not only its header and end: finds a damaged byte inside
+    /// a PNG, at the cost of reading the whole sequence.
+    #[arg(long)]
+    pub verify: bool,
 }
 
 #[derive(Debug, clap::Args)]
@@ -441,6 +450,9 @@ struct Plan {
     aovs: Vec<output::Aov>,
     /// `--samples`, applied to the timeline's scene (and recorded).
     samples: Option<u32>,
+    /// `--verify`: frame files are read to their last byte before they
+    /// count as complete (`output::file_state`).
+    verify: bool,
 }
 
 impl Plan {
@@ -495,6 +507,7 @@ impl Plan {
             preview,
             aovs,
             samples: args.samples,
+            verify: false,
         })
     }
 
@@ -536,6 +549,7 @@ impl Plan {
             preview: job.preview,
             aovs: job.aovs,
             samples: job.samples,
+            verify: false,
             timeline,
         })
     }
@@ -615,7 +629,8 @@ impl Plan {
     fn is_complete(&self, frame: u32, hash: &str) -> bool {
         self.formats.iter().all(|&f| {
             let key = output::stored_key(f, hash, &self.aovs);
-            output::is_current(&self.path(frame, f), f, &key)
+            let state = output::file_state(&self.path(frame, f), f, &key, self.verify);
+            state == output::FileState::Current
         })
     }
 
@@ -850,7 +865,8 @@ fn refuse_other_sequence(
 
 fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Everything is checked before the output folder is touched.
-    let plan = Plan::new(&args.timeline, &args.sequence)?;
+    let mut plan = Plan::new(&args.timeline, &args.sequence)?;
+    plan.verify = args.verify;
     set_threads(args.threads)?;
     let shard = args
         .shard
@@ -1140,9 +1156,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
-        // A shard's frames are part of the sequence: the others' may still be coming.
-        if shard.is_some_and(|(_, n)| n > 1) {
-            eprintln!("encode the video, once every shard has finished, with:");
+        // A shard's frames are part of the sequence, and a --force claim
+        // worker makes one pass: the others' frames may still be coming.
+        if shard.is_some_and(|(_, n)| n > 1) || (args.claim && args.force) {
+            eprintln!("encode the video, once every worker has finished, with:");
         } else {
             eprintln!("encode the video with:");
         }
@@ -1248,7 +1265,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             return Err(Error::usage(
                 option,
                 format!(
-                    "{} is an output folder, which records its own size, formats and layers: \
+                    "{} is an output folder, which records its own size, samples, formats and layers: \
                      give the timeline instead (status TIMELINE {option} …) or leave {option} out",
                     args.target.display()
                 ),
@@ -1263,6 +1280,10 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     } else {
         Plan::new(&args.target, &args.sequence)?
     };
+    let plan = Plan {
+        verify: args.verify,
+        ..plan
+    };
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
@@ -1275,7 +1296,17 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             .collect();
     for frame in plan.range.clone() {
         let (_, hash) = plan.frame(frame);
-        let state = if plan.is_complete(frame, &hash) {
+        // Each file's header read once, and a file read whole only where
+        // its header records these inputs.
+        let files: Vec<output::FileState> = plan
+            .formats
+            .iter()
+            .map(|&f| {
+                let key = output::stored_key(f, &hash, &plan.aovs);
+                output::file_state(&plan.path(frame, f), f, &key, plan.verify)
+            })
+            .collect();
+        let state = if files.iter().all(|&s| s == output::FileState::Current) {
             FrameState::Complete
         } else if let Some(claim) =
             crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
@@ -1293,12 +1324,9 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             plan.layers(),
         ) {
             FrameState::Resumable
-        } else if plan.formats.iter().any(|&f| {
-            let path = plan.path(frame, f);
-            path.exists() && output::stored_hash(&path, f).is_none()
-        }) {
+        } else if files.contains(&output::FileState::Damaged) {
             FrameState::Damaged
-        } else if plan.formats.iter().any(|&f| plan.path(frame, f).exists()) {
+        } else if files.contains(&output::FileState::Stale) {
             FrameState::Stale
         } else {
             FrameState::Missing

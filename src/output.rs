@@ -126,44 +126,136 @@ pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// The hash stored in an existing frame file, if it has one, can be read,
-/// and is whole: every byte of it is checked (`png_is_whole`, and for an
-/// EXR every chunk its offset tables promise, read whole, with nothing
-/// after them), so a frame cut short or damaged by a copy, a full disk or
-/// bit rot is rendered again rather than taken as done.
-pub fn stored_hash(path: &Path, format: Format) -> Option<String> {
-    let file = std::io::BufReader::new(File::open(path).ok()?);
-    match format {
+/// What a frame file holds, against the inputs it should record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileState {
+    /// No file.
+    Missing,
+    /// A file that cannot be read, or that records these inputs but is not
+    /// whole (cut short by a copy or a full disk, a PNG chunk whose CRC
+    /// fails, bytes after its end).
+    Damaged,
+    /// A readable file made from other inputs, or not by mandelreel.
+    Stale,
+    /// Made from these inputs, and whole.
+    Current,
+}
+
+/// The state of the frame file at `path` for inputs `key` (`stored_key`).
+/// The header's hash is read first: a stale file costs no more than its
+/// header. A file that records `key` is then checked for being whole: by
+/// its end (a PNG's IEND chunk is its last bytes; an EXR's last chunk, by
+/// its offset table, ends where the file does), which finds a file cut
+/// short by a copy or a full disk, or one with bytes after its end, in a
+/// few small reads; `thorough` reads every byte instead (every PNG chunk's
+/// CRC, every EXR chunk read, not decompressed), which also finds a
+/// damaged byte inside a PNG, at the cost of reading the whole file.
+pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> FileState {
+    let file = match File::open(path) {
+        Ok(file) => std::io::BufReader::new(file),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return FileState::Missing,
+        Err(_) => return FileState::Damaged,
+    };
+    let whole = match format {
         Format::Png => {
-            if !png_is_whole(path) {
-                return None;
+            let Ok(reader) = png::Decoder::new(file).read_info() else {
+                return FileState::Damaged;
+            };
+            let text = &reader.info().uncompressed_latin1_text;
+            if !text.iter().any(|t| t.keyword == HASH_KEY && t.text == key) {
+                return FileState::Stale;
             }
-            let reader = png::Decoder::new(file).read_info().ok()?;
-            let info = reader.info();
-            info.uncompressed_latin1_text
-                .iter()
-                .find(|t| t.keyword == HASH_KEY)
-                .map(|t| t.text.clone())
+            if thorough {
+                png_is_whole(path)
+            } else {
+                png_ends_with_iend(path)
+            }
         }
         Format::Exr => {
-            let reader = exr::block::read(file, true).ok()?;
-            let header = reader.meta_data().headers.first()?;
-            let hash = match header
-                .own_attributes
-                .other
-                .get(&exr::prelude::Text::from(HASH_KEY))?
-            {
-                exr::meta::attribute::AttributeValue::Text(t) => t.to_string(),
-                _ => return None,
+            let Ok(reader) = exr::block::read(file, true) else {
+                return FileState::Damaged;
             };
-            // The chunks' bytes, not decompressed: a file cut short fails
-            // to read one, and pedantic reading refuses bytes after them.
-            for chunk in reader.all_chunks(true).ok()? {
-                chunk.ok()?;
+            let recorded = reader.meta_data().headers.first().and_then(|header| {
+                match header
+                    .own_attributes
+                    .other
+                    .get(&exr::prelude::Text::from(HASH_KEY))
+                {
+                    Some(exr::meta::attribute::AttributeValue::Text(t)) => Some(t.to_string()),
+                    _ => None,
+                }
+            });
+            if recorded.as_deref() != Some(key) {
+                return FileState::Stale;
             }
-            Some(hash)
+            if thorough {
+                // A file cut short fails to read a chunk; pedantic reading
+                // refuses bytes after the last.
+                reader
+                    .all_chunks(true)
+                    .is_ok_and(|mut chunks| chunks.all(|chunk| chunk.is_ok()))
+            } else {
+                exr_ends_with_its_last_chunk(path).unwrap_or(false)
+            }
         }
+    };
+    if whole {
+        FileState::Current
+    } else {
+        FileState::Damaged
     }
+}
+
+/// Whether a PNG file's last 12 bytes are its IEND chunk.
+fn png_ends_with_iend(path: &Path) -> bool {
+    use std::io::{Read, Seek, SeekFrom};
+    const IEND: [u8; 12] = [0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xAE, 0x42, 0x60, 0x82];
+    let mut tail = [0u8; 12];
+    File::open(path)
+        .and_then(|mut f| {
+            f.seek(SeekFrom::End(-12))?;
+            f.read_exact(&mut tail)
+        })
+        .is_ok()
+        && tail == IEND
+}
+
+/// Whether a single-part EXR (as `write_frame` writes them) ends exactly
+/// where its last chunk does: the header parsed by exr, then the offset
+/// table read, and the chunk at the largest offset (its coordinates: a
+/// tile's four numbers or a scan-line block's y; its byte count; its
+/// bytes) must reach the file's end and not pass it.
+fn exr_ends_with_its_last_chunk(path: &Path) -> std::io::Result<bool> {
+    use std::io::{Read, Seek, SeekFrom};
+    let mut file = std::io::BufReader::new(File::open(path)?);
+    let length = file.get_ref().metadata()?.len();
+    let invalid = |e: exr::error::Error| std::io::Error::other(e.to_string());
+    // exr reads the header up to the null byte that ends it, and no further.
+    let meta = exr::meta::MetaData::read_from_buffered(&mut file, false).map_err(invalid)?;
+    let [header] = meta.headers.as_slice() else {
+        return Ok(false);
+    };
+    let mut last = 0u64;
+    let mut entry = [0u8; 8];
+    for _ in 0..header.chunk_count {
+        file.read_exact(&mut entry)?;
+        last = last.max(u64::from_le_bytes(entry));
+    }
+    let coordinates = match header.blocks {
+        exr::meta::BlockDescription::Tiles(_) => 16,
+        exr::meta::BlockDescription::ScanLines => 4,
+    };
+    if last
+        .checked_add(coordinates + 4)
+        .is_none_or(|end| end > length)
+    {
+        return Ok(false);
+    }
+    file.seek(SeekFrom::Start(last + coordinates))?;
+    let mut size = [0u8; 4];
+    file.read_exact(&mut size)?;
+    let size = i32::from_le_bytes(size);
+    Ok(size >= 0 && last + coordinates + 4 + size as u64 == length)
 }
 
 /// Whether a PNG file is whole: its signature, then chunks whose CRCs all
@@ -217,12 +309,6 @@ pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
         }
         _ => hash.to_string(),
     }
-}
-
-/// Whether `path` holds a finished frame whose recorded inputs are `key`
-/// (`stored_key`).
-pub fn is_current(path: &Path, format: Format, key: &str) -> bool {
-    stored_hash(path, format).as_deref() == Some(key)
 }
 
 /// Writes `film` as `path` in `format`, atomically: the bytes go to a
@@ -1235,9 +1321,13 @@ mod tests {
                 .filter(|e| e.file_name().to_string_lossy().ends_with(".partial"))
                 .collect();
             assert!(leftovers.is_empty(), "temporary files left behind");
-            assert_eq!(stored_hash(&path, format).as_deref(), Some("abc123"));
-            assert!(is_current(&path, format, "abc123"));
-            assert!(!is_current(&path, format, "other"));
+            for thorough in [false, true] {
+                let state = |path: &Path, key| file_state(path, format, key, thorough);
+                assert_eq!(state(&path, "abc123"), FileState::Current);
+                assert_eq!(state(&path, "other"), FileState::Stale);
+                let missing = dir.path().join(frame_file_name(1, format));
+                assert_eq!(state(&missing, "abc123"), FileState::Missing);
+            }
         }
     }
 
@@ -1325,10 +1415,16 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
         write_frame(&path, Format::Png, &film(), "abc", &[]).unwrap();
-        assert!(is_current(&path, Format::Png, "abc"));
+        assert_eq!(
+            file_state(&path, Format::Png, "abc", false),
+            FileState::Current
+        );
         let bytes = std::fs::read(&path).unwrap();
         std::fs::write(&path, &bytes[..bytes.len() - 20]).unwrap();
-        assert!(!is_current(&path, Format::Png, "abc"));
+        for thorough in [false, true] {
+            let state = file_state(&path, Format::Png, "abc", thorough);
+            assert_eq!(state, FileState::Damaged);
+        }
     }
 
     #[test]
@@ -1336,6 +1432,9 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
         std::fs::write(&path, b"\x89PNG\r\n\x1a\n").unwrap();
-        assert!(!is_current(&path, Format::Png, "abc"));
+        assert_eq!(
+            file_state(&path, Format::Png, "abc", false),
+            FileState::Damaged
+        );
     }
 }

@@ -116,12 +116,11 @@ fn tracks_once_each<'de, D: serde::Deserializer<'de>>(
     deserializer.deserialize_map(Tracks)
 }
 
-/// A number as a message shows it: as written for everyday sizes, in
-/// exponent form past a million (1e300 rather than its 301 digits).
 /// The number written at `line`:`column` (1-based), where a parse error
-/// stopped, if it stopped at the fraction or exponent of a number: a field
-/// that counts (iterations, frames, a size) given `10.5` or `1e3`, which
-/// RON reports as a missing comma.
+/// stopped, if it stopped at the fraction of a number: a field that counts
+/// (iterations, frames, a size) given `10.5`, which RON reports as a
+/// missing comma. (`1e3` there gets RON's own "Invalid digit 'e'", at the
+/// number's start.)
 fn fraction_at(text: &str, line: usize, column: usize) -> Option<String> {
     let row = text.lines().nth(line.checked_sub(1)?)?;
     let at = row.char_indices().nth(column.checked_sub(1)?)?.0;

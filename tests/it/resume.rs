@@ -269,27 +269,34 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
 
 #[test]
 fn frames_cut_short_or_damaged_are_rendered_again() {
-    // A frame file whose bytes are not all there or not all right (a copy
-    // cut short, a full disk, bit rot) is not taken for a finished frame,
-    // even though its header carries the current hash.
+    // A frame file whose bytes are not all there (a copy cut short, a full
+    // disk) or that has bytes after its end is not taken for a finished
+    // frame, though its header carries the current hash; a damaged byte
+    // inside a PNG is found by --verify, which reads every byte.
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(3, 6.0));
     let args = ["render", "t.ron", "--format", "png,exr", "--quiet"];
     d.ok(&args);
     let clean = |f: &str| d.bytes(&format!("out/t/{f}"));
     let (exr, png) = (clean("frame_00001.exr"), clean("frame_00002.png"));
+    let states = |extra: &[&str]| -> serde_json::Value {
+        let out = d.run(&[&["status", "out/t", "--json"][..], extra].concat());
+        assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
+        let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
+        v["states"].clone()
+    };
     // The EXR cut to half its length; one byte flipped in the PNG's image data.
     d.write_bytes("out/t/frame_00001.exr", &exr[..exr.len() / 2]);
     let mut flipped = png.clone();
     flipped[png.len() / 2] ^= 0x10;
     d.write_bytes("out/t/frame_00002.png", &flipped);
-    let out = d.run(&["status", "out/t", "--json"]);
-    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
-    let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
-    assert_eq!(v["states"]["damaged"], serde_json::json!([1, 2]), "{v}");
+    assert_eq!(states(&[])["damaged"], serde_json::json!([1]));
+    assert_eq!(states(&["--verify"])["damaged"], serde_json::json!([1, 2]));
     let out = d.ok(&["render", "t.ron", "--format", "png,exr"]);
-    says(&out, "1 of 3 frames already complete");
+    says(&out, "2 of 3 frames already complete");
     assert!(clean("frame_00001.exr") == exr, "EXR not rendered again");
+    let out = d.ok(&["render", "t.ron", "--format", "png,exr", "--verify"]);
+    says(&out, "2 of 3 frames already complete");
     assert!(clean("frame_00002.png") == png, "PNG not rendered again");
     // Bytes after a whole file's end are damage too.
     let mut longer = exr.clone();
@@ -298,9 +305,14 @@ fn frames_cut_short_or_damaged_are_rendered_again() {
     let mut longer = png.clone();
     longer.extend_from_slice(b"tail");
     d.write_bytes("out/t/frame_00002.png", &longer);
-    let out = d.run(&["status", "out/t", "--json"]);
-    let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
-    assert_eq!(v["states"]["damaged"], serde_json::json!([1, 2]), "{v}");
+    assert_eq!(states(&[])["damaged"], serde_json::json!([1, 2]));
+    // A whole PNG that mandelreel did not make is another input's: stale.
+    d.write_bytes("out/t/frame_00001.exr", &exr);
+    d.write_bytes("out/t/frame_00002.png", &png);
+    image::RgbImage::new(48, 27)
+        .save(d.path().join("out/t/frame_00000.png"))
+        .unwrap();
+    assert_eq!(states(&[])["stale"], serde_json::json!([0]));
 }
 
 #[test]
