@@ -225,12 +225,13 @@ pub fn reference_depths(
     (depths, tests)
 }
 
-/// The sRGB image of a film, as 0..1 floats.
-fn srgb(film: &Film) -> Vec<f32> {
+/// The sRGB image of a film as its PNG shows it (`look`'s exposure and
+/// tone map), as 0..1 floats.
+fn srgb(film: &Film, look: &crate::shade::Look) -> Vec<f32> {
     film.colour
         .iter()
         .flat_map(|c| [c.x, c.y, c.z])
-        .map(linear_to_srgb)
+        .map(|x| linear_to_srgb(look.display(x)))
         .collect()
 }
 
@@ -381,7 +382,7 @@ pub fn measure(
     let (reference_depth, tests) = reference_depths(reference, width, height, REFERENCE_STEP);
     let reference_film = render_frame(reference, frame_index, width, height, &|| {});
     let reference_seconds = started.elapsed().as_secs_f64();
-    let reference_image = srgb(&reference_film);
+    let reference_image = srgb(&reference_film, &scene.look);
     let footprint_at_reference = footprints_at(scene, width, height, &reference_depth);
 
     // The same depths at twice the step: how far the reference itself has settled.
@@ -424,7 +425,7 @@ pub fn measure(
         let (film, seconds) = timed_render(&variant.scene, frame_index, width, height);
         let e = compare(
             &film_hits(&film),
-            &srgb(&film),
+            &srgb(&film, &scene.look),
             &reference_image,
             &reference_depth,
             &footprint_at_reference,

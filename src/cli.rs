@@ -668,7 +668,7 @@ impl Plan {
                 layers,
                 on_row,
             );
-            return self.write_film(frame, film, hash);
+            return self.write_film(frame, film, hash, &scenes[0].look);
         }
         let checkpoint = output::checkpoint_path(&self.out_dir, frame);
         let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
@@ -697,7 +697,7 @@ impl Plan {
             }
         }
         let film = acc.finish(n);
-        self.write_film(frame, &film, hash)
+        self.write_film(frame, &film, hash, &scenes[0].look)
     }
 
     /// Writes every format of a finished frame and drops its checkpoint.
@@ -706,9 +706,10 @@ impl Plan {
         frame: u32,
         film: &crate::render::Film,
         hash: &str,
+        look: &crate::shade::Look,
     ) -> anyhow::Result<FrameStats> {
         for &f in &self.formats {
-            output::write_frame(&self.path(frame, f), f, film, hash, &self.aovs)?;
+            output::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
         }
         let _ = std::fs::remove_file(output::checkpoint_path(&self.out_dir, frame));
         Ok(film.stats)

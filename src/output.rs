@@ -315,12 +315,15 @@ pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
 /// temporary file of a unique name in the same folder (so two renders into one
 /// folder never write into each other's file), are flushed to disk, and only
 /// then renamed over the final name.
+/// `look` decides how a PNG shows the film's linear light (its exposure
+/// and tone map); an EXR holds the linear light as it is.
 pub fn write_frame(
     path: &Path,
     format: Format,
     film: &Film,
     hash: &str,
     aovs: &[Aov],
+    look: &crate::shade::Look,
 ) -> Result<()> {
     let image_error = |temp: &Path, message: String| Error::Image {
         path: temp.to_path_buf(),
@@ -328,7 +331,7 @@ pub fn write_frame(
     };
     let key = stored_key(format, hash, aovs);
     write_atomic(path, |writer, temp| match format {
-        Format::Png => encode_png(writer, film, &key).map_err(|m| image_error(temp, m)),
+        Format::Png => encode_png(writer, film, &key, look).map_err(|m| image_error(temp, m)),
         Format::Exr => encode_exr(writer, film, &key, aovs).map_err(|m| image_error(temp, m)),
     })
 }
@@ -391,7 +394,12 @@ fn stats_text(film: &Film) -> String {
     )
 }
 
-fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Result<(), String> {
+fn encode_png(
+    out: &mut impl Write,
+    film: &Film,
+    hash: &str,
+    look: &crate::shade::Look,
+) -> std::result::Result<(), String> {
     let mut encoder = png::Encoder::new(out, film.width, film.height);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
@@ -428,9 +436,17 @@ fn encode_png(out: &mut impl Write, film: &Film, hash: &str) -> std::result::Res
         .par_chunks_mut(3 * row)
         .zip(film.colour.par_chunks(row))
         .for_each(|(bytes, colour)| {
+            if look.is_plain_display() {
+                for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
+                    for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
+                        *byte = srgb.byte(v);
+                    }
+                }
+                return;
+            }
             for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
                 for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
-                    *byte = srgb.byte(v);
+                    *byte = srgb.byte(look.display(v));
                 }
             }
         });
@@ -1182,7 +1198,15 @@ mod tests {
             (&plain, &[][..], 5),
         ];
         for (film, aovs, channels) in cases {
-            write_frame(&path, Format::Exr, film, "h", aovs).unwrap();
+            write_frame(
+                &path,
+                Format::Exr,
+                film,
+                "h",
+                aovs,
+                &crate::shade::Look::default(),
+            )
+            .unwrap();
             let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
             let layer = &image.layer_data[0];
             assert_eq!(layer.size, exr::math::Vec2(w as usize, h as usize));
@@ -1313,7 +1337,15 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for format in [Format::Png, Format::Exr] {
             let path = dir.path().join(frame_file_name(0, format));
-            write_frame(&path, format, &film(), "abc123", &[]).unwrap();
+            write_frame(
+                &path,
+                format,
+                &film(),
+                "abc123",
+                &[],
+                &crate::shade::Look::default(),
+            )
+            .unwrap();
             assert!(path.exists());
             let leftovers: Vec<_> = std::fs::read_dir(dir.path())
                 .unwrap()
@@ -1414,7 +1446,15 @@ mod tests {
     fn a_png_cut_after_its_header_is_not_current() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
-        write_frame(&path, Format::Png, &film(), "abc", &[]).unwrap();
+        write_frame(
+            &path,
+            Format::Png,
+            &film(),
+            "abc",
+            &[],
+            &crate::shade::Look::default(),
+        )
+        .unwrap();
         assert_eq!(
             file_state(&path, Format::Png, "abc", false),
             FileState::Current

@@ -539,6 +539,66 @@ pub struct Look {
     /// Background at the top and bottom of the frame (by the camera's up vector).
     pub background_top: Vec3,
     pub background_bottom: Vec3,
+    /// How linear light becomes 8-bit display values (PNG frames; an EXR
+    /// keeps the linear light as rendered): multiplied by `exposure`, then
+    /// mapped by `tone_map`. Left out of a scene's serialised form at
+    /// their defaults, so frames rendered before they existed keep their
+    /// hashes.
+    #[serde(skip_serializing_if = "ToneMap::is_clip")]
+    pub tone_map: ToneMap,
+    #[serde(skip_serializing_if = "is_one")]
+    pub exposure: f32,
+}
+
+fn is_one(x: &f32) -> bool {
+    *x == 1.0
+}
+
+/// The curve from exposed linear light to display values in [0, 1].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub enum ToneMap {
+    /// Values above 1 are white: each channel clips on its own, so a bright
+    /// orange highlight turns yellow, then white.
+    #[default]
+    Clip,
+    /// A filmic curve (Narkowicz's rational fit of the ACES reference
+    /// transform, per channel): highlights roll off towards white instead
+    /// of clipping, and mid-tones lift (0.18 shows as 0.27); 1 shows as
+    /// 0.80, 4 as 0.97, and white is reached near 7.2.
+    Filmic,
+}
+
+impl ToneMap {
+    fn is_clip(&self) -> bool {
+        *self == ToneMap::Clip
+    }
+
+    /// The display value of exposed linear `x` (at or above 0), before the
+    /// sRGB curve; `Clip` leaves `x` as it is (the sRGB coding clips).
+    #[inline]
+    pub fn apply(self, x: f32) -> f32 {
+        match self {
+            ToneMap::Clip => x,
+            ToneMap::Filmic => {
+                let x = x.max(0.0);
+                (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)
+            }
+        }
+    }
+}
+
+impl Look {
+    /// Whether display values are the linear light itself (clipped), as
+    /// before tone maps existed: PNG coding then takes its plain path.
+    pub fn is_plain_display(&self) -> bool {
+        self.tone_map == ToneMap::Clip && self.exposure == 1.0
+    }
+
+    /// The display value of linear `x` (`exposure`, then `tone_map`).
+    #[inline]
+    pub fn display(&self, x: f32) -> f32 {
+        self.tone_map.apply(x * self.exposure)
+    }
 }
 
 impl Default for Look {
@@ -555,6 +615,8 @@ impl Default for Look {
             trap_occlusion: 0.8,
             background_top: Vec3::new(0.02, 0.03, 0.06),
             background_bottom: Vec3::new(0.10, 0.09, 0.12),
+            tone_map: ToneMap::Clip,
+            exposure: 1.0,
         }
     }
 }
@@ -1073,6 +1135,43 @@ pub fn glow(glow: &Glow, closest: Real) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_filmic_curve_rolls_off_below_white_and_the_default_keeps_hashes() {
+        let f = |x: f32| ToneMap::Filmic.apply(x);
+        assert_eq!(f(0.0), 0.0);
+        // Narkowicz's fit at a few points, by hand: 0.18·0.4818/0.32493 …
+        for (x, y) in [(0.18, 0.2669), (1.0, 0.8038), (4.0, 0.9734)] {
+            assert!((f(x) - y).abs() < 1e-3, "f({x}) = {}", f(x));
+        }
+        let mut last = 0.0;
+        // Rising, and below white until about 7.2 (where the fit crosses 1).
+        for k in 1..=720 {
+            let y = f(k as f32 * 0.01);
+            assert!(y > last && y < 1.0, "not rising below 1 at {k}");
+            last = y;
+        }
+        assert!(f(1e6) < 1.04 && f(-1.0) == 0.0);
+        assert_eq!(ToneMap::Clip.apply(3.0), 3.0);
+        // Left at their defaults, exposure and tone map are not serialised:
+        // frames rendered before they existed keep their hashes.
+        let json = serde_json::to_string(&Look::default()).unwrap();
+        assert!(
+            !json.contains("tone_map") && !json.contains("exposure"),
+            "{json}"
+        );
+        let filmic = Look {
+            tone_map: ToneMap::Filmic,
+            exposure: 2.0,
+            ..Look::default()
+        };
+        let json = serde_json::to_string(&filmic).unwrap();
+        assert!(
+            json.contains("\"tone_map\":\"Filmic\"") && json.contains("\"exposure\":2.0"),
+            "{json}"
+        );
+        assert!(filmic.display(0.5) == f(1.0) && !filmic.is_plain_display());
+    }
 
     /// Where `ray` meets the surface, as shading takes it.
     fn surface_at(

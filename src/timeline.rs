@@ -213,6 +213,7 @@ pub const PARAMETERS: &[(&str, usize)] = &[
     ("look.trap_y_colour", 3),
     ("look.trap_z_colour", 3),
     ("look.trap_occlusion", 1),
+    ("look.exposure", 1),
     ("look.background_top", 3),
     ("look.background_bottom", 3),
     ("effects.shadows.softness", 1),
@@ -271,6 +272,7 @@ fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
         "look.trap_y_colour" => l.trap_y_colour = colour(),
         "look.trap_z_colour" => l.trap_z_colour = colour(),
         "look.trap_occlusion" => l.trap_occlusion = v[0] as f32,
+        "look.exposure" => l.exposure = v[0] as f32,
         "look.background_top" => l.background_top = colour(),
         "look.background_bottom" => l.background_bottom = colour(),
         effect if effect.starts_with("effects.") => {
@@ -1047,6 +1049,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         "look.trap_occlusion",
         || format!("must be in [0, 1], got {}", l.trap_occlusion.shown()),
     )?;
+    positive(l.exposure, "look.exposure")?;
     check(
         l.extra_lights.len() < crate::shade::MAX_LIGHTS,
         "look.extra_lights",

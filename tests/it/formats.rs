@@ -116,3 +116,64 @@ fn extra_layers_decide_the_exr_but_not_the_png() {
     assert!(current(&["--format", "exr", "--aov", "steps,normal"]));
     assert!(!current(&["--format", "exr"]));
 }
+
+#[test]
+fn a_filmic_tone_map_rolls_highlights_off_in_pngs_and_leaves_exrs_linear() {
+    // A bright key light clips many channels; the filmic curve maps each
+    // PNG value from the same linear light, which the EXRs keep unchanged.
+    let d = Dir::new();
+    let bright = tiny_timeline(1, 8.0).replace(
+        "fractal: (iterations: 8)",
+        "fractal: (iterations: 8), look: (light_colour: (4, 3, 2))",
+    );
+    d.write("clip.ron", &bright);
+    d.write(
+        "filmic.ron",
+        &bright.replace("look: (", "look: (tone_map: Filmic, "),
+    );
+    for t in ["clip.ron", "filmic.ron"] {
+        d.ok(&["render", t, "--format", "png,exr", "--quiet"]);
+    }
+    let png = |rel: &str| image::open(d.path().join(rel)).unwrap().to_rgb8();
+    let (clip, filmic) = (
+        png("out/clip/frame_00000.png"),
+        png("out/filmic/frame_00000.png"),
+    );
+    let white = |img: &image::RgbImage| img.as_raw().iter().filter(|&&b| b == 255).count();
+    assert!(white(&clip) > 100, "{} clipped channels", white(&clip));
+    assert!(
+        white(&filmic) < white(&clip) / 10,
+        "{} clipped",
+        white(&filmic)
+    );
+    let (a, b) = (
+        d.exr("out/clip/frame_00000.exr"),
+        d.exr("out/filmic/frame_00000.exr"),
+    );
+    for c in ["R", "G", "B"] {
+        assert!(a.channel(c) == b.channel(c), "EXR channel {c} changed");
+    }
+    // Each filmic byte from the EXR's linear value (half floats: within a
+    // code), by the curve written out here: Narkowicz's fit, then sRGB.
+    let curve = |x: f32| (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14);
+    let srgb = |y: f32| {
+        let y = y.clamp(0.0, 1.0);
+        let s = if y <= 0.0031308 {
+            12.92 * y
+        } else {
+            1.055 * y.powf(1.0 / 2.4) - 0.055
+        };
+        s * 255.0
+    };
+    let linear = [a.channel("R"), a.channel("G"), a.channel("B")];
+    for (k, px) in filmic.pixels().enumerate() {
+        for (c, (&byte, channel)) in px.0.iter().zip(linear).enumerate() {
+            let expected = srgb(curve(channel[k].max(0.0)));
+            let got = byte as f32;
+            assert!(
+                (got - expected).abs() <= 1.5,
+                "pixel {k} channel {c}: {got} vs {expected}"
+            );
+        }
+    }
+}
