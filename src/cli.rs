@@ -671,8 +671,11 @@ impl Plan {
             return self.write_film(frame, film, hash, &scenes[0].look);
         }
         let checkpoint = output::checkpoint_path(&self.out_dir, frame);
-        let saved_acc = output::read_checkpoint(&checkpoint, hash, self.width, self.height, layers)
-            .filter(|a| a.samples_done < n);
+        // A checkpoint holds linear light: how a PNG shows it is not its key.
+        let light = output::light_hash(hash);
+        let saved_acc =
+            output::read_checkpoint(&checkpoint, light, self.width, self.height, layers)
+                .filter(|a| a.samples_done < n);
         let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
@@ -689,7 +692,7 @@ impl Plan {
             let until = (acc.samples_done + wave).min(n);
             crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
             if saving && until < n && saved.elapsed() >= checkpoint_every {
-                if let Err(e) = output::write_checkpoint(&checkpoint, &acc, hash) {
+                if let Err(e) = output::write_checkpoint(&checkpoint, &acc, light) {
                     say(Said::CheckpointFailed { frame, error: e });
                     saving = false;
                 }
@@ -1319,7 +1322,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             FrameState::InProgress
         } else if output::checkpoint_is_for(
             &output::checkpoint_path(&plan.out_dir, frame),
-            &hash,
+            output::light_hash(&hash),
             plan.width,
             plan.height,
             plan.layers(),

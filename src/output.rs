@@ -102,8 +102,37 @@ pub fn frame_pattern(format: Format) -> String {
 /// Hash of everything that decides a frame's pixels: the effective scenes
 /// (one, or one per sample under motion blur), the frame index (it seeds the
 /// sampler), the size and the renderer's revision. Not the extra EXR
-/// layers, which add channels but change no pixel (`stored_key`).
+/// layers, which add channels but change no pixel (`stored_key`). How a
+/// PNG shows the light (`Look::exposure`, `Look::tone_map`) follows the
+/// hash of the light itself after a `~` (`~exposure=2,Filmic`), where it is
+/// not the default: an EXR, which holds the linear light, and a
+/// checkpoint are keyed on the light alone (`light_hash`), so a change of
+/// grade re-renders no EXR-only sequence and keeps checkpoints.
 pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
+    let look = &scenes[0].look;
+    let plain = scenes.iter().all(|s| s.look.is_plain_display());
+    if plain {
+        return light_digest(scenes, frame_index, width, height);
+    }
+    let light: Vec<Scene> = scenes
+        .iter()
+        .map(|s| {
+            let mut s = s.clone();
+            s.look.exposure = 1.0;
+            s.look.tone_map = crate::shade::ToneMap::Clip;
+            s
+        })
+        .collect();
+    let digest = light_digest(&light, frame_index, width, height);
+    format!("{digest}~exposure={},{:?}", look.exposure, look.tone_map)
+}
+
+/// The part of a `frame_hash` that the linear light depends on.
+pub fn light_hash(hash: &str) -> &str {
+    hash.split('~').next().unwrap_or(hash)
+}
+
+fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
     #[derive(Serialize)]
     struct Inputs<'a> {
         renderer: &'a str,
@@ -188,15 +217,13 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
             if recorded.as_deref() != Some(key) {
                 return FileState::Stale;
             }
-            if thorough {
-                // A file cut short fails to read a chunk; pedantic reading
-                // refuses bytes after the last.
-                reader
-                    .all_chunks(true)
-                    .is_ok_and(|mut chunks| chunks.all(|chunk| chunk.is_ok()))
-            } else {
-                exr_ends_with_its_last_chunk(path).unwrap_or(false)
-            }
+            // Thorough reading adds every chunk read whole to the end check
+            // (pedantic reading refuses bytes after the last).
+            exr_ends_with_its_last_chunk(path).unwrap_or(false)
+                && (!thorough
+                    || reader
+                        .all_chunks(true)
+                        .is_ok_and(|mut chunks| chunks.all(|chunk| chunk.is_ok())))
         }
     };
     if whole {
@@ -305,9 +332,10 @@ pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
     match format {
         Format::Exr if !aovs.is_empty() => {
             let names: Vec<&str> = aovs.iter().map(|a| a.name()).collect();
-            format!("{hash}+{}", names.join(","))
+            format!("{}+{}", light_hash(hash), names.join(","))
         }
-        _ => hash.to_string(),
+        Format::Exr => light_hash(hash).to_string(),
+        Format::Png => hash.to_string(),
     }
 }
 
@@ -1277,6 +1305,19 @@ mod tests {
         c.sample_data.value_by_flat_index(i).to_f32()
     }
 
+    /// `write_frame` without layers, shown as by default.
+    fn write_plain(path: &Path, format: Format, film: &Film, hash: &str) {
+        write_frame(
+            path,
+            format,
+            film,
+            hash,
+            &[],
+            &crate::shade::Look::default(),
+        )
+        .unwrap();
+    }
+
     fn film() -> Film {
         Film {
             width: 3,
@@ -1337,15 +1378,7 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         for format in [Format::Png, Format::Exr] {
             let path = dir.path().join(frame_file_name(0, format));
-            write_frame(
-                &path,
-                format,
-                &film(),
-                "abc123",
-                &[],
-                &crate::shade::Look::default(),
-            )
-            .unwrap();
+            write_plain(&path, format, &film(), "abc123");
             assert!(path.exists());
             let leftovers: Vec<_> = std::fs::read_dir(dir.path())
                 .unwrap()
@@ -1443,18 +1476,53 @@ mod tests {
     }
 
     #[test]
+    fn an_exr_whose_offset_table_is_damaged_is_not_current() {
+        // The file keeps its length, but its last offset points at the chunk
+        // before: the end check finds the last chunk short of the end, and
+        // --verify checks that too.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frame_00000.exr");
+        // Big enough for several chunks.
+        let (w, h) = (200, 100);
+        let n = (w * h) as usize;
+        let film = Film {
+            width: w,
+            height: h,
+            colour: (0..n).map(|i| Vec3::splat(i as f32 / n as f32)).collect(),
+            alpha: vec![1.0; n],
+            depth: vec![2.5; n],
+            evaluations: vec![7; n],
+            ..film()
+        };
+        write_plain(&path, Format::Exr, &film, "abc");
+        assert_eq!(
+            file_state(&path, Format::Exr, "abc", true),
+            FileState::Current
+        );
+        let mut bytes = std::fs::read(&path).unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(&bytes[..], false).unwrap();
+        let chunks = meta.headers[0].chunk_count;
+        assert!(chunks >= 2, "{chunks} chunks");
+        let at = |b: &[u8], p: usize| u64::from_le_bytes(b[p..p + 8].try_into().unwrap());
+        // The table sits just before the first chunk, which its first entry names.
+        let table = (8..bytes.len() - 8)
+            .find(|&p| at(&bytes, p) == (p + 8 * chunks) as u64)
+            .expect("the offset table");
+        let (last, before) = (table + 8 * (chunks - 1), table + 8 * (chunks - 2));
+        let previous = at(&bytes, before).to_le_bytes();
+        bytes[last..last + 8].copy_from_slice(&previous);
+        std::fs::write(&path, &bytes).unwrap();
+        for thorough in [false, true] {
+            let state = file_state(&path, Format::Exr, "abc", thorough);
+            assert_eq!(state, FileState::Damaged, "thorough: {thorough}");
+        }
+    }
+
+    #[test]
     fn a_png_cut_after_its_header_is_not_current() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
-        write_frame(
-            &path,
-            Format::Png,
-            &film(),
-            "abc",
-            &[],
-            &crate::shade::Look::default(),
-        )
-        .unwrap();
+        write_plain(&path, Format::Png, &film(), "abc");
         assert_eq!(
             file_state(&path, Format::Png, "abc", false),
             FileState::Current

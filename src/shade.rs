@@ -580,7 +580,9 @@ impl ToneMap {
         match self {
             ToneMap::Clip => x,
             ToneMap::Filmic => {
-                let x = x.max(0.0);
+                // White from about 7.2 on; capped so x² cannot overflow
+                // (infinity over infinity would show black).
+                let x = if x > 0.0 { x.min(64.0) } else { 0.0 };
                 (x * (2.51 * x + 0.03)) / (x * (2.43 * x + 0.59) + 0.14)
             }
         }
@@ -1151,7 +1153,10 @@ mod tests {
             assert!(y > last && y < 1.0, "not rising below 1 at {k}");
             last = y;
         }
-        assert!(f(1e6) < 1.04 && f(-1.0) == 0.0);
+        assert!(f(1e6) < 1.04 && f(-1.0) == 0.0 && f(f32::NAN) == 0.0);
+        for huge in [1e19, 1e30, f32::MAX, f32::INFINITY] {
+            assert!(f(huge) > 1.0, "f({huge}) = {}: white, not black", f(huge));
+        }
         assert_eq!(ToneMap::Clip.apply(3.0), 3.0);
         // Left at their defaults, exposure and tone map are not serialised:
         // frames rendered before they existed keep their hashes.

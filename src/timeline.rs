@@ -1049,7 +1049,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         "look.trap_occlusion",
         || format!("must be in [0, 1], got {}", l.trap_occlusion.shown()),
     )?;
-    positive(l.exposure, "look.exposure")?;
+    non_negative(l.exposure, "look.exposure")?;
     check(
         l.extra_lights.len() < crate::shade::MAX_LIGHTS,
         "look.extra_lights",

@@ -1,6 +1,6 @@
 //! PNG and EXR output decode, with the channels and metadata promised.
 
-use crate::util::{stderr, tiny_timeline, Dir};
+use crate::util::{says, stderr, tiny_timeline, Dir};
 
 #[test]
 fn png_and_exr_decode_with_expected_channels() {
@@ -176,4 +176,57 @@ fn a_filmic_tone_map_rolls_highlights_off_in_pngs_and_leaves_exrs_linear() {
             );
         }
     }
+}
+
+#[test]
+fn a_change_of_grade_rerenders_pngs_but_leaves_exrs_and_fades_to_black() {
+    // Exposure and tone map change how PNGs show the light, not the light:
+    // an EXR-only sequence stays current, PNGs beside EXRs render again.
+    let d = Dir::new();
+    let text = tiny_timeline(2, 6.0);
+    d.write("t.ron", &text);
+    d.ok(&[
+        "render", "t.ron", "--format", "exr", "--out", "exr", "--quiet",
+    ]);
+    d.ok(&[
+        "render", "t.ron", "--format", "png,exr", "--out", "both", "--quiet",
+    ]);
+    let (exr, png) = (
+        d.bytes("both/frame_00001.exr"),
+        d.bytes("both/frame_00001.png"),
+    );
+    let graded = text.replace(
+        "fractal: (iterations: 8)",
+        "fractal: (iterations: 8), look: (exposure: 2, tone_map: Filmic)",
+    );
+    d.write("t.ron", &graded);
+    let out = d.ok(&["render", "t.ron", "--format", "exr", "--out", "exr"]);
+    says(&out, "2 of 2 frames already complete");
+    let out = d.ok(&["render", "t.ron", "--format", "png,exr", "--out", "both"]);
+    says(&out, "2 frames rendered");
+    assert!(
+        d.bytes("both/frame_00001.exr") == exr,
+        "the EXR's light changed"
+    );
+    assert!(
+        d.bytes("both/frame_00001.png") != png,
+        "the PNG kept its grade"
+    );
+    // The exposure track fades frame 1 to black, background and all.
+    let fade = text.replace(
+        "tracks: {",
+        "tracks: {\n        \"look.exposure\": (interpolation: Linear, keys: [(time: 0, value: 1), (time: 0.04, value: 0)]),",
+    );
+    d.write("fade.ron", &fade);
+    d.ok(&["render", "fade.ron", "--quiet"]);
+    let frame = |k: u32| {
+        image::open(d.path().join(format!("out/fade/frame_{k:05}.png")))
+            .unwrap()
+            .to_rgb8()
+    };
+    assert!(frame(0).as_raw().iter().any(|&b| b > 0));
+    assert!(
+        frame(1).as_raw().iter().all(|&b| b == 0),
+        "frame 1 is not black"
+    );
 }
