@@ -342,6 +342,72 @@ fn a_worker_says_which_frames_it_waits_for_and_takes_them_after_the_timeout() {
     assert_eq!(rendered_frames(&err).len(), 2, "{err}");
 }
 
+#[test]
+fn the_waiting_line_names_only_frames_still_held_at_the_end_of_a_pass() {
+    // Frames 0 and 1 are held by a worker elsewhere when this one's pass
+    // reaches them; frame 0 is finished there while this worker renders
+    // frame 2 (a long path-traced frame). The line it prints at the end of
+    // the pass names frame 1 alone; then the claim on 1 times out and it
+    // renders that too, never frame 0.
+    let d = Dir::new();
+    let text = tiny_timeline(3, 8.0)
+        .replace("size: (48, 27)", "size: (120, 68)")
+        .replace(
+            "fractal: (iterations: 8)",
+            "fractal: (iterations: 8), samples_per_pixel: 64, effects: (path_tracing: ())",
+        );
+    d.write("t.ron", &text);
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--frames",
+        "0",
+        "--out",
+        "elsewhere",
+        "--quiet",
+    ]);
+    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
+    let now_ms = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .unwrap()
+        .as_millis();
+    for frame in [0, 1] {
+        let claim = format!(
+            "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t{frame}\",\"heartbeat_ms\":{now_ms}}}"
+        );
+        d.write(&format!("out/t/.frame_0000{frame}.claim"), &claim);
+    }
+    let args = [
+        "render",
+        "t.ron",
+        "--claim",
+        "--claim-timeout",
+        "3",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+    ];
+    let mut command = d.command(&args);
+    command.stderr(std::process::Stdio::piped());
+    // Mid-way through frame 2: frames 0 and 1 were found held.
+    let worker = d.spawn_command_until(command, "out/t", ".ckpt");
+    let done = d.path().join("out/t/finished-elsewhere.png");
+    std::fs::copy(d.path().join("elsewhere/frame_00000.png"), &done).unwrap();
+    std::fs::rename(&done, d.path().join("out/t/frame_00000.png")).unwrap();
+    let out = worker.wait_with_output().unwrap();
+    let err = stderr(&out);
+    assert!(out.status.success(), "{err}");
+    assert!(
+        err.contains("waiting for frame(s) 1 claimed by node7:42"),
+        "{err}"
+    );
+    assert!(!err.contains("waiting for frame(s) 0"), "{err}");
+    let mut rendered = rendered_frames(&err);
+    rendered.sort();
+    assert_eq!(rendered, [1, 2], "{err}");
+}
+
 /// A tiny tmpfs, unmounted when dropped.
 struct SmallDisk(std::path::PathBuf);
 

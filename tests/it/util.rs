@@ -98,7 +98,17 @@ impl Dir {
     /// Starts the binary and waits until a file in `sub` ends with
     /// `suffix`, asserting that it is still running then; returns it running.
     pub fn spawn_until(&self, args: &[&str], sub: &str, suffix: &str) -> std::process::Child {
-        let mut child = self.command(args).spawn().expect("start mandelreel");
+        self.spawn_command_until(self.command(args), sub, suffix)
+    }
+
+    /// `spawn_until` for a command set up by the caller (its output piped).
+    pub fn spawn_command_until(
+        &self,
+        mut command: Command,
+        sub: &str,
+        suffix: &str,
+    ) -> std::process::Child {
+        let mut child = command.spawn().expect("start mandelreel");
         let start = std::time::Instant::now();
         while !self.files(sub).iter().any(|f| f.ends_with(suffix)) {
             assert!(
