@@ -963,6 +963,25 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             inside[0]
         ));
     }
+    // Another render on this folder, where neither shares the frames out
+    // (--claim, --shard): not an error, since the frames come out the same,
+    // but each frame neither has finished is rendered twice.
+    if !args.claim && shard.is_none() && !todo.is_empty() {
+        let me = (crate::output::host_name(), std::process::id());
+        let others: Vec<String> = crate::claim::live_runs(&out_dir, args.claim_timeout)
+            .into_iter()
+            .filter(|run| (run.host.clone(), run.pid) != me)
+            .map(|run| format!("{}:{}", run.host, run.pid))
+            .collect();
+        if !others.is_empty() {
+            say(format!(
+                "warning: another render is running on {} ({}): both will render the frames \
+                 neither has finished; give every worker --claim to share them",
+                out_dir.display(),
+                others.join(", ")
+            ));
+        }
+    }
     // Effects that need several samples a pixel, declared with too few:
     // not an error (a test render may want it), but not what they look like.
     if !plan.preview {

@@ -352,6 +352,11 @@ fn status_lists_a_running_render_and_forgets_a_killed_one() {
     let mut child = render_until_a_checkpoint(&d);
     let me = format!(":{}", child.id());
     let seen = running(&d);
+    // A second plain render on the folder is warned that the work doubles
+    // (one sample a pixel: done long before the first).
+    let out = d.ok(&["render", "t.ron", "--samples", "1", "--quiet"]);
+    says(&out, "warning: another render is running on out/t");
+    says(&out, &me);
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(seen.iter().any(|w| w.ends_with(&me)), "{seen:?} lacks {me}");
