@@ -41,21 +41,23 @@ pub struct ClaimRecord {
 impl ClaimRecord {
     /// A record for this process, with a fresh token and heartbeat.
     fn mine() -> ClaimRecord {
+        let (host, pid) = (crate::output::host_name(), std::process::id());
+        let nanos = SystemTime::now()
+            .duration_since(UNIX_EPOCH)
+            .map(|d| d.as_nanos())
+            .unwrap_or(0);
         ClaimRecord {
-            host: crate::output::host_name(),
-            pid: std::process::id(),
-            token: format!(
-                "{}-{}-{}",
-                crate::output::host_name(),
-                std::process::id(),
-                SystemTime::now()
-                    .duration_since(UNIX_EPOCH)
-                    .map(|d| d.as_nanos())
-                    .unwrap_or(0)
-            ),
+            token: format!("{host}-{pid}-{nanos}"),
+            host,
+            pid,
             heartbeat_ms: now_ms(),
             pid_space: crate::output::pid_space(),
         }
+    }
+
+    /// `host:pid`, as messages and `status` name a worker.
+    pub fn who(&self) -> String {
+        format!("{}:{}", self.host, self.pid)
     }
 }
 
@@ -140,10 +142,11 @@ pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
 /// namespace, is taken over at once, any other after the timeout).
 pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
     let beating = now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64;
-    let seen_from_here = record.host == crate::output::host_name()
-        && record.pid_space.is_some()
-        && record.pid_space == crate::output::pid_space();
-    beating && !(seen_from_here && crate::output::gone_here(record.pid))
+    beating
+        && !(record.host == crate::output::host_name()
+            && record.pid_space.is_some()
+            && record.pid_space == crate::output::pid_space()
+            && crate::output::gone_here(record.pid))
 }
 
 /// Replaces `path` with `record`, atomically (temporary file, then rename).
@@ -175,6 +178,11 @@ pub struct Claim {
 }
 
 impl Claim {
+    /// The token of the record this guard keeps (`ClaimRecord::token`).
+    pub fn token(&self) -> &str {
+        &self.token
+    }
+
     /// A claim on `path` whose heartbeat a thread refreshes every
     /// `interval`. A `contested` path (a frame's claim, which a worker may
     /// take over) is refreshed only while it still holds this record; a

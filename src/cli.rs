@@ -472,10 +472,7 @@ impl Plan {
                 Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
             );
         }
-        let mut timeline = timeline;
-        if let Some(n) = args.samples {
-            timeline.base.samples_per_pixel = n;
-        }
+        let timeline = timeline.with_samples(args.samples);
         let (mut width, mut height) = match &args.size {
             Some(s) => parse_size("--size", s)?,
             None => (timeline.width, timeline.height),
@@ -515,8 +512,9 @@ impl Plan {
         output::layers_for(&self.aovs)
     }
 
-    /// The plan an output folder records (see `output::JobRecord`).
-    fn from_folder(dir: &Path) -> anyhow::Result<Plan> {
+    /// The plan an output folder records (see `output::JobRecord`), and
+    /// the record.
+    fn from_folder(dir: &Path) -> anyhow::Result<(Plan, output::JobRecord)> {
         if !dir.join(output::JOB_FILE).exists() {
             let preview = dir.join("preview");
             let hint = if preview.join(output::JOB_FILE).exists() {
@@ -531,27 +529,26 @@ impl Plan {
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
         let job = output::JobRecord::read(dir)?;
-        let mut timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
-        if let Some(n) = job.samples {
-            timeline.base.samples_per_pixel = n;
-        }
+        let timeline =
+            Timeline::parse(&job.timeline_text, &job.timeline_path)?.with_samples(job.samples);
         let formats = job
             .formats
             .iter()
             .map(|f| <Format as clap::ValueEnum>::from_str(f, true).map_err(|e| anyhow::anyhow!(e)))
             .collect::<anyhow::Result<Vec<_>>>()?;
-        Ok(Plan {
+        let plan = Plan {
             width: job.width,
             height: job.height,
             range: job.frames.0..job.frames.1.min(timeline.frame_count),
             formats,
             out_dir: dir.to_path_buf(),
             preview: job.preview,
-            aovs: job.aovs,
+            aovs: job.aovs.clone(),
             samples: job.samples,
             verify: false,
             timeline,
-        })
+        };
+        Ok((plan, job))
     }
 
     /// Refuses a size whose frame would need more memory than this machine
@@ -559,10 +556,11 @@ impl Plan {
     /// is written: a frame too large would otherwise fail part-way, or be
     /// killed with the machine short of memory.
     fn check_memory(&self, size_given: bool) -> anyhow::Result<()> {
-        let many_samples = self
-            .range
-            .clone()
-            .any(|frame| !self.preview && self.timeline.scene_at(frame).samples_per_pixel > 1);
+        let many_samples = !self.preview
+            && self
+                .range
+                .clone()
+                .any(|frame| self.timeline.scene_at(frame).samples_per_pixel > 1);
         let exr = self.formats.contains(&Format::Exr);
         let (w, h) = (self.width, self.height);
         let need = crate::render::frame_bytes(w, h, self.layers(), exr, many_samples);
@@ -625,13 +623,23 @@ impl Plan {
         self.out_dir.join(output::frame_file_name(frame, format))
     }
 
-    /// Whether every format of `frame` exists and was made from these inputs.
+    /// The state of each format's file of `frame` against these inputs
+    /// (read whole with `--verify`).
+    fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
+        self.formats
+            .iter()
+            .map(|&f| {
+                let key = output::stored_key(f, hash, &self.aovs);
+                output::file_state(&self.path(frame, f), f, &key, self.verify)
+            })
+            .collect()
+    }
+
+    /// Whether every format of `frame` exists, whole, and was made from
+    /// these inputs.
     fn is_complete(&self, frame: u32, hash: &str) -> bool {
-        self.formats.iter().all(|&f| {
-            let key = output::stored_key(f, hash, &self.aovs);
-            let state = output::file_state(&self.path(frame, f), f, &key, self.verify);
-            state == output::FileState::Current
-        })
+        let states = self.file_states(frame, hash);
+        states.iter().all(|&s| s == output::FileState::Current)
     }
 
     /// Renders one frame and writes every format. A frame of one sample per
@@ -901,7 +909,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     record.write(&out_dir)?;
     let stale = output::remove_stale_partials(&out_dir)?;
     // Until this render ends, `status` lists it as running.
-    let _running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
+    let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
 
     let mine: Vec<u32> = plan
         .range
@@ -967,11 +975,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // (--claim, --shard): not an error, since the frames come out the same,
     // but each frame neither has finished is rendered twice.
     if !args.claim && shard.is_none() && !todo.is_empty() {
-        let me = (crate::output::host_name(), std::process::id());
         let others: Vec<String> = crate::claim::live_runs(&out_dir, args.claim_timeout)
-            .into_iter()
-            .filter(|run| (run.host.clone(), run.pid) != me)
-            .map(|run| format!("{}:{}", run.host, run.pid))
+            .iter()
+            .filter(|run| run.token != running.token())
+            .map(crate::claim::ClaimRecord::who)
             .collect();
         if !others.is_empty() {
             say(format!(
@@ -1106,8 +1113,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         // The frames last reported as held by others (said once per change).
         let mut waiting_for = Vec::new();
         // Frames seen finished, here or by others, are not read again: a
-        // frame is checked whole (every byte), and a worker waiting on a
-        // farm's shared storage would otherwise read them all every round.
+        // worker waiting on a farm's shared storage would otherwise check
+        // them all every round (read whole, with --verify).
         let mut finished = vec![false; todo.len()];
         loop {
             let mut held = Vec::new();
@@ -1147,11 +1154,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 break;
             }
             let frames: Vec<u32> = held.iter().map(|(k, _)| todo[*k].0).collect();
-            if !args.quiet && !frames.is_empty() && frames != waiting_for {
-                let mut workers: Vec<String> = held
-                    .iter()
-                    .map(|(_, c)| format!("{}:{}", c.host, c.pid))
-                    .collect();
+            if !args.quiet && frames != waiting_for {
+                let mut workers: Vec<String> = held.iter().map(|(_, c)| c.who()).collect();
                 workers.sort();
                 workers.dedup();
                 say(format!(
@@ -1213,7 +1217,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 }
 
 /// What `Plan::render_frame` has to say while a frame renders.
-pub enum Said {
+enum Said {
     /// It goes on from a checkpoint holding `samples` of its `of` samples a pixel.
     Resumed { frame: u32, samples: u32, of: u32 },
     /// A checkpoint could not be saved; the frame goes on without.
@@ -1273,7 +1277,8 @@ fn ranges(frames: &[u32]) -> String {
 }
 
 fn status(args: StatusArgs) -> anyhow::Result<()> {
-    let plan = if args.target.is_dir() {
+    // The plan, and the folder's record: read once.
+    let (plan, job) = if args.target.is_dir() {
         let s = &args.sequence;
         // The folder records these; only the frames may be narrowed.
         let given = [
@@ -1295,13 +1300,15 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let mut plan = Plan::from_folder(&args.target)?;
+        let (mut plan, job) = Plan::from_folder(&args.target)?;
         if let Some(frames) = &s.frames {
             plan.range = parse_frames(frames, plan.timeline.frame_count)?;
         }
-        plan
+        (plan, Some(job))
     } else {
-        Plan::new(&args.target, &args.sequence)?
+        let plan = Plan::new(&args.target, &args.sequence)?;
+        let job = output::JobRecord::read(&plan.out_dir).ok();
+        (plan, job)
     };
     let plan = Plan {
         verify: args.verify,
@@ -1315,27 +1322,20 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     let mut workers: std::collections::BTreeSet<String> =
         crate::claim::live_runs(&plan.out_dir, args.claim_timeout)
             .iter()
-            .map(|run| format!("{}:{}", run.host, run.pid))
+            .map(crate::claim::ClaimRecord::who)
             .collect();
     for frame in plan.range.clone() {
         let (_, hash) = plan.frame(frame);
         // Each file's header read once, and a file read whole only where
         // its header records these inputs.
-        let files: Vec<output::FileState> = plan
-            .formats
-            .iter()
-            .map(|&f| {
-                let key = output::stored_key(f, &hash, &plan.aovs);
-                output::file_state(&plan.path(frame, f), f, &key, plan.verify)
-            })
-            .collect();
+        let files = plan.file_states(frame, &hash);
         let state = if files.iter().all(|&s| s == output::FileState::Current) {
             FrameState::Complete
         } else if let Some(claim) =
             crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
                 .filter(|c| crate::claim::is_live(c, args.claim_timeout))
         {
-            workers.insert(format!("{}:{}", claim.host, claim.pid));
+            workers.insert(claim.who());
             FrameState::InProgress
         } else if writing.contains(&frame) {
             FrameState::InProgress
@@ -1358,7 +1358,6 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
     }
     let total = plan.range.len();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
-    let job = output::JobRecord::read(&plan.out_dir).ok();
     // A folder last rendered from another timeline file (with --force).
     let other_timeline = job
         .as_ref()
@@ -1790,10 +1789,7 @@ fn set_threads(threads: Option<usize>) -> Result<()> {
 }
 
 fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
-    let mut t = Timeline::load(&args.timeline)?;
-    if let Some(n) = args.samples {
-        t.base.samples_per_pixel = n;
-    }
+    let t = Timeline::load(&args.timeline)?.with_samples(args.samples);
     let (width, height) = match &args.size {
         Some(s) => parse_size("--size", s)?,
         None => {

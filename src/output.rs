@@ -201,10 +201,12 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
             }
         }
         Format::Exr => {
-            let Ok(reader) = exr::block::read(file, true) else {
+            // The header, read once: its hash, then the offset table after it.
+            let mut file = file;
+            let Ok(meta) = exr::meta::MetaData::read_from_buffered(&mut file, false) else {
                 return FileState::Damaged;
             };
-            let recorded = reader.meta_data().headers.first().and_then(|header| {
+            let recorded = meta.headers.first().and_then(|header| {
                 match header
                     .own_attributes
                     .other
@@ -219,11 +221,13 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
             }
             // Thorough reading adds every chunk read whole to the end check
             // (pedantic reading refuses bytes after the last).
-            exr_ends_with_its_last_chunk(path).unwrap_or(false)
-                && (!thorough
-                    || reader
-                        .all_chunks(true)
-                        .is_ok_and(|mut chunks| chunks.all(|chunk| chunk.is_ok())))
+            let every_chunk = || {
+                let file = std::io::BufReader::new(File::open(path).ok()?);
+                let chunks = exr::block::read(file, true).ok()?.all_chunks(true).ok()?;
+                Some(chunks.into_iter().all(|chunk| chunk.is_ok()))
+            };
+            exr_ends_with_its_last_chunk(&mut file, &meta).unwrap_or(false)
+                && (!thorough || every_chunk() == Some(true))
         }
     };
     if whole {
@@ -252,13 +256,14 @@ fn png_ends_with_iend(path: &Path) -> bool {
 /// table read, and the chunk at the largest offset (its coordinates: a
 /// tile's four numbers or a scan-line block's y; its byte count; its
 /// bytes) must reach the file's end and not pass it.
-fn exr_ends_with_its_last_chunk(path: &Path) -> std::io::Result<bool> {
+/// `file` stands just after the header `meta` (exr reads a header up to
+/// the null byte that ends it, and no further): at the offset table.
+fn exr_ends_with_its_last_chunk(
+    file: &mut std::io::BufReader<File>,
+    meta: &exr::meta::MetaData,
+) -> std::io::Result<bool> {
     use std::io::{Read, Seek, SeekFrom};
-    let mut file = std::io::BufReader::new(File::open(path)?);
     let length = file.get_ref().metadata()?.len();
-    let invalid = |e: exr::error::Error| std::io::Error::other(e.to_string());
-    // exr reads the header up to the null byte that ends it, and no further.
-    let meta = exr::meta::MetaData::read_from_buffered(&mut file, false).map_err(invalid)?;
     let [header] = meta.headers.as_slice() else {
         return Ok(false);
     };
@@ -458,23 +463,17 @@ fn encode_png(
     // every thread.
     use rayon::prelude::*;
     let srgb = crate::math::SrgbBytes::get();
+    let plain = look.is_plain_display();
     let row = (film.width as usize).max(1);
     let mut bytes = vec![0u8; film.colour.len() * 3];
     bytes
         .par_chunks_mut(3 * row)
         .zip(film.colour.par_chunks(row))
         .for_each(|(bytes, colour)| {
-            if look.is_plain_display() {
-                for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
-                    for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
-                        *byte = srgb.byte(v);
-                    }
-                }
-                return;
-            }
             for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
                 for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
-                    *byte = srgb.byte(look.display(v));
+                    // At the default display the light is coded as it is.
+                    *byte = srgb.byte(if plain { v } else { look.display(v) });
                 }
             }
         });
@@ -956,12 +955,17 @@ pub const STALE_PARTIAL_AGE: std::time::Duration = std::time::Duration::from_sec
 
 /// This machine's name, for temporary-file tags, claims and `status`.
 pub fn host_name() -> String {
-    std::fs::read_to_string("/proc/sys/kernel/hostname")
-        .ok()
-        .map(|s| s.trim().to_string())
-        .filter(|s| !s.is_empty())
-        .or_else(|| std::env::var("HOSTNAME").ok())
-        .unwrap_or_else(|| "unknown-host".into())
+    // Read once a process: claims ask for it for every frame they look at.
+    static NAME: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    NAME.get_or_init(|| {
+        std::fs::read_to_string("/proc/sys/kernel/hostname")
+            .ok()
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+            .or_else(|| std::env::var("HOSTNAME").ok())
+            .unwrap_or_else(|| "unknown-host".into())
+    })
+    .clone()
 }
 
 /// `host.pid.`: written into every temporary file's name so a later run on
@@ -1009,9 +1013,15 @@ pub fn gone_here(pid: u32) -> bool {
 /// host name see each other's pids only if these match (containers that
 /// share a host name, cloned machines that kept one, do not).
 pub fn pid_space() -> Option<String> {
-    let boot = std::fs::read_to_string("/proc/sys/kernel/random/boot_id").ok()?;
-    let namespace = std::fs::read_link("/proc/self/ns/pid").ok()?;
-    Some(format!("{}/{}", boot.trim(), namespace.display()))
+    // Fixed for the life of a process: read once.
+    static SPACE: std::sync::OnceLock<Option<String>> = std::sync::OnceLock::new();
+    SPACE
+        .get_or_init(|| {
+            let boot = std::fs::read_to_string("/proc/sys/kernel/random/boot_id").ok()?;
+            let namespace = std::fs::read_link("/proc/self/ns/pid").ok()?;
+            Some(format!("{}/{}", boot.trim(), namespace.display()))
+        })
+        .clone()
 }
 
 /// How long ago `path` was last modified (`None` if that cannot be told).
@@ -1371,6 +1381,16 @@ mod tests {
             stored_key(Format::Exr, &h, &layers),
             format!("{h}+normal,steps")
         );
+        // A grade other than the default follows the light's hash in the
+        // PNG's key alone: the EXR's and the checkpoint's are the light's.
+        let mut g = s.clone();
+        g.look.exposure = 2.0;
+        g.look.tone_map = crate::shade::ToneMap::Filmic;
+        let graded = frame_hash(std::slice::from_ref(&g), 0, 4, 3);
+        assert_eq!(graded, format!("{h}~exposure=2,Filmic"));
+        assert_eq!(light_hash(&graded), h);
+        assert_eq!(stored_key(Format::Exr, &graded, &[]), h);
+        assert_eq!(stored_key(Format::Png, &graded, &[]), graded);
     }
 
     #[test]

@@ -1139,7 +1139,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn the_filmic_curve_rolls_off_below_white_and_the_default_keeps_hashes() {
+    fn the_filmic_curve_rolls_off_below_white_and_defaults_are_not_serialised() {
         let f = |x: f32| ToneMap::Filmic.apply(x);
         assert_eq!(f(0.0), 0.0);
         // Narkowicz's fit at a few points, by hand: 0.18·0.4818/0.32493 …

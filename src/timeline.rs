@@ -435,6 +435,15 @@ pub fn read_text(path: &Path) -> Result<String> {
 }
 
 impl Timeline {
+    /// This timeline with `samples` per pixel in place of its own, where
+    /// given (`--samples`).
+    pub fn with_samples(mut self, samples: Option<u32>) -> Timeline {
+        if let Some(n) = samples {
+            self.base.samples_per_pixel = n;
+        }
+        self
+    }
+
     /// Reads, parses and validates a timeline file.
     pub fn load(path: &Path) -> Result<Timeline> {
         let text = read_text(path)?;
@@ -713,8 +722,8 @@ impl Timeline {
             }
             let failure = times.into_iter().find_map(|time| {
                 timeline
-                    .zoom_direction_at(time)
-                    .and_then(|_| validate_scene(&timeline.scene_at_time(time)))
+                    .scene_built(time, true)
+                    .and_then(|scene| validate_scene(&scene))
                     .err()
                     .map(|e| (time, e))
             });
@@ -770,37 +779,36 @@ impl Timeline {
         self.scene_at_time(self.time_of(frame_index))
     }
 
-    /// Where a zoom track is: checks that the camera's position and target
-    /// before it, at `time_seconds`, differ, since `camera.distance` places
-    /// the camera along the line between them.
-    fn zoom_direction_at(&self, time_seconds: Real) -> std::result::Result<(), (String, String)> {
-        if !self.tracks.iter().any(|t| t.name == ZOOM_TRACK) {
-            return Ok(());
-        }
-        let scene = self.scene_from(time_seconds, |t| t.name != ZOOM_TRACK);
-        let c = &scene.camera;
-        let away = c.position - c.target;
-        if away.length() > 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
-            return Ok(());
-        }
-        Err((
-            "camera.position".into(),
-            "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
-        ))
-    }
-
     /// The scene at any time in seconds, between frames too.
     pub fn scene_at_time(&self, time_seconds: Real) -> Scene {
-        self.scene_from(time_seconds, |_| true)
+        self.scene_built(time_seconds, false)
+            .unwrap_or_else(|_| unreachable!("only the check fails"))
     }
 
-    /// The base scene with the tracks `which` keeps applied at a time.
-    fn scene_from(&self, time_seconds: Real, which: impl Fn(&Track) -> bool) -> Scene {
+    /// The base scene with every track applied at a time, the zoom last.
+    /// With `check`, a zoom track where the camera's position and target
+    /// before it coincide is refused: `camera.distance` places the camera
+    /// along the line between them, and there is none.
+    fn scene_built(
+        &self,
+        time_seconds: Real,
+        check: bool,
+    ) -> std::result::Result<Scene, (String, String)> {
         let mut scene = self.base.clone();
-        for track in self.tracks.iter().filter(|t| which(t)) {
+        for track in &self.tracks {
+            if check && track.name == ZOOM_TRACK {
+                let c = &scene.camera;
+                let away = c.position - c.target;
+                if away.length() <= 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
+                    return Err((
+                        "camera.position".into(),
+                        "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
+                    ));
+                }
+            }
             apply(&mut scene, &track.name, &track.sample(time_seconds));
         }
-        scene
+        Ok(scene)
     }
 
     /// The instants a frame's samples see: the frame's own, or with motion

@@ -1,7 +1,7 @@
 //! Rendering through the command line: numbered frames, ranges, sizes, the
 //! ffmpeg command, thread-count determinism, `info` and `pick`.
 
-use crate::util::{says, stderr, stdout, tiny_timeline, Dir};
+use crate::util::{says, stderr, stdout, tiny_timeline, with_scene, Dir};
 
 #[test]
 fn render_writes_numbered_frames_and_prints_the_ffmpeg_command() {
@@ -53,10 +53,7 @@ fn samples_on_the_command_line_render_what_the_timeline_would() {
     let d = Dir::new();
     let text = tiny_timeline(2, 6.0);
     d.write("t.ron", &text);
-    let four = text.replace(
-        "fractal: (iterations: 8)",
-        "fractal: (iterations: 8), samples_per_pixel: 4",
-    );
+    let four = with_scene(&text, "samples_per_pixel: 4");
     d.write("t4.ron", &four);
     d.ok(&["render", "t4.ron", "--quiet"]);
     d.ok(&["render", "t.ron", "--samples", "4", "--quiet"]);
@@ -97,12 +94,11 @@ fn same_frame_is_byte_identical_with_one_or_two_threads() {
     // spans several EXR blocks, whose order must not vary either.
     d.write(
         "t.ron",
-        &tiny_timeline(2, 7.0)
-            .replace(
-                "fractal: (iterations: 8)",
-                // Every sampled effect too: motion blur, a lens, shadows, occlusion.
-                "fractal: (iterations: 8), samples_per_pixel: 4, effects: (motion_blur: (shutter: 0.8), shadows: (), ambient_occlusion: ())",
-            )
+        // Every sampled effect too: motion blur, a lens, shadows, occlusion.
+        &with_scene(
+            &tiny_timeline(2, 7.0),
+            "samples_per_pixel: 4, effects: (motion_blur: (shutter: 0.8), shadows: (), ambient_occlusion: ())",
+        )
             .replace("position: (0, 0.5, 3.0)", "position: (0, 0.5, 3.0), aperture_radius: 0.05")
             .replace("size: (48, 27)", "size: (160, 96)"),
     );
@@ -123,9 +119,9 @@ fn path_traced_frame_is_byte_identical_with_one_or_two_threads() {
     let d = Dir::new();
     d.write(
         "t.ron",
-        &tiny_timeline(1, 8.0).replace(
-            "fractal: (iterations: 8)",
-            "fractal: (iterations: 8), samples_per_pixel: 4, effects: (path_tracing: (max_bounces: 4))",
+        &with_scene(
+            &tiny_timeline(1, 8.0),
+            "samples_per_pixel: 4, effects: (path_tracing: (max_bounces: 4))",
         ),
     );
     d.same_on_one_and_two_threads("t.ron", &["--format", "exr"], &["frame_00000.exr"]);
@@ -372,10 +368,10 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
         (&["sheet", "out/t", "--out", "sheet.jpg"], "name it .png"),
         (&["sheet", "."], "no frame_NNNNN.png files"),
     ];
-    for (args, says) in refused {
+    for (args, what) in refused {
         let out = d.run(args);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {}", stderr(&out));
-        assert!(stderr(&out).contains(says), "{args:?}: {}", stderr(&out));
+        says(&out, what);
     }
     assert!(!d.path().join("big.png").exists() && !d.path().join("sheet.jpg").exists());
     // A preview's frames are pointed at.

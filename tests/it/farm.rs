@@ -1,7 +1,7 @@
 //! Never losing a night's work, and sharing it out: crash-and-resume under
 //! repeated SIGKILL, `status`, `--shard`, `--claim` workers, a full disk.
 
-use crate::util::{says, stderr, stdout, tiny_timeline, Dir};
+use crate::util::{long_frames, says, stderr, stdout, tiny_timeline, Dir};
 use std::collections::BTreeMap;
 use std::time::Duration;
 
@@ -96,20 +96,12 @@ fn status_reports_complete_stale_missing_and_in_progress() {
         stdout(&out)
     );
     d.ok(&["render", "t.ron", "--frames", "0..4", "--quiet"]);
-    let out = d.run(&["status", "t.ron", "--json"]);
-    assert_eq!(out.status.code(), Some(4));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let (code, v) = d.status_json(&["t.ron"]);
+    assert_eq!(code, Some(4));
     assert_eq!(v["complete"], 4);
     assert_eq!(v["states"]["missing"], serde_json::json!([4, 5]));
     // A live claim marks a frame in progress.
-    let claim = format!(
-        "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t1\",\"heartbeat_ms\":{}}}",
-        std::time::SystemTime::now()
-            .duration_since(std::time::UNIX_EPOCH)
-            .unwrap()
-            .as_millis()
-    );
-    d.write("out/t/.frame_00004.claim", &claim);
+    d.claim_elsewhere(4);
     let out = stdout(&d.run(&["status", "t.ron"]));
     assert!(
         out.contains("in progress") && out.contains("node7:42"),
@@ -130,9 +122,8 @@ fn status_reports_complete_stale_missing_and_in_progress() {
     // The timeline changes: frames 1.. are stale against it, and the folder
     // notices that its timeline changed since its render.
     d.write("t.ron", &tiny_timeline(6, 5.0));
-    let out = d.run(&["status", "t.ron", "--json"]);
-    assert_eq!(out.status.code(), Some(4));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let (code, v) = d.status_json(&["t.ron"]);
+    assert_eq!(code, Some(4));
     assert_eq!(v["states"]["stale"], serde_json::json!([1, 2, 3, 4, 5]));
     let folder = stdout(&d.ok(&["status", "out/t"]));
     assert!(folder.contains("has changed since"), "{folder}");
@@ -148,9 +139,8 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
     d.write("t.ron", &tiny_timeline(8, 6.0));
     d.ok(&["render", "t.ron", "--frames", "0..2", "--quiet"]);
     d.ok(&["render", "t.ron", "--frames", "4..6", "--quiet"]);
-    let out = d.run(&["status", "out/t", "--json"]);
-    assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
-    let v: serde_json::Value = serde_json::from_str(&stdout(&out)).unwrap();
+    let (code, v) = d.status_json(&["out/t"]);
+    assert_eq!(code, Some(4), "{v}");
     assert_eq!(v["frames"], serde_json::json!([0, 6]));
     assert_eq!(v["states"]["missing"], serde_json::json!([2, 3]));
     assert_eq!(v["timeline_frames"], 8);
@@ -325,14 +315,7 @@ fn a_worker_says_which_frames_it_waits_for_and_takes_them_after_the_timeout() {
     // takes it over once the claim is a timeout old.
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(2, 6.0));
-    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
-    let now_ms = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_millis();
-    let claim =
-        format!("{{\"host\":\"node7\",\"pid\":42,\"token\":\"t1\",\"heartbeat_ms\":{now_ms}}}");
-    d.write("out/t/.frame_00001.claim", &claim);
+    d.claim_elsewhere(1);
     let out = d.ok(&["render", "t.ron", "--claim", "--claim-timeout", "2"]);
     let err = stderr(&out);
     assert!(
@@ -350,12 +333,7 @@ fn the_waiting_line_names_only_frames_still_held_at_the_end_of_a_pass() {
     // the pass names frame 1 alone; then the claim on 1 times out and it
     // renders that too, never frame 0.
     let d = Dir::new();
-    let text = tiny_timeline(3, 8.0)
-        .replace("size: (48, 27)", "size: (120, 68)")
-        .replace(
-            "fractal: (iterations: 8)",
-            "fractal: (iterations: 8), samples_per_pixel: 64, effects: (path_tracing: ())",
-        );
+    let text = long_frames(3);
     d.write("t.ron", &text);
     d.ok(&[
         "render",
@@ -366,17 +344,8 @@ fn the_waiting_line_names_only_frames_still_held_at_the_end_of_a_pass() {
         "elsewhere",
         "--quiet",
     ]);
-    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
-    let now_ms = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .unwrap()
-        .as_millis();
-    for frame in [0, 1] {
-        let claim = format!(
-            "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t{frame}\",\"heartbeat_ms\":{now_ms}}}"
-        );
-        d.write(&format!("out/t/.frame_0000{frame}.claim"), &claim);
-    }
+    d.claim_elsewhere(0);
+    d.claim_elsewhere(1);
     let args = [
         "render",
         "t.ron",

@@ -1,6 +1,6 @@
 //! PNG and EXR output decode, with the channels and metadata promised.
 
-use crate::util::{says, stderr, tiny_timeline, Dir};
+use crate::util::{says, stderr, tiny_timeline, with_scene, Dir};
 
 #[test]
 fn png_and_exr_decode_with_expected_channels() {
@@ -122,10 +122,7 @@ fn a_filmic_tone_map_rolls_highlights_off_in_pngs_and_leaves_exrs_linear() {
     // A bright key light clips many channels; the filmic curve maps each
     // PNG value from the same linear light, which the EXRs keep unchanged.
     let d = Dir::new();
-    let bright = tiny_timeline(1, 8.0).replace(
-        "fractal: (iterations: 8)",
-        "fractal: (iterations: 8), look: (light_colour: (4, 3, 2))",
-    );
+    let bright = with_scene(&tiny_timeline(1, 8.0), "look: (light_colour: (4, 3, 2))");
     d.write("clip.ron", &bright);
     d.write(
         "filmic.ron",
@@ -195,10 +192,7 @@ fn a_change_of_grade_rerenders_pngs_but_leaves_exrs_and_fades_to_black() {
         d.bytes("both/frame_00001.exr"),
         d.bytes("both/frame_00001.png"),
     );
-    let graded = text.replace(
-        "fractal: (iterations: 8)",
-        "fractal: (iterations: 8), look: (exposure: 2, tone_map: Filmic)",
-    );
+    let graded = with_scene(&text, "look: (exposure: 2, tone_map: Filmic)");
     d.write("t.ron", &graded);
     let out = d.ok(&["render", "t.ron", "--format", "exr", "--out", "exr"]);
     says(&out, "2 of 2 frames already complete");

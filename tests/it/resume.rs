@@ -1,7 +1,7 @@
 //! Resume: complete frames are skipped, stale or partial ones re-rendered, and a
 //! render killed mid-way leaves no damaged frame and finishes identically.
 
-use crate::util::{says, stderr, tiny_timeline, Dir};
+use crate::util::{long_frames, says, stderr, tiny_timeline, with_scene, Dir};
 use std::time::{Duration, Instant};
 
 fn mtimes(d: &Dir, sub: &str) -> Vec<std::time::SystemTime> {
@@ -201,17 +201,6 @@ fn killed_render_resumes_to_identical_frames() {
     }
 }
 
-/// One path-traced frame of 64 samples per pixel: 16 waves of 4, long
-/// enough on one thread to be caught mid-way.
-fn long_frame() -> String {
-    tiny_timeline(1, 8.0)
-        .replace("size: (48, 27)", "size: (120, 68)")
-        .replace(
-            "fractal: (iterations: 8)",
-            "fractal: (iterations: 8), samples_per_pixel: 64, effects: (path_tracing: ())",
-        )
-}
-
 /// Starts rendering `t.ron` into out/t on one thread, saving a checkpoint
 /// after every wave, and returns once the first is saved: mid-frame.
 fn render_until_a_checkpoint(d: &Dir) -> std::process::Child {
@@ -230,7 +219,7 @@ fn render_until_a_checkpoint(d: &Dir) -> std::process::Child {
 #[test]
 fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
     let d = Dir::new();
-    let text = long_frame();
+    let text = long_frames(1);
     d.write("t.ron", &text);
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
     let mut child = render_until_a_checkpoint(&d);
@@ -242,10 +231,7 @@ fn a_long_frame_killed_mid_way_resumes_from_its_checkpoint_identically() {
     );
     // `status` counts the frame resumable, but not against other inputs,
     // for which the checkpoint is no use.
-    let status = |timeline: &str| -> serde_json::Value {
-        let out = d.run(&["status", timeline, "--out", "out/t", "--json"]);
-        serde_json::from_str(&crate::util::stdout(&out)).unwrap()
-    };
+    let status = |timeline: &str| d.status_json(&[timeline, "--out", "out/t"]).1;
     assert_eq!(
         status("t.ron")["states"]["resumable"],
         serde_json::json!([0])
@@ -280,9 +266,8 @@ fn frames_cut_short_or_damaged_are_rendered_again() {
     let clean = |f: &str| d.bytes(&format!("out/t/{f}"));
     let (exr, png) = (clean("frame_00001.exr"), clean("frame_00002.png"));
     let states = |extra: &[&str]| -> serde_json::Value {
-        let out = d.run(&[&["status", "out/t", "--json"][..], extra].concat());
-        assert_eq!(out.status.code(), Some(4), "{}", stderr(&out));
-        let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
+        let (code, v) = d.status_json(&[&["out/t"][..], extra].concat());
+        assert_eq!(code, Some(4), "{v}");
         v["states"].clone()
     };
     // The EXR cut to half its length; one byte flipped in the PNG's image data.
@@ -320,10 +305,7 @@ fn a_checkpoint_that_cannot_be_saved_warns_and_the_frame_goes_on() {
     // A full disk (here, a folder in the checkpoint's place) must not end a
     // render whose frames still fit.
     let d = Dir::new();
-    let text = tiny_timeline(1, 8.0).replace(
-        "fractal: (iterations: 8)",
-        "fractal: (iterations: 8), samples_per_pixel: 16",
-    );
+    let text = with_scene(&tiny_timeline(1, 8.0), "samples_per_pixel: 16");
     d.write("t.ron", &text);
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
     std::fs::create_dir_all(d.path().join("out/t/.frame_00000.ckpt")).unwrap();
@@ -343,11 +325,9 @@ fn status_lists_a_running_render_and_forgets_a_killed_one() {
     // A plain render (no claims) is listed as running while it runs, and
     // not once it has been killed; the next render clears its record.
     let d = Dir::new();
-    d.write("t.ron", &long_frame());
+    d.write("t.ron", &long_frames(1));
     let running = |d: &Dir| -> Vec<String> {
-        let out = d.run(&["status", "t.ron", "--json"]);
-        let v: serde_json::Value = serde_json::from_str(&crate::util::stdout(&out)).unwrap();
-        serde_json::from_value(v["workers"].clone()).unwrap()
+        serde_json::from_value(d.status_json(&["t.ron"]).1["workers"].clone()).unwrap()
     };
     let mut child = render_until_a_checkpoint(&d);
     let me = format!(":{}", child.id());

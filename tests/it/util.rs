@@ -23,6 +23,23 @@ pub fn tiny_timeline(frames: u32, power_end: f64) -> String {
     )
 }
 
+/// `timeline` (a `tiny_timeline`) with `fields` added to its scene, after
+/// the fractal: `with_scene(&tiny_timeline(1, 8.0), "samples_per_pixel: 4")`.
+pub fn with_scene(timeline: &str, fields: &str) -> String {
+    let fractal = "fractal: (iterations: 8)";
+    assert!(timeline.contains(fractal), "not a tiny_timeline");
+    timeline.replace(fractal, &format!("{fractal}, {fields}"))
+}
+
+/// `frames` path-traced frames of 120×68 at 64 samples a pixel: 16 waves
+/// of 4 each, long enough on one thread to be caught mid-way.
+pub fn long_frames(frames: u32) -> String {
+    with_scene(
+        &tiny_timeline(frames, 8.0).replace("size: (48, 27)", "size: (120, 68)"),
+        "samples_per_pixel: 64, effects: (path_tracing: ())",
+    )
+}
+
 impl Dir {
     pub fn new() -> Dir {
         Dir {
@@ -152,6 +169,28 @@ impl ExrFrame {
 }
 
 impl Dir {
+    /// Runs `status ARGS --json`: its exit code and its report.
+    pub fn status_json(&self, args: &[&str]) -> (Option<i32>, serde_json::Value) {
+        let out = self.run(&[&["status"][..], args, &["--json"]].concat());
+        let report =
+            serde_json::from_str(&stdout(&out)).unwrap_or_else(|e| panic!("{e}: {}", stderr(&out)));
+        (out.status.code(), report)
+    }
+
+    /// Writes a fresh claim on `frame` in out/t, held by a worker on
+    /// another machine (node7:42).
+    pub fn claim_elsewhere(&self, frame: u32) {
+        let now_ms = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_millis();
+        let claim = format!(
+            "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t{frame}\",\"heartbeat_ms\":{now_ms}}}"
+        );
+        std::fs::create_dir_all(self.path().join("out/t")).unwrap();
+        self.write(&format!("out/t/.frame_{frame:05}.claim"), &claim);
+    }
+
     /// Reads the EXR file at `rel`.
     pub fn exr(&self, rel: &str) -> ExrFrame {
         let image = exr::prelude::read_all_flat_layers_from_file(self.path().join(rel))

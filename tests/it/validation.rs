@@ -57,7 +57,7 @@ fn a_timeline_that_is_not_utf8_is_a_syntax_error_at_its_place() {
         .map(|b| if b == 1 { 0xE9 } else { b })
         .collect();
     let d = Dir::new();
-    std::fs::write(d.path().join("bad.ron"), &bytes).unwrap();
+    d.write_bytes("bad.ron", &bytes);
     let out = d.run(&["render", "bad.ron"]);
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(3), "{err}");
