@@ -885,28 +885,20 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         .as_deref()
         .map(|s| parse_shard(s, &|k| std::env::var(k).ok()))
         .transpose()?;
-    let mut record = plan.record()?;
+    let record = plan.record()?;
     let (width, height, out_dir) = (plan.width, plan.height, plan.out_dir.clone());
     plan.check_memory(args.sequence.size.is_some())?;
-    if let Ok(old) = output::JobRecord::read(&out_dir) {
-        if old.same_sequence(&record) {
-            // The folder is meant to hold every range rendered into it:
-            // renders in pieces (--frames 0..60, then 60..120) leave a
-            // record of 0..120, so `status OUTDIR` counts the gaps.
-            record.frames = (
-                old.frames.0.min(record.frames.0),
-                old.frames.1.max(record.frames.1),
-            );
-        } else if !args.force && !args.replace {
-            refuse_other_sequence(&out_dir, &old, &record)?;
-        }
-    }
     if out_dir.exists() && !out_dir.is_dir() {
         let message = format!("{} is a file, not a folder", out_dir.display());
         return Err(Error::usage("--out", message).into());
     }
+    if let Ok(old) = output::JobRecord::read(&out_dir) {
+        if !old.same_sequence(&record) && !args.force && !args.replace {
+            refuse_other_sequence(&out_dir, &old, &record)?;
+        }
+    }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
-    record.write(&out_dir)?;
+    record.record_in(&out_dir)?;
     let stale = output::remove_stale_partials(&out_dir)?;
     // Until this render ends, `status` lists it as running.
     let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;

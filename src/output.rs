@@ -731,6 +731,10 @@ pub fn csv_text<T: Serialize>(rows: &[T]) -> String {
 /// work from the folder alone.
 pub const JOB_FILE: &str = "mandelreel-job.json";
 
+/// The empty file renders lock while they update `JOB_FILE`
+/// (`JobRecord::record_in`).
+pub const JOB_LOCK: &str = ".mandelreel-job.lock";
+
 /// What an output folder was rendered from: enough to recompute every
 /// frame's hash without the original timeline file.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
@@ -775,6 +779,38 @@ impl JobRecord {
     pub fn same_sequence(&self, other: &JobRecord) -> bool {
         self.of_timeline(&other.timeline_path)
             && (self.width, self.height) == (other.width, other.height)
+    }
+
+    /// Writes this record into `dir`, spanning the frames of the one there
+    /// too if that renders the same sequence (`same_sequence`): a folder is
+    /// meant to hold every range rendered into it, so renders in pieces
+    /// (`--frames 0..60`, then `60..120`, or both at once on a farm) leave
+    /// a record of 0..120 and `status OUTDIR` counts the gaps. An exclusive
+    /// lock on the folder's `JOB_LOCK` is held from the read to the write,
+    /// so renders started at the same moment each merge into the record the
+    /// one before wrote, and none loses another's range. Where the file
+    /// system cannot lock, it goes on without: the record is bookkeeping,
+    /// not worth a render.
+    pub fn record_in(self, dir: &Path) -> Result<()> {
+        let lock_path = dir.join(JOB_LOCK);
+        let lock = std::fs::OpenOptions::new()
+            .create(true)
+            .truncate(false)
+            .write(true)
+            .open(&lock_path)
+            .map_err(|e| Error::io(&lock_path, e))?;
+        let _ = lock.lock();
+        let record = match JobRecord::read(dir) {
+            Ok(old) if old.same_sequence(&self) => JobRecord {
+                frames: (
+                    old.frames.0.min(self.frames.0),
+                    old.frames.1.max(self.frames.1),
+                ),
+                ..self
+            },
+            _ => self,
+        };
+        record.write(dir)
     }
 
     pub fn read(dir: &Path) -> Result<JobRecord> {
@@ -1391,6 +1427,52 @@ mod tests {
         assert_eq!(light_hash(&graded), h);
         assert_eq!(stored_key(Format::Exr, &graded, &[]), h);
         assert_eq!(stored_key(Format::Png, &graded, &[]), graded);
+    }
+
+    #[test]
+    fn renders_started_together_each_add_their_range_to_the_record() {
+        let record = |frames| JobRecord {
+            renderer: "test".into(),
+            timeline_path: "zoom.ron".into(),
+            timeline_text: String::new(),
+            width: 8,
+            height: 8,
+            formats: vec!["png".into()],
+            frames,
+            preview: false,
+            aovs: Vec::new(),
+            samples: None,
+        };
+        const WORKERS: u32 = 8;
+        for _ in 0..20 {
+            let dir = tempfile::tempdir().unwrap();
+            // Another size is another sequence: its range is not kept.
+            JobRecord {
+                width: 9,
+                ..record((100, 200))
+            }
+            .write(dir.path())
+            .unwrap();
+            let start = std::sync::Barrier::new(WORKERS as usize);
+            std::thread::scope(|s| {
+                for worker in 0..WORKERS {
+                    let (start, dir) = (&start, dir.path());
+                    s.spawn(move || {
+                        start.wait();
+                        record((worker * 10 + 5, worker * 10 + 10))
+                            .record_in(dir)
+                            .unwrap();
+                    });
+                }
+            });
+            let merged = JobRecord::read(dir.path()).unwrap();
+            assert_eq!(
+                merged.frames,
+                (5, WORKERS * 10),
+                "every worker's range is kept"
+            );
+            assert_eq!(merged.width, 8);
+        }
     }
 
     #[test]

@@ -11,6 +11,7 @@ fn render_writes_numbered_frames_and_prints_the_ffmpeg_command() {
     assert_eq!(
         d.files("out/t"),
         [
+            ".mandelreel-job.lock",
             "frame_00000.png",
             "frame_00001.png",
             "frame_00002.png",
@@ -39,7 +40,12 @@ fn frame_range_is_half_open_and_size_overrides() {
     ]);
     assert_eq!(
         d.files("o"),
-        ["frame_00001.png", "frame_00002.png", "mandelreel-job.json"]
+        [
+            ".mandelreel-job.lock",
+            "frame_00001.png",
+            "frame_00002.png",
+            "mandelreel-job.json"
+        ]
     );
     let img = image::open(d.path().join("o/frame_00001.png")).unwrap();
     assert_eq!((img.width(), img.height()), (20, 10));

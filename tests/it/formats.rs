@@ -9,7 +9,12 @@ fn png_and_exr_decode_with_expected_channels() {
     d.ok(&["render", "t.ron", "--format", "png,exr"]);
     assert_eq!(
         d.files("out/t"),
-        ["frame_00000.exr", "frame_00000.png", "mandelreel-job.json"]
+        [
+            ".mandelreel-job.lock",
+            "frame_00000.exr",
+            "frame_00000.png",
+            "mandelreel-job.json"
+        ]
     );
 
     let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();

@@ -127,6 +127,7 @@ fn stale_temporary_and_foreign_files_are_not_taken_for_frames() {
         d.files("out/t"),
         [
             ".frame_00001.png.a1b2c3.partial",
+            ".mandelreel-job.lock",
             "frame_00000.png",
             "frame_00001.png",
             "mandelreel-job.json"
