@@ -255,7 +255,7 @@ pub struct RenderArgs {
 #[derive(Debug, clap::Args)]
 pub struct StatusArgs {
     /// An output folder (uses what it records), or a timeline (with the same
-    /// --out, --size, --format, --frames and --preview as its render).
+    /// --out, --size, --format, --aov, --samples, --frames and --preview as its render).
     pub target: PathBuf,
     #[command(flatten)]
     pub sequence: SequenceArgs,
@@ -364,9 +364,17 @@ pub fn parse_frames(text: &str, count: u32) -> Result<std::ops::Range<u32>> {
         if s.trim().is_empty() {
             Ok(default)
         } else {
-            s.trim()
-                .parse()
-                .map_err(|_| bad(format!("{s:?} is not a frame number")))
+            s.trim().parse().map_err(|_| {
+                let hint = if s.contains('-') && !s.trim().starts_with('-') {
+                    format!(
+                        " (a range is written with two dots: {})",
+                        s.replacen('-', "..", 1)
+                    )
+                } else {
+                    String::new()
+                };
+                bad(format!("{s:?} is not a frame number{hint}"))
+            })
         }
     };
     let range = match text.split_once("..") {
@@ -918,11 +926,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     }
     let total = mine.len();
     let skipped = total - todo.len();
-    let inside: Vec<u32> = todo
-        .iter()
-        .filter(|(_, scenes, _)| scenes[0].fractal.contains(scenes[0].camera.position))
-        .map(|(frame, _, _)| *frame)
-        .collect();
 
     let show_bars = !args.quiet && std::io::stderr().is_terminal();
     let log_lines = !args.quiet && !show_bars;
@@ -954,14 +957,9 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("{line}");
         }
     };
-    if !inside.is_empty() {
-        // Not an error (a fly-through may pass through the surface), but those
-        // frames show only the inside: every ray starts in the set.
-        say(format!(
-            "warning: the camera is inside the fractal in {} frame(s) (first: {}); they render as a flat inside colour",
-            inside.len(),
-            inside[0]
-        ));
+    let frames: Vec<u32> = todo.iter().map(|(frame, _, _)| *frame).collect();
+    for warning in warnings(&plan.timeline, &frames, !plan.preview) {
+        say(format!("warning: {warning}"));
     }
     // Another render on this folder, where neither shares the frames out
     // (--claim, --shard): not an error, since the frames come out the same,
@@ -979,44 +977,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 out_dir.display(),
                 others.join(", ")
             ));
-        }
-    }
-    // Effects that need several samples a pixel, declared with too few:
-    // not an error (a test render may want it), but not what they look like.
-    if !plan.preview {
-        let short = |needs: &dyn Fn(&crate::scene::Scene) -> bool| -> Vec<u32> {
-            let frames = todo.iter().filter(|(_, scenes, _)| needs(&scenes[0]));
-            frames.map(|(frame, _, _)| *frame).collect()
-        };
-        let lens = short(&|s| {
-            s.camera.frame().has_lens() && s.samples_per_pixel < crate::scene::LENS_SAMPLES
-        });
-        let blur = short(&|s| {
-            s.effects.motion_blur.is_some()
-                && s.samples_per_pixel < crate::scene::MOTION_BLUR_SAMPLES
-        });
-        let needs = [
-            (
-                lens,
-                "depth of field",
-                crate::scene::LENS_SAMPLES,
-                "to be smooth",
-            ),
-            (
-                blur,
-                "motion blur",
-                crate::scene::MOTION_BLUR_SAMPLES,
-                "to blur rather than ghost",
-            ),
-        ];
-        for (frames, effect, n, why) in needs {
-            if !frames.is_empty() {
-                say(format!(
-                    "warning: {effect} needs samples_per_pixel of {n} or more {why}; \
-                     frame(s) {} have fewer",
-                    ranges(&frames)
-                ));
-            }
         }
     }
     if !args.quiet && stale > 0 {
@@ -1171,7 +1131,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     if !args.quiet {
         let elapsed = started.elapsed().as_secs_f64();
         eprintln!(
-            "{rendered} frames rendered in {elapsed:.1} s ({:.2} s/frame), {skipped} skipped; frames in {}",
+            "{rendered} frame{} rendered in {elapsed:.1} s ({:.2} s/frame), {skipped} skipped; frames in {}",
+            if rendered == 1 { "" } else { "s" },
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
@@ -1250,6 +1211,78 @@ impl FrameState {
 }
 
 /// `0-3, 7, 9-12` for sorted frame numbers.
+/// What is allowed but likely not what the author meant, in `frames` of
+/// `timeline`: `render` and `info` print these. `samples_matter` is false
+/// for previews, which take one sample whatever the timeline says.
+fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<String> {
+    let mut said = Vec::new();
+    // Keys all on one side of the film: the track never changes a frame.
+    let end = timeline.time_of(timeline.frame_count - 1);
+    for track in timeline.tracks.iter().filter(|t| t.key_times.len() > 1) {
+        let (first, last) = (
+            track.key_times[0],
+            track.key_times[track.key_times.len() - 1],
+        );
+        let side = if first > end {
+            format!("after the last frame (t = {end:.3} s)")
+        } else if last < 0.0 {
+            "before the first frame (t = 0 s)".to_string()
+        } else {
+            continue;
+        };
+        said.push(format!(
+            "every key of track \"{}\" ({first} s .. {last} s) is {side}, so it never changes the film",
+            track.name
+        ));
+    }
+    let scenes: Vec<(u32, crate::scene::Scene)> =
+        frames.iter().map(|&f| (f, timeline.scene_at(f))).collect();
+    let which = |needs: &dyn Fn(&crate::scene::Scene) -> bool| -> Vec<u32> {
+        scenes
+            .iter()
+            .filter(|(_, s)| needs(s))
+            .map(|(f, _)| *f)
+            .collect()
+    };
+    // Not an error (a fly-through may pass through the surface), but those
+    // frames show only the inside: every ray starts in the set.
+    let inside = which(&|s| s.fractal.contains(s.camera.position));
+    if !inside.is_empty() {
+        said.push(format!(
+            "the camera is inside the fractal in {} frame(s) ({}); they render as a flat inside colour",
+            inside.len(),
+            ranges(&inside)
+        ));
+    }
+    // Effects that need several samples a pixel, declared with too few:
+    // not an error (a test render may want it), but not what they look like.
+    if samples_matter {
+        use crate::scene::{LENS_SAMPLES, MOTION_BLUR_SAMPLES};
+        let lens = which(&|s| s.camera.frame().has_lens() && s.samples_per_pixel < LENS_SAMPLES);
+        let blur = which(&|s| {
+            s.effects.motion_blur.is_some() && s.samples_per_pixel < MOTION_BLUR_SAMPLES
+        });
+        let needs = [
+            (lens, "depth of field", LENS_SAMPLES, "to be smooth"),
+            (
+                blur,
+                "motion blur",
+                MOTION_BLUR_SAMPLES,
+                "to blur rather than ghost",
+            ),
+        ];
+        for (short, effect, n, why) in needs {
+            if !short.is_empty() {
+                said.push(format!(
+                    "{effect} needs samples_per_pixel of {n} or more {why}; frame(s) {} have fewer",
+                    ranges(&short)
+                ));
+            }
+        }
+    }
+    said
+}
+
 fn ranges(frames: &[u32]) -> String {
     let mut parts = Vec::new();
     let mut i = 0;
@@ -1635,6 +1668,10 @@ fn info(path: &Path) -> anyhow::Result<()> {
         without.stats.de_evaluations
     );
     out!("output:   out/{}/ by default", t.name);
+    let all: Vec<u32> = (0..t.frame_count).collect();
+    for warning in warnings(&t, &all, true) {
+        out!("warning:  {warning}");
+    }
     Ok(())
 }
 
@@ -1959,6 +1996,11 @@ mod tests {
             .to_string()
             .contains("10 frames"));
         assert!(parse_frames("a..b", 10).is_err());
+        // A dash, as other tools write ranges: the two-dot form is suggested.
+        let e = parse_frames("0-3", 10).unwrap_err().to_string();
+        assert!(e.contains("written with two dots: 0..3"), "{e}");
+        let e = parse_frames("-3", 10).unwrap_err().to_string();
+        assert!(!e.contains("two dots"), "{e}");
     }
 
     #[test]

@@ -62,6 +62,7 @@ impl Default for PathTracing {
 
 /// The light arriving from directions that leave the scene.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Sky {
     /// The background gradient (`look.background_top` / `_bottom`).
     Gradient,

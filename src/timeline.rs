@@ -39,11 +39,60 @@ impl Interpolation {
 }
 
 /// A key's value: a number or a triple such as a position or colour.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum KeyValue {
     Number(Real),
     Triple(Real, Real, Real),
+}
+
+/// A number, or a triple written `(x, y, z)` (or `[x, y, z]`, or inside
+/// `Some(…)` as `julia` is in a scene). Written by hand rather than derived
+/// as an untagged enum, whose one message for every mistake ("did not
+/// match any variant") names neither shape.
+impl<'de> Deserialize<'de> for KeyValue {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Shape;
+        impl<'de> serde::de::Visitor<'de> for Shape {
+            type Value = KeyValue;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or a triple (x, y, z)")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<KeyValue, E> {
+                Ok(KeyValue::Number(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<KeyValue, E> {
+                Ok(KeyValue::Number(v as Real))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<KeyValue, E> {
+                Ok(KeyValue::Number(v as Real))
+            }
+            fn visit_some<D: serde::Deserializer<'de>>(
+                self,
+                d: D,
+            ) -> std::result::Result<KeyValue, D::Error> {
+                d.deserialize_any(Shape)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> std::result::Result<KeyValue, A::Error> {
+                let mut values = Vec::new();
+                while let Some(v) = seq.next_element::<Real>()? {
+                    values.push(v);
+                }
+                match values[..] {
+                    [x, y, z] => Ok(KeyValue::Triple(x, y, z)),
+                    [v] => Ok(KeyValue::Number(v)),
+                    _ => Err(serde::de::Error::custom(format!(
+                        "expected a number or a triple (x, y, z), got {} numbers",
+                        values.len()
+                    ))),
+                }
+            }
+        }
+        d.deserialize_any(Shape)
+    }
 }
 
 impl KeyValue {
@@ -134,6 +183,124 @@ fn fraction_at(text: &str, line: usize, column: usize) -> Option<String> {
     let sign = if digits.ends_with('-') { "-" } else { "" };
     let rest: String = after.chars().take_while(|&c| number(c)).collect();
     Some(format!("{sign}{whole}{rest}"))
+}
+
+/// Where RON's parse error `e` points and what it says, told for a timeline
+/// (`line`, `column`, 1-based): the field a wrong value was given to, a
+/// missing comma at the end of the line that lacks it, trailing text where
+/// it starts, and our own types by what they are rather than their names.
+fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), String) {
+    use ron::error::Error as Ron;
+    let (line, column) = (e.span.start.line, e.span.start.col);
+    let row = |line: usize| text.lines().nth(line.wrapping_sub(1)).unwrap_or("");
+    let before = |line: usize, column: usize| -> String {
+        row(line).chars().take(column.saturating_sub(1)).collect()
+    };
+    // The `name:` (or `"track.name":`) whose value the error is in, on its line.
+    let field = {
+        let head = before(line, column);
+        head.rfind(':').and_then(|colon| {
+            let name = head[..colon].trim_end().trim_end_matches('"');
+            let start = name
+                .rfind(|c: char| !(c.is_alphanumeric() || c == '_' || c == '.'))
+                .map_or(0, |i| i + 1);
+            Some(&name[start..])
+                .filter(|n| !n.is_empty())
+                .map(|n| format!("`{n}`: "))
+        })
+    };
+    let in_field = field.clone().unwrap_or_default();
+    let named = |message: String| {
+        // Our types as a timeline's author knows them.
+        [
+            ("struct `DVec3`", "a triple (x, y, z)"),
+            ("struct `Vec3`", "a triple (x, y, z)"),
+            ("`DVec3`", "a triple (x, y, z)"),
+            ("`Vec3`", "a triple (x, y, z)"),
+            ("struct `TimelineFile`", "the timeline"),
+            ("`TimelineFile`", "the timeline"),
+            ("`TrackSpec`", "a track"),
+            ("`KeySpec`", "a key"),
+        ]
+        .iter()
+        .fold(message, |m, (ours, theirs)| m.replace(ours, theirs))
+    };
+    if let Some(number) = fraction_at(text, line, column) {
+        let whole = number.parse::<Real>().ok().filter(|v| v.fract() == 0.0);
+        let message = match whole {
+            Some(v) if v.abs() < 1e15 => format!(
+                "{in_field}expected a whole number, written without a decimal point: {v}, not {number}"
+            ),
+            _ => format!("{in_field}expected a whole number here, got {number}"),
+        };
+        return ((line, column), message);
+    }
+    match &e.code {
+        // RON stops at the next field; the comma belongs after the value
+        // before it, at the end of the last line with anything on it.
+        Ron::ExpectedComma if before(line, column).trim().is_empty() => {
+            let previous = (1..line).rev().find(|&l| {
+                let code = row(l).split("//").next().unwrap_or("");
+                !code.trim().is_empty()
+            });
+            match previous {
+                Some(l) => {
+                    let code = row(l).split("//").next().unwrap_or("").trim_end();
+                    (
+                        (l, code.chars().count() + 1),
+                        "expected a comma after this value".into(),
+                    )
+                }
+                None => ((line, column), "expected a comma".into()),
+            }
+        }
+        // RON points at the end of the timeline; show where the extra text starts.
+        Ron::TrailingCharacters => {
+            let mut at = (line, column);
+            for (l, text_row) in text.lines().enumerate().skip(line - 1) {
+                let skip = if l + 1 == line { column - 1 } else { 0 };
+                let rest: String = text_row.chars().skip(skip).collect();
+                let code = rest.split("//").next().unwrap_or("");
+                if let Some(offset) = code.find(|c: char| !c.is_whitespace()) {
+                    at = (l + 1, skip + code[..offset].chars().count() + 1);
+                    break;
+                }
+            }
+            (
+                at,
+                "text after the timeline's closing `)`: a timeline is one `( … )`".into(),
+            )
+        }
+        Ron::IntegerOutOfBounds => {
+            let head = before(line, column + 1);
+            let most = if in_field == "`seed`: " {
+                u64::MAX.to_string()
+            } else {
+                u32::MAX.to_string()
+            };
+            let message = if head
+                .trim_end_matches(|c: char| c.is_ascii_digit())
+                .ends_with('-')
+            {
+                format!("{in_field}must be 0 or more: counts, sizes and seeds are never negative")
+            } else {
+                format!("{in_field}too large: at most {most}")
+            };
+            ((line, column), message)
+        }
+        Ron::SuggestRawIdentifier(found) => (
+            (line, column),
+            format!("expected a field name here (`name: value`), got `{found}`"),
+        ),
+        Ron::ExpectedFloat
+        | Ron::ExpectedInteger
+        | Ron::ExpectedBoolean
+        | Ron::ExpectedString
+        | Ron::InvalidValueForType { .. } => {
+            ((line, column), named(format!("{in_field}{}", e.code)))
+        }
+        code => ((line, column), named(code.to_string())),
+    }
 }
 
 /// A value as messages show it: numbers as written at ordinary
@@ -454,14 +621,14 @@ impl Timeline {
     pub fn parse(text: &str, path: &Path) -> Result<Timeline> {
         let options = ron::Options::default()
             .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-        let mut file: TimelineFile = options.from_str(text).map_err(|e| Error::Syntax {
-            file: path.to_path_buf(),
-            line: e.span.start.line,
-            column: e.span.start.col,
-            message: match fraction_at(text, e.span.start.line, e.span.start.col) {
-                Some(number) => format!("expected a whole number here, got {number}"),
-                None => e.code.to_string(),
-            },
+        let mut file: TimelineFile = options.from_str(text).map_err(|e| {
+            let ((line, column), message) = syntax_message(text, &e);
+            Error::Syntax {
+                file: path.to_path_buf(),
+                line,
+                column,
+                message,
+            }
         })?;
         let invalid = |line: Option<usize>, field: String, message: String| Error::Invalid {
             file: path.to_path_buf(),
@@ -736,17 +903,35 @@ impl Timeline {
                         || (t.name == ZOOM_TRACK && field.starts_with("camera"))
                 };
                 let in_group = |t: &&Track| t.name.split('.').next() == Some(group);
-                let mut animated: Vec<String> = timeline
-                    .tracks
-                    .iter()
-                    .filter(setting)
-                    .map(|t| format!("\"{}\"", t.name))
-                    .collect();
-                if animated.is_empty() {
-                    animated = (timeline.tracks.iter().filter(in_group))
-                        .map(|t| format!("\"{}\"", t.name))
-                        .collect();
+                let mut culprits: Vec<&Track> = timeline.tracks.iter().filter(setting).collect();
+                if culprits.is_empty() {
+                    culprits = timeline.tracks.iter().filter(in_group).collect();
                 }
+                // A key that is itself out of range: point at it, not at
+                // the first frame its curve crosses the limit.
+                let bad_key = culprits.iter().find_map(|track| {
+                    track.key_times.iter().enumerate().find_map(|(k, &time)| {
+                        let checked = timeline.scene_built(time, true);
+                        match checked.and_then(|scene| validate_scene(&scene)) {
+                            Err((f, message)) if f == field => Some((track, k, message)),
+                            _ => None,
+                        }
+                    })
+                });
+                if let Some((track, k, message)) = bad_key {
+                    let quoted = format!("\"{}\"", track.name);
+                    return Err(invalid(
+                        nth_line_after(text, &quoted, "time", k).or(line_of(text, &quoted, 0)),
+                        format!("tracks[{quoted}].keys[{k}].value"),
+                        if track.name == field {
+                            message
+                        } else {
+                            format!("makes scene.{field} invalid: {message}")
+                        },
+                    ));
+                }
+                let animated: Vec<String> =
+                    culprits.iter().map(|t| format!("\"{}\"", t.name)).collect();
                 return Err(invalid(
                     animated.first().and_then(|n| line_of(text, n, 0)),
                     format!("frame {frame} (t = {time:.4} s): scene.{field}"),
@@ -1160,7 +1345,19 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                     )
                 },
             )?,
-            crate::shade::Sky::Gradient | crate::shade::Sky::Environment { .. } => {}
+            crate::shade::Sky::Environment {
+                rotation_degrees, ..
+            } => check(
+                rotation_degrees.is_finite(),
+                "effects.path_tracing.sky",
+                || {
+                    format!(
+                        "Environment rotation_degrees must be finite, got {}",
+                        rotation_degrees.shown()
+                    )
+                },
+            )?,
+            crate::shade::Sky::Gradient => {}
         }
     }
     if let Some(m) = &e.motion_blur {
@@ -1319,14 +1516,96 @@ mod tests {
 
     #[test]
     fn syntax_error_names_line_and_column() {
-        let e = error_of("(\n  fps: 24,\n  frames: 3\n  size: (8, 6),\n)");
-        assert!(e.starts_with("test.ron:4:"), "{e}");
+        let e = error_of("(\n  fps: 24,\n  frames: 3,\n  size: (8; 6),\n)");
+        assert!(e.starts_with("test.ron:4:11:"), "{e}");
+    }
+
+    #[test]
+    fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
+        // A missing comma: at the end of the line that lacks it, not at the next field.
+        let e = error_of("(\n  fps: 24,\n  frames: 3 // three\n\n  size: (8, 6),\n)");
+        assert_eq!(e, "test.ron:3:12: expected a comma after this value");
+        // Text after the timeline: where it starts.
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6))\n// done\n  (fps: 12)");
+        assert!(
+            e.starts_with("test.ron:3:3: text after the timeline"),
+            "{e}"
+        );
+        // A whole number written with a point, a negative and a huge count: the field named.
+        let e = error_of("(fps: 24, frames: 3.0, size: (8, 6))");
+        assert!(
+            e.ends_with(
+                "`frames`: expected a whole number, written without a decimal point: 3, not 3.0"
+            ),
+            "{e}"
+        );
+        let e = error_of("(fps: 24, frames: 3, size: (8, -6))");
+        assert!(e.contains("`size`: must be 0 or more"), "{e}");
+        let e = error_of("(fps: 24, frames: 99999999999, size: (8, 6))");
+        assert!(
+            e.ends_with("`frames`: too large: at most 4294967295"),
+            "{e}"
+        );
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: \"8\")))");
+        assert!(e.contains("`power`: Expected float"), "{e}");
+        // Keys written as tuples, and our own type names.
+        let e = error_of(&with_track("\"fractal.power\": (keys: [(0, 8)])"));
+        assert!(
+            e.contains("expected a field name here (`name: value`), got `0`"),
+            "{e}"
+        );
+        let e = error_of(&with_track(
+            "\"fractal.power\": (keys: [(tme: 0, value: 8)])",
+        ));
+        assert!(e.contains("in a key,"), "{e}");
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (camera: (up: [0, 1, 0])))");
+        assert!(
+            e.contains("a triple (x, y, z)") && !e.contains("DVec3"),
+            "{e}"
+        );
+        assert!(error_of("").contains("for the timeline"));
+    }
+
+    #[test]
+    fn a_key_of_the_wrong_shape_says_what_shapes_there_are() {
+        for (value, says) in [
+            (
+                "(0.5, 0.5)",
+                "expected a number or a triple (x, y, z), got 2 numbers",
+            ),
+            (
+                "(1, 2, 3, 4)",
+                "expected a number or a triple (x, y, z), got 4 numbers",
+            ),
+            (
+                "\"8\"",
+                "Expected a number or a triple (x, y, z) but found the string \"8\"",
+            ),
+        ] {
+            let e = error_of(&with_track(&format!(
+                "\"fractal.julia\": (keys: [(time: 0, value: {value})])"
+            )));
+            assert!(e.contains(says), "{value}: {e}");
+        }
+        // A julia constant as a scene writes it, and a list, are triples too.
+        for value in ["Some((0.1, 0.2, 0.3))", "[0.1, 0.2, 0.3]"] {
+            let t = parse(&with_track(&format!(
+                "\"fractal.julia\": (keys: [(time: 0, value: {value})])"
+            )))
+            .unwrap();
+            assert_eq!(t.scene_at(0).fractal.julia, Some(DVec3::new(0.1, 0.2, 0.3)));
+        }
     }
 
     #[test]
     fn unknown_field_is_rejected_with_its_name() {
         let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (camra: ()))");
         assert!(e.contains("camra") && e.starts_with("test.ron:1:"), "{e}");
+        // Inside an enum's variant too.
+        let e = error_of(
+            "(fps: 24, frames: 3, size: (8, 6), scene: (effects: (path_tracing: (sky: Preetham(turbidty: 3)))))",
+        );
+        assert!(e.contains("turbidty"), "{e}");
     }
 
     #[test]
@@ -1426,7 +1705,7 @@ mod tests {
             "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: -3)])",
         ));
         assert!(
-            e.contains("frame") && e.contains("camera.fov_degrees"),
+            e.contains("tracks[\"camera.fov_degrees\"].keys[1].value: must be between 0 and 179"),
             "{e}"
         );
     }
@@ -1457,6 +1736,16 @@ mod tests {
             "\"camera.distance\": (keys: [(time: 0, value: 0)])",
         ));
         assert!(e.contains("positive"), "{e}");
+    }
+
+    #[test]
+    fn a_key_out_of_range_is_named_on_its_own_line() {
+        // Reached only by interpolation at frame 21; the key itself is the mistake.
+        let text = "(fps: 24, frames: 24, size: (8, 6), tracks: {\n  \"fractal.power\": (interpolation: Linear, keys: [\n    (time: 0, value: 8),\n    (time: 0.5, value: 4),\n    (time: 1, value: 90),\n  ]),\n})";
+        assert_eq!(
+            error_of(text),
+            "test.ron:5: tracks[\"fractal.power\"].keys[2].value: must be between 1 and 64, got 90"
+        );
     }
 
     #[test]
@@ -1594,21 +1883,18 @@ mod tests {
 
     #[test]
     fn a_camera_track_onto_the_target_is_refused_at_its_line() {
-        // The position track sets the camera onto the target at frame 0:
+        // The position track's first key puts the camera onto the target:
         // alone, the scene's own check catches it; with a zoom track, which
         // would otherwise pick a direction of its own, the zoom's does. Both
-        // name the frame, the track and its line.
+        // name the key and its line.
         let position = "\"camera.position\": (keys: [(time: 0, value: (0, 0, 0)), (time: 1, value: (0, 0, 2))])";
         let zoom = "\"camera.distance\": (keys: [(time: 0, value: 3), (time: 1, value: 2)])";
         for tracks in [position.to_string(), format!("\n{zoom},\n{position}")] {
             let text = with_track(&tracks).replace("size: (8, 6),", "size: (8, 6),\n");
             let line = line_of(&text, "\"camera.position\"", 0).unwrap();
             let e = parse(&text).unwrap_err().to_string();
-            assert!(e.starts_with(&format!("test.ron:{line}: frame 0 ")), "{e}");
-            assert!(
-                e.contains("coincide") && e.contains("\"camera.position\""),
-                "{e}"
-            );
+            let key = format!("test.ron:{line}: tracks[\"camera.position\"].keys[0].value: ");
+            assert!(e.starts_with(&key) && e.contains("coincide"), "{e}");
         }
         // A light's error inside a list is found at the list's line.
         let text = "(fps: 10, frames: 2, size: (8, 6),\n scene: (look: (\n extra_lights: [(direction: (1, 1, 1), colour: (1, 1, 1), intensity: -1)])))";
@@ -1625,7 +1911,10 @@ mod tests {
         let e = parse("(fps: 10, frames: 2,\n size: (320.5, 180))")
             .unwrap_err()
             .to_string();
-        assert_eq!(e, "test.ron:2:12: expected a whole number here, got 320.5");
+        assert_eq!(
+            e,
+            "test.ron:2:12: `size`: expected a whole number here, got 320.5"
+        );
         let e = parse("(fps: 10, frames: 2.5, size: (8, 6))")
             .unwrap_err()
             .to_string();

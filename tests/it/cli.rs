@@ -411,6 +411,13 @@ fn effects_declared_with_too_few_samples_render_with_a_warning() {
         err.contains("motion blur needs samples_per_pixel of 8"),
         "{err}"
     );
+    // info says the same, before anything is rendered.
+    let info = stdout(&d.ok(&["info", "few.ron"]));
+    assert!(
+        info.contains("warning:  depth of field needs samples_per_pixel of 4")
+            && info.contains("warning:  motion blur needs samples_per_pixel of 8"),
+        "{info}"
+    );
     d.write("some.ron", &scene(4));
     let err = stderr(&d.ok(&["render", "some.ron", "--size", "16x9"]));
     assert!(!err.contains("depth of field needs"), "{err}");
@@ -420,4 +427,46 @@ fn effects_declared_with_too_few_samples_render_with_a_warning() {
     assert!(!err.contains("warning"), "{err}");
     let err = stderr(&d.ok(&["render", "few.ron", "--preview"]));
     assert!(!err.contains("warning"), "{err}");
+}
+
+#[test]
+fn a_track_whose_keys_all_lie_outside_the_film_is_warned_of() {
+    let d = Dir::new();
+    let timeline = |keys: &str| {
+        format!("(fps: 24, frames: 3, size: (16, 9), tracks: {{ \"fractal.power\": (keys: [{keys}]) }})")
+    };
+    // Three frames at 24 fps end at 1/12 s.
+    d.write(
+        "late.ron",
+        &timeline("(time: 5, value: 4), (time: 10, value: 8)"),
+    );
+    let late = "every key of track \"fractal.power\" (5 s .. 10 s) is after the last frame (t = 0.083 s), so it never changes the film";
+    assert!(stdout(&d.ok(&["info", "late.ron"])).contains(late));
+    says(&d.ok(&["render", "late.ron"]), late);
+    d.write(
+        "early.ron",
+        &timeline("(time: -2, value: 4), (time: -1, value: 8)"),
+    );
+    let early = "(-2 s .. -1 s) is before the first frame (t = 0 s)";
+    assert!(stdout(&d.ok(&["info", "early.ron"])).contains(early));
+    // Keys on both sides of the film animate it: nothing to say.
+    d.write(
+        "across.ron",
+        &timeline("(time: -1, value: 4), (time: 1, value: 8)"),
+    );
+    assert!(!stdout(&d.ok(&["info", "across.ron"])).contains("warning"));
+    assert!(!stderr(&d.ok(&["render", "across.ron"])).contains("warning"));
+}
+
+#[test]
+fn the_readmes_reference_timeline_is_valid_and_draws_no_warning() {
+    let readme = include_str!("../../README.md");
+    let section = &readme[readme.find("## Timeline format").unwrap()..];
+    let start = section.find("```ron\n").unwrap() + "```ron\n".len();
+    let block = &section[start..start + section[start..].find("```").unwrap()];
+    let d = Dir::new();
+    d.write("reference.ron", block);
+    let info = stdout(&d.ok(&["info", "reference.ron"]));
+    assert!(info.contains("frames:   120 at 24 fps"), "{info}");
+    assert!(!info.contains("warning"), "{info}");
 }

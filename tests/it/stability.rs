@@ -179,4 +179,15 @@ fn environment_map_lights_a_path_traced_frame_deterministically() {
     assert_eq!(out.status.code(), Some(3));
     says(&out, "nope.exr");
     assert!(!d.path().join("never").exists());
+    // A misspelt field of the map and a NaN turn are errors too, not ignored.
+    for (bad, named) in [
+        ("rotation_degrees: 30", "rotaton_degrees: 30"),
+        ("rotation_degrees: 30", "rotation_degrees: NaN"),
+    ] {
+        d.write("bad.ron", &text.replace(bad, named));
+        let out = d.run(&["render", "bad.ron", "--out", "never"]);
+        assert_eq!(out.status.code(), Some(3), "{named}");
+        says(&out, named.split(':').next().unwrap());
+        assert!(!d.path().join("never").exists());
+    }
 }

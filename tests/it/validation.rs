@@ -28,7 +28,8 @@ fn syntax_error_points_at_line_and_column() {
         "(\n  fps: 24,\n  frames: 3\n  size: (8, 6),\n)",
         &[],
         3,
-        &["bad.ron:4:"],
+        // At the end of the line that lacks the comma.
+        &["bad.ron:3:12: expected a comma after this value"],
     );
 }
 
@@ -103,7 +104,11 @@ fn values_that_would_draw_a_surface_where_there_is_none_are_refused() {
         &tiny_timeline(2, 6.0).replace("    },\n)", track),
         &[],
         3,
-        &["bad.ron", "frame 1", "fractal.julia"],
+        &[
+            "bad.ron:",
+            "tracks[\"fractal.julia\"].keys[1].value",
+            "1e15",
+        ],
     );
     let big = "fractal: (iterations: 8), quality: (bounding_radius: 1e100))";
     rejected(
@@ -326,7 +331,8 @@ fn motion_blur_instants_between_frames_are_checked_too() {
 fn a_blurred_frames_own_instant_is_checked_too() {
     // Frame 1's own instant dips below bailout 1 while every instant its open
     // shutter samples (1.025 s to 1.175 s) is past the dip: previews, `info`
-    // and `pick` show that instant, so it is rejected as well.
+    // and `pick` show that instant, so it is rejected as well, and the key
+    // that sets it is named.
     let timeline = "(
     fps: 1,
     frames: 3,
@@ -336,5 +342,6 @@ fn a_blurred_frames_own_instant_is_checked_too() {
         \"fractal.bailout\": (interpolation: Linear, keys: [(time: 0, value: 4), (time: 1, value: 0.9), (time: 1.01, value: 4)]),
     },
 )";
-    rejected(timeline, &[], 3, &["frame 1 (t = 1", "fractal.bailout"]);
+    let key = "bad.ron:7: tracks[\"fractal.bailout\"].keys[1].value: must be a finite number above 1, got 0.9";
+    rejected(timeline, &[], 3, &[key]);
 }
