@@ -21,4 +21,4 @@ pub mod shade;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.
-pub const RENDERER_REVISION: u32 = 12;
+pub const RENDERER_REVISION: u32 = 13;

@@ -1022,6 +1022,14 @@ impl Timeline {
 }
 
 /// Checks one frame's scene; on failure returns the field path and the problem.
+/// The narrowest field of view. A ray's points are its origin plus a
+/// distance along it, so they are placed no finer than 2⁻⁵² of the camera's
+/// distance, while a pixel is as wide as its angle times that distance: a
+/// pixel's angle must stay well above 2⁻⁵² (64 times, 1.4e-14 radians) for
+/// marching to resolve it. 1e-7° over 32 768 rows is 5.3e-14 radians a
+/// pixel. (A camera a billion units away frames the bulb at 1.03e-7°.)
+pub const MIN_FOV_DEGREES: Real = 1e-7;
+
 pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     // The message is built only when the check fails: every rendered
     // scene is checked, thousands per frame under motion blur.
@@ -1080,12 +1088,18 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         format!("must be finite, got {}", c.roll_degrees.shown())
     })?;
     check(
-        c.fov_degrees.is_finite() && c.fov_degrees > 0.0 && c.fov_degrees < 179.0,
+        c.fov_degrees.is_finite() && c.fov_degrees >= MIN_FOV_DEGREES && c.fov_degrees < 179.0,
         "camera.fov_degrees",
         || {
             format!(
-                "must be between 0 and 179 degrees, got {}",
-                c.fov_degrees.shown()
+                "must be from {MIN_FOV_DEGREES:e} to below 179 degrees, got {}{}",
+                c.fov_degrees.shown(),
+                if c.fov_degrees > 0.0 && c.fov_degrees < MIN_FOV_DEGREES {
+                    " (narrower, a pixel would span less than f64 can tell apart along a \
+                     ray; move the camera closer instead)"
+                } else {
+                    ""
+                }
             )
         },
     )?;
@@ -1705,7 +1719,9 @@ mod tests {
             "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: -3)])",
         ));
         assert!(
-            e.contains("tracks[\"camera.fov_degrees\"].keys[1].value: must be between 0 and 179"),
+            e.contains(
+                "tracks[\"camera.fov_degrees\"].keys[1].value: must be from 1e-7 to below 179"
+            ),
             "{e}"
         );
     }
