@@ -501,12 +501,10 @@ pub fn sample_1d(seed: u64, frame: u32, pixel: u64, sample: u32, dim: u32) -> Re
 }
 
 /// Converts a linear-light value to the sRGB transfer curve (IEC 61966-2-1).
+/// NaN shows as 0 and +infinity as 1: light too bright for f32 (a huge
+/// exposure times a bright light) is white, not black.
 pub fn linear_to_srgb(x: f32) -> f32 {
-    let x = if x.is_finite() {
-        x.clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
+    let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
     if x <= 0.003_130_8 {
         12.92 * x
     } else {
@@ -579,15 +577,15 @@ impl SrgbBytes {
         table
     }
 
-    /// The 8-bit sRGB code of linear `x`: 0 for NaN, infinities and
-    /// anything at or below 0, 255 from 1 up.
+    /// The 8-bit sRGB code of linear `x`: 0 for NaN and anything at or
+    /// below 0, 255 from 1 up, +infinity included.
     #[inline]
     pub fn byte(&self, x: f32) -> u8 {
         // Without branches (a frame's values come in no order a predictor
-        // could follow): NaN and infinities become 0; the clamp takes all
-        // below the lowest value to it, whose code is 0 too, and 1 and up to
-        // the float just below 1, whose code is 255.
-        let x = if x.is_finite() { x } else { 0.0 };
+        // could follow): NaN becomes 0; the clamp takes all below the lowest
+        // value to it, whose code is 0 too, and 1 and up to the float just
+        // below 1, whose code is 255.
+        let x = if x.is_nan() { 0.0 } else { x };
         let x = x.clamp(SRGB_LOWEST, SRGB_BELOW_ONE);
         let i = ((x.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
         self.base[i] + (x >= self.next[i]) as u8
@@ -811,6 +809,9 @@ mod tests {
         }
         // The curve's own ends and mid-grey, stated independently.
         assert_eq!(table.byte(1.0), 255);
+        assert_eq!(table.byte(f32::INFINITY), 255); // too bright for f32: white
+        assert_eq!(table.byte(f32::NAN), 0);
+        assert_eq!(table.byte(f32::NEG_INFINITY), 0);
         assert_eq!(table.byte(0.18), 118); // 0.4613 · 255 + 0.5
         assert_eq!(table.byte(0.0031308), 10); // 0.04045 · 255 + 0.5
     }

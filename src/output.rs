@@ -634,6 +634,13 @@ fn write_exr_blocks(
     })
 }
 
+/// `v` as a half float, light past the largest half (65504) held at it:
+/// rounded as it comes, it would be infinite in the file.
+fn half_float(v: f32) -> exr::prelude::f16 {
+    let largest = exr::prelude::f16::MAX.to_f32();
+    exr::prelude::f16::from_f32(v.clamp(-largest, largest))
+}
+
 /// One line of a channel's samples into `line`, as `sample`s, native-endian.
 fn put_line(
     line: &mut [u8],
@@ -642,9 +649,10 @@ fn put_line(
 ) {
     use exr::meta::attribute::SampleType;
     match sample {
-        SampleType::F16 => line.chunks_exact_mut(2).zip(values).for_each(|(out, v)| {
-            out.copy_from_slice(&exr::prelude::f16::from_f32(v).to_ne_bytes())
-        }),
+        SampleType::F16 => line
+            .chunks_exact_mut(2)
+            .zip(values)
+            .for_each(|(out, v)| out.copy_from_slice(&half_float(v).to_ne_bytes())),
         SampleType::F32 => line
             .chunks_exact_mut(4)
             .zip(values)
@@ -1298,9 +1306,17 @@ mod tests {
     }
 
     /// What the EXR of `film` should hold at pixel `i` in each channel it
-    /// has, as read back (f16 channels rounded to f16).
+    /// has, as read back (f16 channels rounded to f16, beyond its range held
+    /// at its largest).
     fn expected_samples(film: &Film, steps: bool, i: usize) -> Vec<(&'static str, f32)> {
-        let half = |x: f32| exr::prelude::f16::from_f32(x).to_f32();
+        let half = |x: f32| {
+            let rounded = exr::prelude::f16::from_f32(x).to_f32();
+            if rounded.is_infinite() {
+                65504.0f32.copysign(x)
+            } else {
+                rounded
+            }
+        };
         let mut expected = vec![
             ("R", half(film.colour[i].x)),
             ("G", half(film.colour[i].y)),

@@ -230,3 +230,23 @@ fn environment_map_lights_a_path_traced_frame_deterministically() {
         assert!(!d.path().join("never").exists());
     }
 }
+
+#[test]
+fn light_too_bright_for_the_file_is_white_and_finite() {
+    // Light of 1e30 exposed by 1e30 is past f32: every pixel shows white (the
+    // lit surface showed black, its infinite value taken for a bad one), and
+    // the EXR's half floats hold 65504 rather than infinity.
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        &scene("look: (light_colour: (1e30, 1e30, 1e30), exposure: 1e30)"),
+    );
+    d.ok(&["render", "t.ron", "--format", "png,exr"]);
+    let (alpha, _) = finite_channels(&d, "out/t/frame_00000.exr");
+    assert!(alpha.contains(&1.0), "the bulb is in view");
+    let exr = d.exr("out/t/frame_00000.exr");
+    assert!(exr.channel("R").contains(&65504.0));
+    let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();
+    let black = png.to_rgb8().pixels().filter(|p| p.0 != [255; 3]).count();
+    assert_eq!(black, 0, "pixels not white");
+}
