@@ -367,7 +367,10 @@ impl Walk for ConeWalk {
         // keeps within the plain step the estimate allows.
         let reach = self.spread.0 + self.t * self.spread.1;
         let step = (CONE_TRUST * settings.step(estimate.distance) - reach) / (1.0 + self.spread.1);
-        if step < footprint || self.steps >= settings.max_steps {
+        // A ray alone hits within hit_threshold footprints of the surface:
+        // past a threshold of 1, the rays go on alone that much sooner.
+        let alone = footprint * settings.hit_threshold.max(1.0);
+        if step < alone || self.steps >= settings.max_steps {
             return Some((self.t, self.evaluations));
         }
         self.previous = self.t;
