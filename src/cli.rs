@@ -994,6 +994,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
 
     let started = Instant::now();
     let mut totals = FrameStats::default();
+    // Frames where many camera rays ran out of steps (said once, at the end).
+    let mut short_of_steps = Vec::new();
     let mut rendered = 0usize;
     let mut film = crate::render::Film::default();
     let mut render_one = |frame: u32,
@@ -1025,13 +1027,16 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             },
         )?;
         totals = totals + stats;
+        if out_of_steps_matters(&stats) {
+            short_of_steps.push(frame);
+        }
         rendered += 1;
         overall.inc(1);
         let seconds = t0.elapsed().as_secs_f64();
         // Asked for, so printed even with --quiet.
         if args.stats {
             say(format!(
-                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit, {} repaired",
+                "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit ({} out of steps), {} repaired",
                 stats.de_evaluations,
                 stats.de_evaluations as f64 / stats.samples.max(1) as f64,
                 stats.max_pixel_evaluations,
@@ -1043,6 +1048,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 stats.sun_evaluations,
                 stats.hits,
                 stats.samples,
+                stats.out_of_steps,
                 stats.repaired_samples
             ));
         } else if log_lines {
@@ -1127,6 +1133,12 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     }
     current.finish_and_clear();
     overall.finish_and_clear();
+    if !args.quiet && !short_of_steps.is_empty() {
+        eprintln!(
+            "warning: {}",
+            out_of_steps_warning(&short_of_steps, &plan.timeline)
+        );
+    }
 
     if !args.quiet {
         let elapsed = started.elapsed().as_secs_f64();
@@ -1281,6 +1293,28 @@ fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<St
         }
     }
     said
+}
+
+/// Whether enough of a frame's camera rays ran out of steps to say so: 1%.
+fn out_of_steps_matters(stats: &FrameStats) -> bool {
+    stats.out_of_steps * 100 >= stats.samples.max(1)
+}
+
+/// What to say of `frames`, in each of which 1% or more of the camera rays
+/// ran out of `quality.max_steps`.
+fn out_of_steps_warning(frames: &[u32], timeline: &Timeline) -> String {
+    let quality = &timeline.scene_at(frames[0]).quality;
+    format!(
+        "in frame(s) {}, 1% or more of the camera rays ran out of quality.max_steps ({}) and \
+         count as hits where they stopped (a false surface in the background): raise max_steps{}",
+        ranges(frames),
+        quality.max_steps,
+        if quality.fudge < 0.5 {
+            format!(", or quality.fudge ({}): a step of a fudge of the estimate needs about 1/fudge times the steps", quality.fudge)
+        } else {
+            String::new()
+        }
+    )
 }
 
 fn ranges(frames: &[u32]) -> String {
@@ -1661,6 +1695,7 @@ fn info(path: &Path) -> anyhow::Result<()> {
         film
     };
     let (with, without) = (probe(&scenes), probe(&plain));
+    let probe_short = out_of_steps_matters(&with.stats);
     out!(
         "cost:     frame 0 at {probe_w}x{probe_h}: {} estimates, {:.2}x the same frame without effects ({})",
         with.stats.de_evaluations,
@@ -1671,6 +1706,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
     let all: Vec<u32> = (0..t.frame_count).collect();
     for warning in warnings(&t, &all, true) {
         out!("warning:  {warning}");
+    }
+    if probe_short {
+        out!(
+            "warning:  {} (of the thumbnail)",
+            out_of_steps_warning(&[0], &t)
+        );
     }
     Ok(())
 }

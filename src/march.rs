@@ -166,6 +166,8 @@ pub struct MarchResult {
     /// Smallest estimate along the ray, in pixel footprints (∞ when nothing
     /// was estimated): how near a miss came, for glow.
     pub closest: Real,
+    /// The march ran out of `max_steps` and its hit is where it stopped.
+    pub out_of_steps: bool,
 }
 
 impl Default for MarchResult {
@@ -175,6 +177,7 @@ impl Default for MarchResult {
             hit: None,
             evaluations: 0,
             closest: Real::INFINITY,
+            out_of_steps: false,
         }
     }
 }
@@ -544,6 +547,7 @@ impl Marcher {
             }),
             evaluations: self.evaluations,
             closest: self.closest,
+            out_of_steps: false,
         }
     }
 }
@@ -568,8 +572,11 @@ impl Walk for Marcher {
             // Out of steps inside the bounding sphere: the ray is creeping
             // along a surface it keeps almost touching (a grazing ray).
             // Calling that a miss punches background-coloured speckles into
-            // the surface; call it a hit.
-            return Some(self.hit(t, *estimate));
+            // the surface; call it a hit, and count it.
+            return Some(MarchResult {
+                out_of_steps: true,
+                ..self.hit(t, *estimate)
+            });
         }
         self.steps += 1;
         self.closest = self.closest.min(estimate.distance / footprint);
@@ -615,6 +622,7 @@ impl Walk for Marcher {
                 hit: None,
                 evaluations: self.evaluations,
                 closest: self.closest,
+                out_of_steps: false,
             });
         }
         None
@@ -1384,9 +1392,11 @@ mod tests {
         };
         let f = Fractal::default();
         let r = ray(DVec3::new(0.2, 0.3, 3.0), -DVec3::Z);
-        let first = march(&r, &f, &settings)
-            .hit
-            .expect("out of steps counts as a hit");
+        let result = march(&r, &f, &settings);
+        assert!(result.out_of_steps, "and is counted as out of steps");
+        let first = result.hit.expect("out of steps counts as a hit");
+        // With steps enough, the same ray's hit is a true one.
+        assert!(!march(&r, &f, &MarchSettings::default()).out_of_steps);
         for _ in 0..5 {
             assert_eq!(march(&r, &f, &settings).hit.unwrap().t, first.t);
         }

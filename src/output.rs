@@ -412,7 +412,7 @@ pub fn write_atomic(
 
 fn stats_text(film: &Film) -> String {
     format!(
-        "de_evaluations={} primary={} normals={} shadows={} occlusion={} bounces={} sun={} samples={} hits={} max_pixel_evaluations={} repaired_samples={}",
+        "de_evaluations={} primary={} normals={} shadows={} occlusion={} bounces={} sun={} samples={} hits={} max_pixel_evaluations={} repaired_samples={} out_of_steps={}",
         film.stats.de_evaluations,
         film.stats.primary_evaluations,
         film.stats.normal_evaluations,
@@ -423,7 +423,8 @@ fn stats_text(film: &Film) -> String {
         film.stats.samples,
         film.stats.hits,
         film.stats.max_pixel_evaluations,
-        film.stats.repaired_samples
+        film.stats.repaired_samples,
+        film.stats.out_of_steps
     )
 }
 

@@ -147,6 +147,11 @@ pub struct FrameStats {
     /// black. Every known cause is guarded upstream, so this should stay 0;
     /// debug builds stop at the first one instead.
     pub repaired_samples: u64,
+    /// Camera rays that ran out of `quality.max_steps` (counted as hits,
+    /// where they stopped): many mean too few steps for the scene, or a
+    /// small fudge.
+    #[serde(default)]
+    pub out_of_steps: u64,
 }
 
 impl FrameStats {
@@ -187,6 +192,7 @@ impl std::ops::Add for FrameStats {
             max_pixel_evaluations: self.max_pixel_evaluations.max(o.max_pixel_evaluations),
             de_iterations: self.de_iterations + o.de_iterations,
             repaired_samples: self.repaired_samples + o.repaired_samples,
+            out_of_steps: self.out_of_steps + o.out_of_steps,
         }
     }
 }
@@ -742,6 +748,7 @@ fn render_band(frame: &FrameSetup, y0: usize, sums: RowSums) -> FrameStats {
             // The pixel's offset in the band; its camera ray's cost first.
             let p = order[i];
             stats.primary_evaluations += result.evaluations as u64;
+            stats.out_of_steps += result.out_of_steps as u64;
             spent_row[p] += result.evaluations as u64;
             let before = stats.stage_total();
             let c = trace(

@@ -1,7 +1,7 @@
 //! Hard cases through the binary: whole frames that must come out finite,
 //! quickly, and with a clear message where the scene is odd.
 
-use crate::util::{says, stderr, Dir};
+use crate::util::{says, stderr, stdout, Dir};
 
 /// Every channel of an EXR frame, checked finite; returns (alpha, depth).
 fn finite_channels(d: &Dir, rel: &str) -> (Vec<f32>, Vec<f32>) {
@@ -249,4 +249,33 @@ fn light_too_bright_for_the_file_is_white_and_finite() {
     let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();
     let black = png.to_rgb8().pixels().filter(|p| p.0 != [255; 3]).count();
     assert_eq!(black, 0, "pixels not white");
+}
+
+#[test]
+fn rays_running_out_of_steps_are_counted_and_warned_of() {
+    // A fudge of 0.01 takes a hundredth of each estimate: 300 steps cannot
+    // cross the bounding sphere, so rays stop as hits in the background.
+    // Counted per frame and said once, with the fix; at the default fudge
+    // no ray runs out and nothing is said.
+    let d = Dir::new();
+    d.write("small.ron", &scene("quality: (fudge: 0.01)"));
+    let out = d.ok(&["render", "small.ron", "--stats"]);
+    says(
+        &out,
+        "in frame(s) 0, 1% or more of the camera rays ran out of quality.max_steps (300)",
+    );
+    says(&out, "or quality.fudge (0.01)");
+    let err = stderr(&out);
+    let counted = err
+        .split(" out of steps)")
+        .next()
+        .and_then(|s| s.rsplit('(').next())
+        .and_then(|n| n.parse::<u32>().ok())
+        .unwrap();
+    assert!(counted > 32 * 18 / 10, "{err}");
+    assert!(stdout(&d.ok(&["info", "small.ron"])).contains("ran out of quality.max_steps"));
+    d.write("plain.ron", &scene("quality: (fudge: 1)"));
+    let out = d.ok(&["render", "plain.ron", "--stats"]);
+    says(&out, "(0 out of steps)");
+    assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
 }
