@@ -1638,6 +1638,46 @@ mod tests {
     }
 
     #[test]
+    fn a_scan_line_exr_is_checked_to_its_end_too() {
+        // Our writer makes tiled files; another tool re-saving one keeps
+        // the hash in scan-line blocks, whose chunks start with a y (4
+        // bytes) rather than a tile's four numbers (16).
+        use exr::prelude::*;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("frame_00000.exr");
+        let mut attributes = LayerAttributes::named("");
+        attributes.other.insert(
+            Text::from(HASH_KEY),
+            exr::meta::attribute::AttributeValue::Text(Text::from("abc")),
+        );
+        let encoding = Encoding {
+            blocks: Blocks::ScanLines,
+            compression: Compression::ZIP1,
+            line_order: LineOrder::Increasing,
+        };
+        let channels = SpecificChannels::rgb(|p: Vec2<usize>| (p.x() as f32, p.y() as f32, 0.5f32));
+        let layer = Layer::new((64, 40), attributes, encoding, channels);
+        Image::from_layer(layer).write().to_file(&path).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        let meta = exr::meta::MetaData::read_from_buffered(&bytes[..], false).unwrap();
+        assert!(matches!(
+            meta.headers[0].blocks,
+            exr::meta::BlockDescription::ScanLines
+        ));
+        assert!(meta.headers[0].chunk_count > 2);
+        for thorough in [false, true] {
+            let state = |p: &Path| file_state(p, Format::Exr, "abc", thorough);
+            assert_eq!(state(&path), FileState::Current, "thorough: {thorough}");
+            let cut = dir.path().join("cut.exr");
+            std::fs::write(&cut, &bytes[..bytes.len() - 3]).unwrap();
+            assert_eq!(state(&cut), FileState::Damaged, "thorough: {thorough}");
+            let long = dir.path().join("long.exr");
+            std::fs::write(&long, [&bytes[..], &[0]].concat()).unwrap();
+            assert_eq!(state(&long), FileState::Damaged, "thorough: {thorough}");
+        }
+    }
+
+    #[test]
     fn a_png_cut_after_its_header_is_not_current() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("frame_00000.png");
