@@ -1133,7 +1133,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     }
     current.finish_and_clear();
     overall.finish_and_clear();
-    if !args.quiet && !short_of_steps.is_empty() {
+    if !short_of_steps.is_empty() {
         eprintln!(
             "warning: {}",
             out_of_steps_warning(&short_of_steps, &plan.timeline)
@@ -1222,7 +1222,6 @@ impl FrameState {
     }
 }
 
-/// `0-3, 7, 9-12` for sorted frame numbers.
 /// What is allowed but likely not what the author meant, in `frames` of
 /// `timeline`: `render` and `info` print these. `samples_matter` is false
 /// for previews, which take one sample whatever the timeline says.
@@ -1235,15 +1234,16 @@ fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<St
             track.key_times[0],
             track.key_times[track.key_times.len() - 1],
         );
-        let side = if first > end {
-            format!("after the last frame (t = {end:.3} s)")
+        let (side, held) = if first > end {
+            (format!("after the last frame (t = {end:.3} s)"), "first")
         } else if last < 0.0 {
-            "before the first frame (t = 0 s)".to_string()
+            ("before the first frame (t = 0 s)".to_string(), "last")
         } else {
             continue;
         };
         said.push(format!(
-            "every key of track \"{}\" ({first} s .. {last} s) is {side}, so it never changes the film",
+            "every key of track \"{}\" ({first} s .. {last} s) is {side}: it does not animate, \
+             every frame holds its {held} key's value",
             track.name
         ));
     }
@@ -1317,6 +1317,7 @@ fn out_of_steps_warning(frames: &[u32], timeline: &Timeline) -> String {
     )
 }
 
+/// `0-3, 7, 9-12` for sorted frame numbers.
 fn ranges(frames: &[u32]) -> String {
     let mut parts = Vec::new();
     let mut i = 0;

@@ -797,18 +797,23 @@ impl JobRecord {
     /// a record of 0..120 and `status OUTDIR` counts the gaps. An exclusive
     /// lock on the folder's `JOB_LOCK` is held from the read to the write,
     /// so renders started at the same moment each merge into the record the
-    /// one before wrote, and none loses another's range. Where the file
-    /// system cannot lock, it goes on without: the record is bookkeeping,
-    /// not worth a render.
+    /// one before wrote, and none loses another's range. Where the lock
+    /// cannot be had (a file system without locks, a lock file this user
+    /// cannot open), it goes on without: the record is bookkeeping, not
+    /// worth a render.
     pub fn record_in(self, dir: &Path) -> Result<()> {
+        // Read-only where another user made it (a lock needs no write
+        // access), and none at all where it cannot be had.
         let lock_path = dir.join(JOB_LOCK);
         let lock = std::fs::OpenOptions::new()
             .create(true)
             .truncate(false)
             .write(true)
             .open(&lock_path)
-            .map_err(|e| Error::io(&lock_path, e))?;
-        let _ = lock.lock();
+            .or_else(|_| File::open(&lock_path));
+        if let Ok(lock) = &lock {
+            let _ = lock.lock();
+        }
         let record = match JobRecord::read(dir) {
             Ok(old) if old.same_sequence(&self) => JobRecord {
                 frames: (
@@ -1490,6 +1495,12 @@ mod tests {
             );
             assert_eq!(merged.width, 8);
         }
+        // A lock file this render cannot open for writing (another user's,
+        // here a folder, which only opens for reading) does not stop it.
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::create_dir(dir.path().join(JOB_LOCK)).unwrap();
+        record((0, 3)).record_in(dir.path()).unwrap();
+        assert_eq!(JobRecord::read(dir.path()).unwrap().frames, (0, 3));
     }
 
     #[test]

@@ -185,6 +185,52 @@ fn fraction_at(text: &str, line: usize, column: usize) -> Option<String> {
     Some(format!("{sign}{whole}{rest}"))
 }
 
+/// For each line of `text`, the columns (1-based, in characters) of its
+/// code: every character that is not white space and not in a comment
+/// (`// …` to the end of the line, `/* … */` across lines; a string's
+/// characters, `//` included, are code).
+fn code_columns(text: &str) -> Vec<Vec<usize>> {
+    let (mut in_string, mut in_block) = (false, false);
+    text.lines()
+        .map(|row| {
+            let chars: Vec<char> = row.chars().collect();
+            let mut code = Vec::new();
+            let mut i = 0;
+            while i < chars.len() {
+                let (c, next) = (chars[i], chars.get(i + 1).copied());
+                if in_block {
+                    if c == '*' && next == Some('/') {
+                        in_block = false;
+                        i += 1;
+                    }
+                } else if in_string {
+                    code.push(i + 1);
+                    match c {
+                        '\\' => {
+                            code.extend(next.map(|_| i + 2));
+                            i += 1;
+                        }
+                        '"' => in_string = false,
+                        _ => {}
+                    }
+                } else if c == '/' && next == Some('/') {
+                    break;
+                } else if c == '/' && next == Some('*') {
+                    in_block = true;
+                    i += 1;
+                } else {
+                    in_string = c == '"';
+                    if !c.is_whitespace() {
+                        code.push(i + 1);
+                    }
+                }
+                i += 1;
+            }
+            code
+        })
+        .collect()
+}
+
 /// Where RON's parse error `e` points and what it says, told for a timeline
 /// (`line`, `column`, 1-based): the field a wrong value was given to, a
 /// missing comma at the end of the line that lacks it, trailing text where
@@ -202,8 +248,10 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         head.rfind(':').and_then(|colon| {
             let name = head[..colon].trim_end().trim_end_matches('"');
             let start = name
-                .rfind(|c: char| !(c.is_alphanumeric() || c == '_' || c == '.'))
-                .map_or(0, |i| i + 1);
+                .char_indices()
+                .rev()
+                .find(|&(_, c)| !(c.is_alphanumeric() || c == '_' || c == '.'))
+                .map_or(0, |(i, c)| i + c.len_utf8());
             Some(&name[start..])
                 .filter(|n| !n.is_empty())
                 .map(|n| format!("`{n}`: "))
@@ -219,7 +267,9 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
             ("`Vec3`", "a triple (x, y, z)"),
             ("struct `TimelineFile`", "the timeline"),
             ("`TimelineFile`", "the timeline"),
+            ("struct `TrackSpec`", "a track"),
             ("`TrackSpec`", "a track"),
+            ("struct `KeySpec`", "a key"),
             ("`KeySpec`", "a key"),
         ]
         .iter()
@@ -238,34 +288,29 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
     match &e.code {
         // RON stops at the next field; the comma belongs after the value
         // before it, at the end of the last line with anything on it.
-        Ron::ExpectedComma if before(line, column).trim().is_empty() => {
-            let previous = (1..line).rev().find(|&l| {
-                let code = row(l).split("//").next().unwrap_or("");
-                !code.trim().is_empty()
-            });
+        Ron::ExpectedComma
+            if code_columns(text)
+                .get(line - 1)
+                .is_some_and(|code| code.iter().all(|&c| c >= column)) =>
+        {
+            let code = code_columns(text);
+            let previous = (1..line)
+                .rev()
+                .find_map(|l| code[l - 1].last().map(|&c| (l, c + 1)));
             match previous {
-                Some(l) => {
-                    let code = row(l).split("//").next().unwrap_or("").trim_end();
-                    (
-                        (l, code.chars().count() + 1),
-                        "expected a comma after this value".into(),
-                    )
-                }
+                Some(at) => (at, "expected a comma after this value".into()),
                 None => ((line, column), "expected a comma".into()),
             }
         }
         // RON points at the end of the timeline; show where the extra text starts.
         Ron::TrailingCharacters => {
-            let mut at = (line, column);
-            for (l, text_row) in text.lines().enumerate().skip(line - 1) {
-                let skip = if l + 1 == line { column - 1 } else { 0 };
-                let rest: String = text_row.chars().skip(skip).collect();
-                let code = rest.split("//").next().unwrap_or("");
-                if let Some(offset) = code.find(|c: char| !c.is_whitespace()) {
-                    at = (l + 1, skip + code[..offset].chars().count() + 1);
-                    break;
-                }
-            }
+            let code = code_columns(text);
+            let at = (line..=code.len())
+                .find_map(|l| {
+                    let first = code[l - 1].iter().find(|&&c| l > line || c >= column);
+                    first.map(|&c| (l, c))
+                })
+                .unwrap_or((line, column));
             (
                 at,
                 "text after the timeline's closing `)`: a timeline is one `( … )`".into(),
@@ -900,16 +945,23 @@ impl Timeline {
                 let group = field.split('.').next().unwrap_or("");
                 let setting = |t: &&Track| {
                     field.starts_with(t.name.as_str())
-                        || (t.name == ZOOM_TRACK && field.starts_with("camera"))
+                        // The zoom places the camera.
+                        || (t.name == ZOOM_TRACK && matches!(field.as_str(), "camera.position" | "camera.target"))
+                        // The target coincides with the position.
+                        || (field == "camera.target" && t.name == "camera.position")
                 };
                 let in_group = |t: &&Track| t.name.split('.').next() == Some(group);
                 let mut culprits: Vec<&Track> = timeline.tracks.iter().filter(setting).collect();
                 if culprits.is_empty() {
                     culprits = timeline.tracks.iter().filter(in_group).collect();
                 }
-                // A key that is itself out of range: point at it, not at
-                // the first frame its curve crosses the limit.
-                let bad_key = culprits.iter().find_map(|track| {
+                // A key of the field's own track that is itself out of
+                // range: point at it, not at the first frame its curve
+                // crosses the limit. (Where the field's check involves
+                // others, a camera position and its target, a key's time
+                // says nothing of which key is wrong.)
+                let own = culprits.iter().filter(|track| track.name == field);
+                let bad_key = own.into_iter().find_map(|track| {
                     track.key_times.iter().enumerate().find_map(|(k, &time)| {
                         let checked = timeline.scene_built(time, true);
                         match checked.and_then(|scene| validate_scene(&scene)) {
@@ -923,11 +975,7 @@ impl Timeline {
                     return Err(invalid(
                         nth_line_after(text, &quoted, "time", k).or(line_of(text, &quoted, 0)),
                         format!("tracks[{quoted}].keys[{k}].value"),
-                        if track.name == field {
-                            message
-                        } else {
-                            format!("makes scene.{field} invalid: {message}")
-                        },
+                        message,
                     ));
                 }
                 let animated: Vec<String> =
@@ -986,7 +1034,7 @@ impl Timeline {
                 let away = c.position - c.target;
                 if away.length() <= 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
                     return Err((
-                        "camera.position".into(),
+                        "camera.target".into(),
                         "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
                     ));
                 }
@@ -1021,7 +1069,6 @@ impl Timeline {
     }
 }
 
-/// Checks one frame's scene; on failure returns the field path and the problem.
 /// The narrowest field of view. A ray's points are its origin plus a
 /// distance along it, so they are placed no finer than 2⁻⁵² of the camera's
 /// distance, while a pixel is as wide as its angle times that distance: a
@@ -1030,6 +1077,7 @@ impl Timeline {
 /// pixel. (A camera a billion units away frames the bulb at 1.03e-7°.)
 pub const MIN_FOV_DEGREES: Real = 1e-7;
 
+/// Checks one frame's scene; on failure returns the field path and the problem.
 pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     // The message is built only when the check fails: every rendered
     // scene is checked, thousands per frame under motion blur.
@@ -1539,10 +1587,27 @@ mod tests {
         // A missing comma: at the end of the line that lacks it, not at the next field.
         let e = error_of("(\n  fps: 24,\n  frames: 3 // three\n\n  size: (8, 6),\n)");
         assert_eq!(e, "test.ron:3:12: expected a comma after this value");
+        // Not fooled by `//` in a string, nor by block comments.
+        let e = error_of(
+            "(\n  fps: 24, frames: 3, scene: (fractal: (formula: Quilez)), size: (8, 6) // \"x\"\n  /* one */ /* and\n two */\n  tracks: {}, // y\n)",
+        );
+        assert_eq!(e, "test.ron:2:72: expected a comma after this value");
+        let e = error_of(
+            "(fps: 24, frames: 3, size: (8, 6), scene: (effects: (path_tracing: (sky: Environment(path: \"//x/\\\"sky.exr\"))))\n  tracks: {},\n)",
+        );
+        assert!(e.starts_with("test.ron:1:111: expected a comma"), "{e}");
+        // A track name with characters of several bytes.
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6), tracks: { \"é→power\": 1.5 })");
+        assert!(e.contains("for a track"), "{e}");
         // Text after the timeline: where it starts.
         let e = error_of("(fps: 24, frames: 3, size: (8, 6))\n// done\n  (fps: 12)");
         assert!(
             e.starts_with("test.ron:3:3: text after the timeline"),
+            "{e}"
+        );
+        let e = error_of("(fps: 24, frames: 3, size: (8, 6)) /* done */ x");
+        assert!(
+            e.starts_with("test.ron:1:47: text after the timeline"),
             "{e}"
         );
         // A whole number written with a point, a negative and a huge count: the field named.
@@ -1755,6 +1820,19 @@ mod tests {
     }
 
     #[test]
+    fn only_a_key_of_the_failing_parameter_is_blamed() {
+        // The fov curve overshoots past 179 between its keys at t = 0.6,
+        // where the zoom has a key: no key is wrong, so the frame and the
+        // fov track are named.
+        let e = error_of(&with_track(
+            "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: 175), (time: 0.7, value: 178), (time: 1, value: 60)]),\n\"camera.distance\": (keys: [(time: 0, value: 4), (time: 0.6, value: 3)])",
+        ));
+        let frame = "test.ron:1: frame 6 (t = 0.6000 s): scene.camera.fov_degrees: must be from 1e-7 to below 179 degrees, got 187.1";
+        assert!(e.starts_with(frame), "{e}");
+        assert!(e.ends_with("(set by track \"camera.fov_degrees\")"), "{e}");
+    }
+
+    #[test]
     fn a_key_out_of_range_is_named_on_its_own_line() {
         // Reached only by interpolation at frame 21; the key itself is the mistake.
         let text = "(fps: 24, frames: 24, size: (8, 6), tracks: {\n  \"fractal.power\": (interpolation: Linear, keys: [\n    (time: 0, value: 8),\n    (time: 0.5, value: 4),\n    (time: 1, value: 90),\n  ]),\n})";
@@ -1899,18 +1977,21 @@ mod tests {
 
     #[test]
     fn a_camera_track_onto_the_target_is_refused_at_its_line() {
-        // The position track's first key puts the camera onto the target:
+        // The position track sets the camera onto the target at frame 0:
         // alone, the scene's own check catches it; with a zoom track, which
         // would otherwise pick a direction of its own, the zoom's does. Both
-        // name the key and its line.
+        // name the frame, the track and its line.
         let position = "\"camera.position\": (keys: [(time: 0, value: (0, 0, 0)), (time: 1, value: (0, 0, 2))])";
         let zoom = "\"camera.distance\": (keys: [(time: 0, value: 3), (time: 1, value: 2)])";
         for tracks in [position.to_string(), format!("\n{zoom},\n{position}")] {
             let text = with_track(&tracks).replace("size: (8, 6),", "size: (8, 6),\n");
             let line = line_of(&text, "\"camera.position\"", 0).unwrap();
             let e = parse(&text).unwrap_err().to_string();
-            let key = format!("test.ron:{line}: tracks[\"camera.position\"].keys[0].value: ");
-            assert!(e.starts_with(&key) && e.contains("coincide"), "{e}");
+            assert!(e.starts_with(&format!("test.ron:{line}: frame 0 ")), "{e}");
+            assert!(
+                e.contains("coincide") && e.contains("\"camera.position\""),
+                "{e}"
+            );
         }
         // A light's error inside a list is found at the list's line.
         let text = "(fps: 10, frames: 2, size: (8, 6),\n scene: (look: (\n extra_lights: [(direction: (1, 1, 1), colour: (1, 1, 1), intensity: -1)])))";

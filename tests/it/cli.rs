@@ -440,7 +440,7 @@ fn a_track_whose_keys_all_lie_outside_the_film_is_warned_of() {
         "late.ron",
         &timeline("(time: 5, value: 4), (time: 10, value: 8)"),
     );
-    let late = "every key of track \"fractal.power\" (5 s .. 10 s) is after the last frame (t = 0.083 s), so it never changes the film";
+    let late = "every key of track \"fractal.power\" (5 s .. 10 s) is after the last frame (t = 0.083 s): it does not animate, every frame holds its first key's value";
     assert!(stdout(&d.ok(&["info", "late.ron"])).contains(late));
     says(&d.ok(&["render", "late.ron"]), late);
     d.write(

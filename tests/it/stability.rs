@@ -274,6 +274,9 @@ fn rays_running_out_of_steps_are_counted_and_warned_of() {
         .unwrap();
     assert!(counted > 32 * 18 / 10, "{err}");
     assert!(stdout(&d.ok(&["info", "small.ron"])).contains("ran out of quality.max_steps"));
+    // A farm's quiet workers say it too, as they do every warning.
+    let quiet = d.ok(&["render", "small.ron", "--force", "-q"]);
+    says(&quiet, "ran out of quality.max_steps");
     d.write("plain.ron", &scene("quality: (fudge: 1)"));
     let out = d.ok(&["render", "plain.ron", "--stats"]);
     says(&out, "(0 out of steps)");
