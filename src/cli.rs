@@ -957,8 +957,12 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("{line}");
         }
     };
-    let frames: Vec<u32> = todo.iter().map(|(frame, _, _)| *frame).collect();
-    for warning in warnings(&plan.timeline, &frames, !plan.preview) {
+    // The scenes the frames to do were planned with.
+    let planned: Vec<(u32, &crate::scene::Scene)> = todo
+        .iter()
+        .map(|(frame, scenes, _)| (*frame, &scenes[0]))
+        .collect();
+    for warning in warnings(&plan.timeline, &planned, !plan.preview) {
         say(format!("warning: {warning}"));
     }
     // Another render on this folder, where neither shares the frames out
@@ -1222,10 +1226,14 @@ impl FrameState {
     }
 }
 
-/// What is allowed but likely not what the author meant, in `frames` of
-/// `timeline`: `render` and `info` print these. `samples_matter` is false
+/// What is allowed but likely not what the author meant, in the `scenes`
+/// of frames of `timeline`: `render` and `info` print these. `samples_matter` is false
 /// for previews, which take one sample whatever the timeline says.
-fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<String> {
+fn warnings(
+    timeline: &Timeline,
+    scenes: &[(u32, &crate::scene::Scene)],
+    samples_matter: bool,
+) -> Vec<String> {
     let mut said = Vec::new();
     // Keys all on one side of the film: the track never changes a frame.
     let end = timeline.time_of(timeline.frame_count - 1);
@@ -1247,8 +1255,6 @@ fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<St
             track.name
         ));
     }
-    let scenes: Vec<(u32, crate::scene::Scene)> =
-        frames.iter().map(|&f| (f, timeline.scene_at(f))).collect();
     let which = |needs: &dyn Fn(&crate::scene::Scene) -> bool| -> Vec<u32> {
         scenes
             .iter()
@@ -1704,7 +1710,9 @@ fn info(path: &Path) -> anyhow::Result<()> {
         without.stats.de_evaluations
     );
     out!("output:   out/{}/ by default", t.name);
-    let all: Vec<u32> = (0..t.frame_count).collect();
+    let all: Vec<(u32, crate::scene::Scene)> =
+        (0..t.frame_count).map(|f| (f, t.scene_at(f))).collect();
+    let all: Vec<(u32, &crate::scene::Scene)> = all.iter().map(|(f, s)| (*f, s)).collect();
     for warning in warnings(&t, &all, true) {
         out!("warning:  {warning}");
     }

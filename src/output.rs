@@ -638,8 +638,8 @@ fn write_exr_blocks(
 /// `v` as a half float, light past the largest half (65504) held at it:
 /// rounded as it comes, it would be infinite in the file.
 fn half_float(v: f32) -> exr::prelude::f16 {
-    let largest = exr::prelude::f16::MAX.to_f32();
-    exr::prelude::f16::from_f32(v.clamp(-largest, largest))
+    const LARGEST: f32 = 65504.0; // f16::MAX, as an f32 constant
+    exr::prelude::f16::from_f32(v.clamp(-LARGEST, LARGEST))
 }
 
 /// One line of a channel's samples into `line`, as `sample`s, native-endian.

@@ -285,15 +285,15 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         };
         return ((line, column), message);
     }
+    let code = code_columns(text);
     match &e.code {
         // RON stops at the next field; the comma belongs after the value
         // before it, at the end of the last line with anything on it.
         Ron::ExpectedComma
-            if code_columns(text)
+            if code
                 .get(line - 1)
-                .is_some_and(|code| code.iter().all(|&c| c >= column)) =>
+                .is_some_and(|columns| columns.iter().all(|&c| c >= column)) =>
         {
-            let code = code_columns(text);
             let previous = (1..line)
                 .rev()
                 .find_map(|l| code[l - 1].last().map(|&c| (l, c + 1)));
@@ -304,7 +304,6 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         }
         // RON points at the end of the timeline; show where the extra text starts.
         Ron::TrailingCharacters => {
-            let code = code_columns(text);
             let at = (line..=code.len())
                 .find_map(|l| {
                     let first = code[l - 1].iter().find(|&&c| l > line || c >= column);
