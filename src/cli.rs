@@ -856,7 +856,7 @@ fn refuse_other_sequence(
     out_dir: &Path,
     old: &output::JobRecord,
     record: &output::JobRecord,
-) -> anyhow::Result<()> {
+) -> crate::error::Result<()> {
     let frames: usize = [Format::Png, Format::Exr]
         .into_iter()
         .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
@@ -879,8 +879,7 @@ fn refuse_other_sequence(
             output::JOB_FILE,
             what(record),
         ),
-    )
-    .into())
+    ))
 }
 
 fn render(args: RenderArgs) -> anyhow::Result<()> {
@@ -900,13 +899,16 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let message = format!("{} is a file, not a folder", out_dir.display());
         return Err(Error::usage("--out", message).into());
     }
-    if let Ok(old) = output::JobRecord::read(&out_dir) {
-        if !old.same_sequence(&record) && !args.force && !args.replace {
-            refuse_other_sequence(&out_dir, &old, &record)?;
-        }
-    }
     std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
-    record.record_in(&out_dir)?;
+    // Checked under the record's lock, so two renders started at once
+    // cannot both pass it.
+    let replacing = args.force || args.replace;
+    record.clone().record_in(&out_dir, |old| {
+        if old.same_sequence(&record) || replacing {
+            return Ok(());
+        }
+        refuse_other_sequence(&out_dir, old, &record)
+    })?;
     let stale = output::remove_stale_partials(&out_dir)?;
     // Until this render ends, `status` lists it as running.
     let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;

@@ -800,8 +800,11 @@ impl JobRecord {
     /// one before wrote, and none loses another's range. Where the lock
     /// cannot be had (a file system without locks, a lock file this user
     /// cannot open), it goes on without: the record is bookkeeping, not
-    /// worth a render.
-    pub fn record_in(self, dir: &Path) -> Result<()> {
+    /// worth a render. `check` sees the record already there, if any,
+    /// under the same lock, and its error stops the write: so a render
+    /// refused over another sequence's frames cannot slip in between
+    /// another render's check and its write.
+    pub fn record_in(self, dir: &Path, check: impl FnOnce(&JobRecord) -> Result<()>) -> Result<()> {
         // Read-only where another user made it (a lock needs no write
         // access), and none at all where it cannot be had.
         let lock_path = dir.join(JOB_LOCK);
@@ -814,7 +817,11 @@ impl JobRecord {
         if let Ok(lock) = &lock {
             let _ = lock.lock();
         }
-        let record = match JobRecord::read(dir) {
+        let old = JobRecord::read(dir);
+        if let Ok(old) = &old {
+            check(old)?;
+        }
+        let record = match old {
             Ok(old) if old.same_sequence(&self) => JobRecord {
                 frames: (
                     old.frames.0.min(self.frames.0),
@@ -1451,9 +1458,9 @@ mod tests {
         assert_eq!(stored_key(Format::Png, &graded, &[]), graded);
     }
 
-    #[test]
-    fn renders_started_together_each_add_their_range_to_the_record() {
-        let record = |frames| JobRecord {
+    /// An 8×8 PNG job of `zoom.ron` over `frames`.
+    fn record(frames: (u32, u32)) -> JobRecord {
+        JobRecord {
             renderer: "test".into(),
             timeline_path: "zoom.ron".into(),
             timeline_text: String::new(),
@@ -1464,7 +1471,11 @@ mod tests {
             preview: false,
             aovs: Vec::new(),
             samples: None,
-        };
+        }
+    }
+
+    #[test]
+    fn renders_started_together_each_add_their_range_to_the_record() {
         const WORKERS: u32 = 8;
         for _ in 0..20 {
             let dir = tempfile::tempdir().unwrap();
@@ -1482,7 +1493,7 @@ mod tests {
                     s.spawn(move || {
                         start.wait();
                         record((worker * 10 + 5, worker * 10 + 10))
-                            .record_in(dir)
+                            .record_in(dir, |_| Ok(()))
                             .unwrap();
                     });
                 }
@@ -1499,8 +1510,31 @@ mod tests {
         // here a folder, which only opens for reading) does not stop it.
         let dir = tempfile::tempdir().unwrap();
         std::fs::create_dir(dir.path().join(JOB_LOCK)).unwrap();
-        record((0, 3)).record_in(dir.path()).unwrap();
+        record((0, 3)).record_in(dir.path(), |_| Ok(())).unwrap();
         assert_eq!(JobRecord::read(dir.path()).unwrap().frames, (0, 3));
+    }
+
+    #[test]
+    fn the_check_of_the_record_there_runs_under_the_lock_and_can_stop_the_write() {
+        let dir = tempfile::tempdir().unwrap();
+        record((0, 3)).write(dir.path()).unwrap();
+        let refused = JobRecord {
+            width: 9,
+            ..record((5, 6))
+        }
+        .record_in(dir.path(), |old| {
+            assert_eq!(old.frames, (0, 3), "the check sees the record there");
+            // Another render cannot take the lock while the check runs.
+            let other = File::open(dir.path().join(JOB_LOCK)).unwrap();
+            assert!(
+                matches!(other.try_lock(), Err(std::fs::TryLockError::WouldBlock)),
+                "the check runs under the folder's lock"
+            );
+            Err(Error::usage("--out", "another sequence"))
+        });
+        assert!(refused.is_err());
+        let kept = JobRecord::read(dir.path()).unwrap();
+        assert_eq!((kept.width, kept.frames), (8, (0, 3)), "nothing written");
     }
 
     #[test]
