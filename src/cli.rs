@@ -1565,6 +1565,13 @@ fn info(path: &Path) -> anyhow::Result<()> {
         t.height,
         base.samples_per_pixel
     );
+    if t.looping {
+        out!(
+            "loop:     seamless: every track repeats every {:.3} s, so frame {} would be frame 0 again",
+            t.duration_seconds(),
+            t.frame_count
+        );
+    }
     let f = &base.fractal;
     let animated_julia = t.tracks.iter().any(|tr| tr.name == "fractal.julia");
     let mode = match (f.julia, animated_julia) {

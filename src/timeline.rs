@@ -129,6 +129,9 @@ struct TimelineFile {
     #[serde(default)]
     duration_seconds: Option<Real>,
     size: (u32, u32),
+    /// The film is one period of a seamless loop (`Timeline::period`).
+    #[serde(default, rename = "loop")]
+    looping: bool,
     #[serde(default)]
     scene: Scene,
     #[serde(default, deserialize_with = "tracks_once_each")]
@@ -387,6 +390,15 @@ macro_rules! shown_vector {
 shown_vector!(DVec3);
 shown_vector!(Vec3);
 
+impl Shown for KeyValue {
+    fn shown(&self) -> String {
+        match *self {
+            KeyValue::Number(v) => v.shown(),
+            KeyValue::Triple(x, y, z) => DVec3::new(x, y, z).shown(),
+        }
+    }
+}
+
 /// The largest camera position or target component a scene may have.
 const MAX_COORDINATE: Real = 1e15;
 
@@ -529,14 +541,28 @@ pub struct Track {
     ends: (Vec<Real>, Vec<Real>),
     /// Values are stored as logarithms and exponentiated when sampled.
     log_space: bool,
+    /// In a looping film, its period: the track repeats with it, and its
+    /// splines hold the keys of three periods (`build_spline`).
+    period: Option<Real>,
 }
 
 impl Track {
-    /// The parameter's value at `time_seconds`; held constant outside the keys.
+    /// The parameter's value at `time_seconds`; held constant outside the
+    /// keys, or in a looping film the same every period.
     pub fn sample(&self, time_seconds: Real) -> Vec<Real> {
         let first = self.key_times[0];
         let last = self.key_times[self.key_times.len() - 1];
-        let raw: Vec<Real> = if time_seconds <= first {
+        let raw: Vec<Real> = if let Some(period) = self.period {
+            // Into [0, period): a tiny negative time's remainder can round
+            // up to the period itself.
+            let t = time_seconds.rem_euclid(period);
+            let t = if t < period { t } else { 0.0 };
+            self.splines
+                .iter()
+                .zip(&self.ends.0)
+                .map(|(s, &fallback)| s.sample(t).unwrap_or(fallback))
+                .collect()
+        } else if time_seconds <= first {
             self.ends.0.clone()
         } else if time_seconds >= last {
             self.ends.1.clone()
@@ -557,9 +583,24 @@ impl Track {
 
 /// Builds the spline of one component. Phantom keys are mirrored beyond both
 /// ends so Catmull–Rom, which needs a neighbour on each side, covers the first
-/// and last segments too.
-fn build_spline(times: &[Real], values: &[Real], mode: Interpolation) -> Spline<Real, Real> {
+/// and last segments too. With a `period` (a looping film; `times` in
+/// [0, period)), the keys are laid out over the period before, this one and
+/// the next instead, so every segment in [0, period) has its true
+/// neighbours: the last key leads into the first as any key into the next.
+fn build_spline(
+    times: &[Real],
+    values: &[Real],
+    mode: Interpolation,
+    period: Option<Real>,
+) -> Spline<Real, Real> {
     let m = mode.spline_mode();
+    if let Some(period) = period {
+        let keys = [-period, 0.0, period].into_iter().flat_map(|shift| {
+            let key = move |(&t, &v): (&Real, &Real)| Key::new(t + shift, v, m);
+            times.iter().zip(values).map(key)
+        });
+        return Spline::from_vec(keys.collect());
+    }
     let mut keys: Vec<Key<Real, Real>> = times
         .iter()
         .zip(values)
@@ -592,6 +633,9 @@ pub struct Timeline {
     /// The scene before any track is applied.
     pub base: Scene,
     pub tracks: Vec<Track>,
+    /// `loop: true`: the film is one period of a seamless loop, and frame
+    /// `frame_count` would be frame 0 again. The period is `duration_seconds`.
+    pub looping: bool,
 }
 
 /// The longest file read as a timeline: real ones are a few kilobytes, and
@@ -893,16 +937,72 @@ impl Timeline {
                 columns.iter().map(|c| c[0]).collect(),
                 columns.iter().map(|c| c[c.len() - 1]).collect(),
             );
+            let period = file.looping.then_some(frame_count as Real / file.fps);
+            // The keys the splines go through: in a looping film, those of
+            // one period, in [0, period).
+            let (mut loop_times, mut loop_columns) = (times.clone(), columns);
+            if let Some(period) = period {
+                let last = times.len() - 1;
+                // A key written at the period's end is the loop's start again.
+                let at_end = |t: Real| (t - period).abs() <= 1e-9 * period.max(1.0);
+                for (k, &time) in times.iter().enumerate() {
+                    if time < 0.0 || (time > period && !at_end(time)) {
+                        return Err(at(
+                            format!(".keys[{k}].time"),
+                            Some(k),
+                            format!(
+                                "a looping film's keys lie within its one period, 0 s to {period} s                                  (frames / fps), got {time}; the loop repeats them every {period} s"
+                            ),
+                        ));
+                    }
+                }
+                if at_end(times[last]) {
+                    let (end, start) = (&spec.keys[last].value, &spec.keys[0].value);
+                    if times[0] == 0.0 && last > 0 {
+                        let (values, start_values) = (end.components(), start.components());
+                        let same = start_values
+                            .iter()
+                            .zip(&values)
+                            .all(|(a, b)| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0));
+                        if !same {
+                            return Err(at(
+                                format!(".keys[{last}].value"),
+                                Some(last),
+                                format!(
+                                    "in a looping film the key at its end ({} s) is the key at 0 s again,                                      so it must have the same value: {} here, {} at 0 s (or leave one of them out)",
+                                    times[last],
+                                    end.shown(),
+                                    start.shown()
+                                ),
+                            ));
+                        }
+                        loop_times.pop();
+                        loop_columns.iter_mut().for_each(|c| {
+                            c.pop();
+                        });
+                    } else {
+                        // The only key at the start: it moves to 0 s.
+                        loop_times.pop();
+                        loop_times.insert(0, 0.0);
+                        for c in &mut loop_columns {
+                            let v = c.pop().expect("a key per column");
+                            c.insert(0, v);
+                        }
+                    }
+                }
+            }
+            let splines = loop_columns
+                .iter()
+                .map(|c| build_spline(&loop_times, c, interpolation, period))
+                .collect();
             tracks.push(Track {
                 name: name.clone(),
                 interpolation,
-                splines: columns
-                    .iter()
-                    .map(|c| build_spline(&times, c, interpolation))
-                    .collect(),
+                splines,
                 key_times: times,
                 ends,
                 log_space,
+                period,
             });
         }
         // The zoom distance acts on the animated position and target, so it goes last.
@@ -921,6 +1021,7 @@ impl Timeline {
             height,
             base: file.scene,
             tracks,
+            looping: file.looping,
         };
         // Splines can overshoot their keys: check every scene the frames
         // render, motion blur's instants between frames included, and each
@@ -1764,6 +1865,113 @@ mod tests {
             e.starts_with("test.ron:5: tracks[\"fractal.power\"].keys[2].time"),
             "{e}"
         );
+    }
+
+    /// A looping film of 24 frames at 4 fps (a 6 s period) and `tracks`.
+    fn looping(tracks: &str) -> String {
+        format!("(fps: 4, frames: 24, size: (8, 6), loop: true, tracks: {{ {tracks} }})")
+    }
+
+    /// julia_morph.ron's camera orbit: four keys around the y axis and back
+    /// to the first at 6 s.
+    const ORBIT: &str = "\"camera.position\": (keys: [
+        (time: 0.0, value: (3.1, 0.8, 0.0)),
+        (time: 1.5, value: (0.0, 0.8, 3.1)),
+        (time: 3.0, value: (-3.1, 0.8, 0.0)),
+        (time: 4.5, value: (0.0, 0.8, -3.1)),
+        (time: 6.0, value: (3.1, 0.8, 0.0)),
+    ])";
+
+    #[test]
+    fn a_looping_film_comes_back_to_its_start_without_a_kink() {
+        let velocity = |track: &Track, from: Real, to: Real| -> DVec3 {
+            let at = |t| DVec3::from_slice(&track.sample(t));
+            (at(to) - at(from)) / (to - from)
+        };
+        let h = 1e-5;
+        for mode in ["Step", "Linear", "CatmullRom", "Smooth"] {
+            let text = looping(&ORBIT.replace("(keys", &format!("(interpolation: {mode}, keys")));
+            let t = parse(&text).unwrap();
+            let orbit = &t.tracks[0];
+            // One period on, the same value: frame 24 would be frame 0.
+            for time in [0.0, 0.3, 1.5, 2.2, 5.9] {
+                let (now, later) = (orbit.sample(time), orbit.sample(time + 6.0));
+                let close = now.iter().zip(&later).all(|(a, b)| (a - b).abs() < 1e-12);
+                assert!(close, "{mode} at {time}: {now:?} then {later:?}");
+            }
+            assert_eq!(orbit.sample(0.0), vec![3.1, 0.8, 0.0], "{mode}");
+            assert_eq!(orbit.sample(-1.5), vec![0.0, 0.8, -3.1], "{mode}");
+            // Between the last key and the period's end the track leads into
+            // the first key as between any two keys: no value is held.
+            if mode != "Step" {
+                let p = orbit.sample(5.25);
+                assert!(p[0] > 0.5 && p[0] < 3.1 && p[2] < -0.5, "{mode}: {p:?}");
+            }
+        }
+        // Catmull-Rom's velocity runs on through the wrap; without the loop
+        // the mirrored end keys turn it by a right angle there.
+        let smooth = parse(&looping(ORBIT)).unwrap();
+        let plain = parse(&looping(ORBIT).replace("loop: true", "loop: false")).unwrap();
+        let (orbit, open) = (&smooth.tracks[0], &plain.tracks[0]);
+        let leaving = velocity(orbit, 0.0, h);
+        let arriving = velocity(orbit, 6.0 - h, 6.0);
+        assert!(
+            (leaving - arriving).length() < 1e-3,
+            "{leaving} vs {arriving}"
+        );
+        let (leaving, arriving) = (velocity(open, 0.0, h), velocity(open, 6.0 - h, 6.0));
+        assert!(
+            (leaving - arriving).length() > 2.0,
+            "{leaving} vs {arriving}"
+        );
+        assert!(smooth.looping && !plain.looping);
+    }
+
+    #[test]
+    fn a_looping_films_keys_lie_within_its_period() {
+        // The end key may be left out: the start key closes the loop.
+        let open = ORBIT.replace("\n        (time: 6.0, value: (3.1, 0.8, 0.0)),", "");
+        assert_ne!(open, ORBIT);
+        let (a, b) = (
+            parse(&looping(ORBIT)).unwrap(),
+            parse(&looping(&open)).unwrap(),
+        );
+        for time in [0.0, 0.7, 4.9, 5.6] {
+            assert_eq!(a.tracks[0].sample(time), b.tracks[0].sample(time), "{time}");
+        }
+        // A key at the end alone is the start's.
+        let end_only = "\"fractal.power\": (interpolation: Linear, keys: [(time: 3, value: 4), (time: 6, value: 8)])";
+        let t = parse(&looping(end_only)).unwrap();
+        assert_eq!(t.tracks[0].sample(0.0), vec![8.0]);
+        assert_eq!(t.tracks[0].sample(1.5), vec![6.0]);
+        assert_eq!(t.tracks[0].sample(4.5), vec![6.0]);
+        // A key past the end, or before the start, names its line.
+        let past = looping(&ORBIT.replace("time: 6.0", "time: 6.5"));
+        let e = error_of(&past);
+        assert!(
+            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].time: a looping film's keys lie within its one period, 0 s to 6 s"),
+            "{e}"
+        );
+        let before = looping(&ORBIT.replace("time: 0.0", "time: -0.5"));
+        assert!(
+            error_of(&before).contains("keys[0].time: a looping film"),
+            "{}",
+            error_of(&before)
+        );
+        // The end key is the start key again: another value is refused.
+        let torn = looping(&ORBIT.replace(
+            "(time: 6.0, value: (3.1, 0.8, 0.0))",
+            "(time: 6.0, value: (3.0, 0.8, 0.0))",
+        ));
+        let e = error_of(&torn);
+        assert!(
+            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].value: in a looping film the key at its end (6 s) is the key at 0 s again")
+                && e.contains("(3, 0.8, 0) here, (3.1, 0.8, 0) at 0 s"),
+            "{e}"
+        );
+        // Without the loop, the same keys are fine.
+        let unlooped = |text: String| text.replace("loop: true", "loop: false");
+        assert!(parse(&unlooped(past)).is_ok() && parse(&unlooped(torn)).is_ok());
     }
 
     #[test]

@@ -332,6 +332,12 @@ fn example_timelines_are_valid() {
     let before = &zoom[..zoom.find(" decades").expect("zoom line in info")];
     let decades: f64 = before.rsplit(' ').next().unwrap().parse().unwrap();
     assert!(decades >= 4.0, "{zoom}");
+    // The Julia morph is a seamless loop.
+    let morph = stdout(&d.ok(&[
+        "info",
+        root.join("timelines/julia_morph.ron").to_str().unwrap(),
+    ]));
+    assert!(morph.contains("loop:     seamless"), "{morph}");
 }
 
 #[test]
@@ -469,4 +475,79 @@ fn the_readmes_reference_timeline_is_valid_and_draws_no_warning() {
     let info = stdout(&d.ok(&["info", "reference.ron"]));
     assert!(info.contains("frames:   120 at 24 fps"), "{info}");
     assert!(!info.contains("warning"), "{info}");
+}
+
+/// A key of `looping_morph`: time, Julia constant, camera position.
+type MorphKey = (f64, [f64; 3], [f64; 3]);
+
+/// A looping Julia morph with an orbiting camera, 24 frames at 4 fps (a 6 s
+/// period).
+fn looping_morph(keys: &[MorphKey]) -> String {
+    let track = |pick: &dyn Fn(&MorphKey) -> [f64; 3]| {
+        let keys: Vec<String> = keys
+            .iter()
+            .map(|k| {
+                let [x, y, z] = pick(k);
+                format!("(time: {}, value: ({x}, {y}, {z}))", k.0)
+            })
+            .collect();
+        format!("(keys: [{}])", keys.join(", "))
+    };
+    format!(
+        "(fps: 4, frames: 24, size: (48, 27), loop: true,
+          scene: (fractal: (iterations: 8, julia: (0.5, 0.5, 0.5))),
+          tracks: {{ \"fractal.julia\": {}, \"camera.position\": {} }})",
+        track(&|k| k.1),
+        track(&|k| k.2)
+    )
+}
+
+#[test]
+fn a_looping_film_has_no_start_a_quarter_period_later_is_the_same_film() {
+    let shapes = [
+        [0.5, 0.5, 0.5],
+        [0.8, -0.4, 0.2],
+        [-0.6, -0.2, -0.6],
+        [-0.2, 0.7, -0.3],
+    ];
+    let orbit = [
+        [3.1, 0.8, 0.0],
+        [0.0, 0.8, 3.1],
+        [-3.1, 0.8, 0.0],
+        [0.0, 0.8, -3.1],
+    ];
+    // `a` closes its loop with a key at 6 s equal to the first; `b` starts
+    // at `a`'s second key (1.5 s, 6 frames in) and leaves the end key out.
+    let mut a: Vec<_> = (0..4)
+        .map(|k| (1.5 * k as f64, shapes[k], orbit[k]))
+        .collect();
+    a.push((6.0, shapes[0], orbit[0]));
+    let b: Vec<_> = (0..4)
+        .map(|k| (1.5 * k as f64, shapes[(k + 1) % 4], orbit[(k + 1) % 4]))
+        .collect();
+    let d = Dir::new();
+    d.write("a.ron", &looping_morph(&a));
+    d.write("b.ron", &looping_morph(&b));
+    assert!(stdout(&d.ok(&["info", "a.ron"])).contains("loop:     seamless"));
+    // Frame 1 of `a` (0.25 s) lies between its first two keys, where the
+    // loop's last key leads in; `b` reaches it at frame 19, between its last
+    // key and the end of the period. Frame 23 of `a`, before its end, is
+    // `b`'s frame 17.
+    d.ok(&["render", "a.ron", "-q", "--frames", "0..2"]);
+    d.ok(&["render", "a.ron", "-q", "--frames", "23"]);
+    d.ok(&["render", "b.ron", "-q", "--frames", "17"]);
+    d.ok(&["render", "b.ron", "-q", "--frames", "19"]);
+    let pixels = |f: &str| image::open(d.path().join(f)).unwrap().to_rgb8().into_raw();
+    assert_ne!(
+        pixels("out/a/frame_00000.png"),
+        pixels("out/a/frame_00001.png"),
+        "the film moves"
+    );
+    for (of_a, of_b) in [(1, 19), (23, 17)] {
+        assert!(
+            pixels(&format!("out/a/frame_{of_a:05}.png"))
+                == pixels(&format!("out/b/frame_{of_b:05}.png")),
+            "frame {of_a} of a differs from frame {of_b} of b"
+        );
+    }
 }
