@@ -943,15 +943,22 @@ impl Timeline {
             let (mut loop_times, mut loop_columns) = (times.clone(), columns);
             if let Some(period) = period {
                 let last = times.len() - 1;
-                // A key written at the period's end is the loop's start again.
-                let at_end = |t: Real| (t - period).abs() <= 1e-9 * period.max(1.0);
+                // A key written at the period's end is the loop's start
+                // again: within half a frame of it, since `duration_seconds`
+                // is rounded to whole frames (4 s at 29.97 fps is 120 frames,
+                // a period of 4.004 s), and no frame lies between.
+                let at_end = |t: Real| (t - period).abs() < 0.5 / file.fps;
+                let seconds = |t: Real| (t * 1e6).round() / 1e6;
                 for (k, &time) in times.iter().enumerate() {
                     if time < 0.0 || (time > period && !at_end(time)) {
+                        let period = seconds(period);
                         return Err(at(
                             format!(".keys[{k}].time"),
                             Some(k),
                             format!(
-                                "a looping film's keys lie within its one period, 0 s to {period} s                                  (frames / fps), got {time}; the loop repeats them every {period} s"
+                                "a looping film's keys lie within its one period, 0 s to \
+                                 {period} s (frames / fps), got {time}; the loop repeats \
+                                 them every {period} s"
                             ),
                         ));
                     }
@@ -969,7 +976,9 @@ impl Timeline {
                                 format!(".keys[{last}].value"),
                                 Some(last),
                                 format!(
-                                    "in a looping film the key at its end ({} s) is the key at 0 s again,                                      so it must have the same value: {} here, {} at 0 s (or leave one of them out)",
+                                    "in a looping film the key at its end ({} s) is the key at \
+                                     0 s again, so it must have the same value: {} here, {} at \
+                                     0 s (or leave one of them out)",
                                     times[last],
                                     end.shown(),
                                     start.shown()
@@ -1949,7 +1958,7 @@ mod tests {
         let past = looping(&ORBIT.replace("time: 6.0", "time: 6.5"));
         let e = error_of(&past);
         assert!(
-            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].time: a looping film's keys lie within its one period, 0 s to 6 s"),
+            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].time: a looping film's keys lie within its one period, 0 s to 6 s (frames / fps), got 6.5; the loop repeats them every 6 s"),
             "{e}"
         );
         let before = looping(&ORBIT.replace("time: 0.0", "time: -0.5"));
@@ -1965,13 +1974,30 @@ mod tests {
         ));
         let e = error_of(&torn);
         assert!(
-            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].value: in a looping film the key at its end (6 s) is the key at 0 s again")
-                && e.contains("(3, 0.8, 0) here, (3.1, 0.8, 0) at 0 s"),
+            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].value: in a looping film the key at its end (6 s) is the key at 0 s again, so it must have the same value: (3, 0.8, 0) here, (3.1, 0.8, 0) at 0 s (or leave one of them out)"),
             "{e}"
         );
         // Without the loop, the same keys are fine.
         let unlooped = |text: String| text.replace("loop: true", "loop: false");
         assert!(parse(&unlooped(past)).is_ok() && parse(&unlooped(torn)).is_ok());
+        // 4 s at 29.97 fps is 120 frames, a period of 4.004 s: a key written
+        // at 4 s is within half a frame of its end, so it is the start key
+        // again, not a key of its own 4 ms before it.
+        let ntsc = format!(
+            "(fps: 29.97, duration_seconds: 4.0, size: (8, 6), loop: true, tracks: {{ {} }})",
+            "\"fractal.power\": (interpolation: Linear, keys: [(time: 0, value: 8), (time: 2, value: 4), (time: 4, value: 8)])"
+        );
+        let t = parse(&ntsc).unwrap();
+        let period = 120.0 / 29.97;
+        let power = |time: Real| t.tracks[0].sample(time)[0];
+        assert!(
+            (power(period - 0.002) - 8.0).abs() < 0.01,
+            "{}",
+            power(period - 0.002)
+        );
+        assert!((power(3.0) - 6.0).abs() < 0.01, "{}", power(3.0));
+        let torn = ntsc.replace("(time: 4, value: 8)", "(time: 4, value: 7)");
+        assert!(error_of(&torn).contains("the key at its end (4 s) is the key at 0 s again"));
     }
 
     #[test]
