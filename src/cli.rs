@@ -856,12 +856,13 @@ fn refuse_other_sequence(
     out_dir: &Path,
     old: &output::JobRecord,
     record: &output::JobRecord,
+    running: usize,
 ) -> crate::error::Result<()> {
     let frames: usize = [Format::Png, Format::Exr]
         .into_iter()
         .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
         .sum();
-    if frames == 0 {
+    if frames == 0 && running == 0 {
         return Ok(());
     }
     let what = |r: &output::JobRecord| {
@@ -871,12 +872,17 @@ fn refuse_other_sequence(
     Err(Error::usage(
         "--out",
         format!(
-            "{} holds {frames} frame file(s) of {} (by its {}); rendering {} there would \
+            "{} holds {frames} frame file(s) of {} (by its {}){}; rendering {} there would \
              replace them or mix two sequences in one folder: choose another folder with \
              --out, or pass --replace to replace them",
             out_dir.display(),
             what(old),
             output::JOB_FILE,
+            if running > 0 {
+                format!(" and {running} render(s) of it still running")
+            } else {
+                String::new()
+            },
             what(record),
         ),
     ))
@@ -907,7 +913,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         if old.same_sequence(&record) || replacing {
             return Ok(());
         }
-        refuse_other_sequence(&out_dir, old, &record)
+        let running = crate::claim::live_runs(&out_dir, args.claim_timeout);
+        refuse_other_sequence(&out_dir, old, &record, running.len())
     })?;
     let stale = output::remove_stale_partials(&out_dir)?;
     // Until this render ends, `status` lists it as running.
@@ -1239,7 +1246,9 @@ fn warnings(
     let mut said = Vec::new();
     // Keys all on one side of the film: the track never changes a frame.
     let end = timeline.time_of(timeline.frame_count - 1);
-    for track in timeline.tracks.iter().filter(|t| t.key_times.len() > 1) {
+    // A looping film's keys all lie in its period, and repeat.
+    let unlooped = timeline.tracks.iter().filter(|_| !timeline.looping);
+    for track in unlooped.filter(|t| t.key_times.len() > 1) {
         let (first, last) = (
             track.key_times[0],
             track.key_times[track.key_times.len() - 1],
@@ -1608,7 +1617,17 @@ fn info(path: &Path) -> anyhow::Result<()> {
                 tr.key_times.len()
             );
             if tr.name == ZOOM_TRACK {
-                let (a, b) = (tr.sample(first)[0], tr.sample(last)[0]);
+                let (mut a, mut b) = (tr.sample(first)[0], tr.sample(last)[0]);
+                if t.looping {
+                    // The last key may be the first again: the zoom's
+                    // reach is between its farthest and nearest frames.
+                    // (Every frame, or 10 000 spread over a longer film.)
+                    let step = (t.frame_count / 10_000).max(1) as usize;
+                    let frames = (0..t.frame_count).step_by(step);
+                    let d: Vec<f64> = frames.map(|f| tr.sample(t.time_of(f))[0]).collect();
+                    a = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    b = d.iter().copied().fold(f64::INFINITY, f64::min);
+                }
                 line += &format!(
                     "  (log-space zoom {a:.3e} -> {b:.3e}, {:.1} decades)",
                     (a / b).log10().abs()

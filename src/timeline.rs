@@ -965,7 +965,8 @@ impl Timeline {
                 }
                 if at_end(times[last]) {
                     let (end, start) = (&spec.keys[last].value, &spec.keys[0].value);
-                    if times[0] == 0.0 && last > 0 {
+                    // A first key within half a frame of 0 is the start's.
+                    if times[0] < 0.5 / file.fps && last > 0 {
                         let (values, start_values) = (end.components(), start.components());
                         let same = start_values
                             .iter()
@@ -1997,6 +1998,11 @@ mod tests {
         );
         assert!((power(3.0) - 6.0).abs() < 0.01, "{}", power(3.0));
         let torn = ntsc.replace("(time: 4, value: 8)", "(time: 4, value: 7)");
+        assert!(error_of(&torn).contains("the key at its end (4 s) is the key at 0 s again"));
+        // So is a first key within half a frame of 0 the start key.
+        let late_start = ntsc.replace("(time: 0, value: 8)", "(time: 0.001, value: 8)");
+        assert!(parse(&late_start).is_ok());
+        let torn = late_start.replace("(time: 4, value: 8)", "(time: 4, value: 7)");
         assert!(error_of(&torn).contains("the key at its end (4 s) is the key at 0 s again"));
     }
 

@@ -462,6 +462,30 @@ fn a_track_whose_keys_all_lie_outside_the_film_is_warned_of() {
     );
     assert!(!stdout(&d.ok(&["info", "across.ron"])).contains("warning"));
     assert!(!stderr(&d.ok(&["render", "across.ron"])).contains("warning"));
+    // In a looping film keys after the last frame still animate it: the
+    // track wraps (frame 0 is at the 5 s key, which the end key closes to).
+    let looped = timeline("(time: 0.1, value: 4), (time: 0.125, value: 8)")
+        .replace("size: (16, 9),", "size: (16, 9), loop: true,");
+    d.write("looped.ron", &looped);
+    assert!(!stdout(&d.ok(&["info", "looped.ron"])).contains("warning"));
+}
+
+#[test]
+fn info_gives_a_looping_zooms_reach_from_its_frames() {
+    // The end key is the start again: first and last keys say nothing.
+    let d = Dir::new();
+    d.write(
+        "z.ron",
+        "(fps: 4, frames: 8, size: (16, 9), loop: true,
+          scene: (camera: (position: (0, 0, 3), target: (0, 0, 1.1))),
+          tracks: { \"camera.distance\": (interpolation: Linear, keys: [
+            (time: 0, value: 3), (time: 1, value: 0.03), (time: 2, value: 3)]) })",
+    );
+    let info = stdout(&d.ok(&["info", "z.ron"]));
+    assert!(
+        info.contains("log-space zoom 3.000e0 -> 3.000e-2, 2.0 decades"),
+        "{info}"
+    );
 }
 
 #[test]

@@ -102,6 +102,32 @@ fn another_timeline_is_not_rendered_over_a_folders_frames() {
 }
 
 #[test]
+fn another_sequence_is_refused_while_a_render_still_works_on_its_first_frame() {
+    // No frame is finished yet, but the folder's render is running: a
+    // render of another size would take the record over and write the
+    // same frame names.
+    let d = Dir::new();
+    d.write("t.ron", &long_frames(1));
+    let mut child = render_until_a_checkpoint(&d);
+    assert!(!d.files("out/t").iter().any(|f| f.ends_with(".png")));
+    let record = d.bytes("out/t/mandelreel-job.json");
+    let out = d.run(&["render", "t.ron", "--size", "40x20"]);
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("holds 0 frame file(s) of t.ron at 120x68")
+            && err.contains("and 1 render(s) of it still running"),
+        "{err}"
+    );
+    assert!(
+        d.bytes("out/t/mandelreel-job.json") == record,
+        "record rewritten"
+    );
+}
+
+#[test]
 fn stale_temporary_and_foreign_files_are_not_taken_for_frames() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(2, 6.0));
