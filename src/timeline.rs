@@ -1558,8 +1558,26 @@ fn line_of(text: &str, needle: &str, from: usize) -> Option<usize> {
     Some(text[..at].matches('\n').count() + 1)
 }
 
-/// Line of the `k`-th (0-based) `word` after the first `anchor`: locates a key inside a track.
+/// Line of the `k`-th (0-based) `word` after the first `anchor`: locates a key
+/// inside a track. Words in comments do not count (`// at this time …`).
 fn nth_line_after(text: &str, anchor: &str, word: &str, k: usize) -> Option<usize> {
+    // The text with every comment character blanked, lines kept.
+    let code = code_columns(text);
+    let text: String = text
+        .lines()
+        .zip(&code)
+        .map(|(row, columns)| {
+            let blanked = row.chars().enumerate().map(|(i, c)| {
+                if columns.binary_search(&(i + 1)).is_ok() {
+                    c
+                } else {
+                    ' '
+                }
+            });
+            blanked.chain(['\n']).collect::<String>()
+        })
+        .collect();
+    let text = text.as_str();
     let mut at = text.find(anchor)?;
     for _ in 0..=k {
         at += text[at..].find(word)? + word.len();
@@ -2004,6 +2022,16 @@ mod tests {
         assert!(parse(&late_start).is_ok());
         let torn = late_start.replace("(time: 4, value: 8)", "(time: 4, value: 7)");
         assert!(error_of(&torn).contains("the key at its end (4 s) is the key at 0 s again"));
+    }
+
+    #[test]
+    fn a_word_in_a_comment_does_not_move_a_keys_line() {
+        let text = "(fps: 10, frames: 3, size: (8, 6), tracks: {\n  \"fractal.power\": (keys: [\n    (time: 0, value: 8),\n    // at this time the bulb swells\n    (time: 1, value: 7),\n    (time: 1, value: 6),\n  ]),\n})";
+        let e = error_of(text);
+        assert!(
+            e.starts_with("test.ron:6: tracks[\"fractal.power\"].keys[2].time"),
+            "{e}"
+        );
     }
 
     #[test]
