@@ -6,7 +6,7 @@ use crate::error::{Error, Result};
 use crate::march::{march, normal};
 use crate::output::{self, Format};
 use crate::render::FrameStats;
-use crate::timeline::{Timeline, ZOOM_TRACK};
+use crate::timeline::{Timeline, Track, ZOOM_TRACK};
 use clap::{Parser, Subcommand};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
@@ -1246,9 +1246,9 @@ fn warnings(
     let mut said = Vec::new();
     // Keys all on one side of the film: the track never changes a frame.
     let end = timeline.time_of(timeline.frame_count - 1);
-    // A looping film's keys all lie in its period, and repeat.
-    let unlooped = timeline.tracks.iter().filter(|_| !timeline.looping);
-    for track in unlooped.filter(|t| t.key_times.len() > 1) {
+    // (A looping film's keys all lie in its period, and repeat.)
+    let animating = |t: &&Track| !timeline.looping && t.key_times.len() > 1;
+    for track in timeline.tracks.iter().filter(animating) {
         let (first, last) = (
             track.key_times[0],
             track.key_times[track.key_times.len() - 1],

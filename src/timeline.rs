@@ -129,7 +129,7 @@ struct TimelineFile {
     #[serde(default)]
     duration_seconds: Option<Real>,
     size: (u32, u32),
-    /// The film is one period of a seamless loop (`Timeline::period`).
+    /// The film is one period of a seamless loop (`Timeline::looping`).
     #[serde(default, rename = "loop")]
     looping: bool,
     #[serde(default)]
@@ -581,6 +581,71 @@ impl Track {
     }
 }
 
+/// A key's problem: its index, the field (`time` or `value`), the message.
+type KeyError = (usize, &'static str, String);
+
+/// The keys of a looping film's track (`times`, one column of values per
+/// component, written as `keys`) laid out over one period, [0, `period`).
+/// A key at the period's end is the start's again: within half a frame of
+/// it, since `duration_seconds` is rounded to whole frames (4 s at 29.97 fps
+/// is 120 frames, a period of 4.004 s), and no frame lies between. It must
+/// equal a key at the start (within half a frame of 0), which then stands
+/// for both; without one it moves to 0 s. A key outside the period is an
+/// error.
+fn one_period(
+    times: &[Real],
+    mut columns: Vec<Vec<Real>>,
+    keys: &[KeySpec],
+    period: Real,
+    fps: Real,
+) -> std::result::Result<(Vec<Real>, Vec<Vec<Real>>), KeyError> {
+    let half_frame = 0.5 / fps;
+    let at_end = |t: Real| (t - period).abs() < half_frame;
+    if let Some(k) = times
+        .iter()
+        .position(|&t| t < 0.0 || (t > period && !at_end(t)))
+    {
+        let period = (period * 1e6).round() / 1e6;
+        let message = format!(
+            "a looping film's keys lie within its one period, 0 s to {period} s (frames / fps), \
+             got {}; the loop repeats them every {period} s",
+            times[k]
+        );
+        return Err((k, "time", message));
+    }
+    let mut times = times.to_vec();
+    let last = times.len() - 1;
+    if !at_end(times[last]) {
+        return Ok((times, columns));
+    }
+    times.pop();
+    let end_values: Vec<Real> = columns.iter_mut().filter_map(|c| c.pop()).collect();
+    if last > 0 && times[0] < half_frame {
+        let (end, start) = (&keys[last].value, &keys[0].value);
+        let same = start
+            .components()
+            .iter()
+            .zip(end.components())
+            .all(|(a, b)| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0));
+        if !same {
+            let message = format!(
+                "in a looping film the key at its end ({} s) is the key at 0 s again, so it \
+                 must have the same value: {} here, {} at 0 s (or leave one of them out)",
+                keys[last].time,
+                end.shown(),
+                start.shown()
+            );
+            return Err((last, "value", message));
+        }
+    } else {
+        times.insert(0, 0.0);
+        for (c, v) in columns.iter_mut().zip(end_values) {
+            c.insert(0, v);
+        }
+    }
+    Ok((times, columns))
+}
+
 /// Builds the spline of one component. Phantom keys are mirrored beyond both
 /// ends so Catmull–Rom, which needs a neighbour on each side, covers the first
 /// and last segments too. With a `period` (a looping film; `times` in
@@ -940,67 +1005,12 @@ impl Timeline {
             let period = file.looping.then_some(frame_count as Real / file.fps);
             // The keys the splines go through: in a looping film, those of
             // one period, in [0, period).
-            let (mut loop_times, mut loop_columns) = (times.clone(), columns);
-            if let Some(period) = period {
-                let last = times.len() - 1;
-                // A key written at the period's end is the loop's start
-                // again: within half a frame of it, since `duration_seconds`
-                // is rounded to whole frames (4 s at 29.97 fps is 120 frames,
-                // a period of 4.004 s), and no frame lies between.
-                let at_end = |t: Real| (t - period).abs() < 0.5 / file.fps;
-                let seconds = |t: Real| (t * 1e6).round() / 1e6;
-                for (k, &time) in times.iter().enumerate() {
-                    if time < 0.0 || (time > period && !at_end(time)) {
-                        let period = seconds(period);
-                        return Err(at(
-                            format!(".keys[{k}].time"),
-                            Some(k),
-                            format!(
-                                "a looping film's keys lie within its one period, 0 s to \
-                                 {period} s (frames / fps), got {time}; the loop repeats \
-                                 them every {period} s"
-                            ),
-                        ));
-                    }
-                }
-                if at_end(times[last]) {
-                    let (end, start) = (&spec.keys[last].value, &spec.keys[0].value);
-                    // A first key within half a frame of 0 is the start's.
-                    if times[0] < 0.5 / file.fps && last > 0 {
-                        let (values, start_values) = (end.components(), start.components());
-                        let same = start_values
-                            .iter()
-                            .zip(&values)
-                            .all(|(a, b)| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0));
-                        if !same {
-                            return Err(at(
-                                format!(".keys[{last}].value"),
-                                Some(last),
-                                format!(
-                                    "in a looping film the key at its end ({} s) is the key at \
-                                     0 s again, so it must have the same value: {} here, {} at \
-                                     0 s (or leave one of them out)",
-                                    times[last],
-                                    end.shown(),
-                                    start.shown()
-                                ),
-                            ));
-                        }
-                        loop_times.pop();
-                        loop_columns.iter_mut().for_each(|c| {
-                            c.pop();
-                        });
-                    } else {
-                        // The only key at the start: it moves to 0 s.
-                        loop_times.pop();
-                        loop_times.insert(0, 0.0);
-                        for c in &mut loop_columns {
-                            let v = c.pop().expect("a key per column");
-                            c.insert(0, v);
-                        }
-                    }
-                }
-            }
+            let (loop_times, loop_columns) = match period {
+                Some(period) => one_period(&times, columns, &spec.keys, period, file.fps).map_err(
+                    |(k, what, message)| at(format!(".keys[{k}].{what}"), Some(k), message),
+                )?,
+                None => (times.clone(), columns),
+            };
             let splines = loop_columns
                 .iter()
                 .map(|c| build_spline(&loop_times, c, interpolation, period))

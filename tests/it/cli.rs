@@ -463,7 +463,8 @@ fn a_track_whose_keys_all_lie_outside_the_film_is_warned_of() {
     assert!(!stdout(&d.ok(&["info", "across.ron"])).contains("warning"));
     assert!(!stderr(&d.ok(&["render", "across.ron"])).contains("warning"));
     // In a looping film keys after the last frame still animate it: the
-    // track wraps (frame 0 is at the 5 s key, which the end key closes to).
+    // track wraps (its period is 3 frames, 0.125 s: the key there is the
+    // start's, so frame 0 is 8 and the power falls to 4 at 0.1 s).
     let looped = timeline("(time: 0.1, value: 4), (time: 0.125, value: 8)")
         .replace("size: (16, 9),", "size: (16, 9), loop: true,");
     d.write("looped.ron", &looped);
