@@ -15,11 +15,12 @@ pub enum Error {
         message: String,
     },
     /// The timeline parses but a value is unusable.
-    #[error("{file}{}: {path}: {message}", line.map(|l| format!(":{l}")).unwrap_or_default())]
+    #[error("{file}{}: {path}: {message}", place.map(|p| format!(":{}:{}", p.line, p.column)).unwrap_or_default())]
     Invalid {
         file: PathBuf,
-        /// Line of the offending item in the file, where it can be found.
-        line: Option<usize>,
+        /// Where the offending value is written, or the block that would
+        /// hold it where a default is at fault.
+        place: Option<crate::spans::Place>,
         /// Field path, e.g. `tracks["camera.position"].keys[3].time`.
         path: String,
         message: String,

@@ -9,6 +9,7 @@
 use crate::error::{Error, Result};
 use crate::math::{DVec3, Real, Vec3};
 use crate::scene::Scene;
+use crate::spans::{self, Place};
 use serde::{Deserialize, Serialize};
 use splines::{Key, Spline};
 use std::collections::BTreeMap;
@@ -240,13 +241,22 @@ fn code_columns(text: &str) -> Vec<Vec<usize>> {
 /// it starts, and our own types by what they are rather than their names.
 fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), String) {
     use ron::error::Error as Ron;
-    let (line, column) = (e.span.start.line, e.span.start.col);
+    let (mut line, mut column) = (e.span.start.line, e.span.start.col);
     let row = |line: usize| text.lines().nth(line.wrapping_sub(1)).unwrap_or("");
     let before = |line: usize, column: usize| -> String {
         row(line).chars().take(column.saturating_sub(1)).collect()
     };
-    // The `name:` (or `"track.name":`) whose value the error is in, on its line.
-    let field = {
+    // The field the error is in, by its path where the text is RON (a value
+    // of the wrong shape); else the `name:` before it on its line.
+    let typed = spans::path_at(text, line, column).filter(|path| !path.is_empty());
+    if let Some(at) = typed
+        .as_ref()
+        .and_then(|_| spans::next_code(text, line, column))
+    {
+        // RON stops before the value of the wrong shape; point at the value.
+        (line, column) = (at.line, at.column);
+    }
+    let field = typed.map(|path| format!("`{path}`: ")).or_else(|| {
         let head = before(line, column);
         head.rfind(':').and_then(|colon| {
             let name = head[..colon].trim_end().trim_end_matches('"');
@@ -259,7 +269,7 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
                 .filter(|n| !n.is_empty())
                 .map(|n| format!("`{n}`: "))
         })
-    };
+    });
     let in_field = field.clone().unwrap_or_default();
     let named = |message: String| {
         // Our types as a timeline's author knows them.
@@ -320,7 +330,7 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         }
         Ron::IntegerOutOfBounds => {
             let head = before(line, column + 1);
-            let most = if in_field == "`seed`: " {
+            let most = if in_field.ends_with("seed`: ") {
                 u64::MAX.to_string()
             } else {
                 u32::MAX.to_string()
@@ -346,7 +356,7 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         | Ron::InvalidValueForType { .. } => {
             ((line, column), named(format!("{in_field}{}", e.code)))
         }
-        code => ((line, column), named(code.to_string())),
+        code => ((line, column), named(format!("{in_field}{code}"))),
     }
 }
 
@@ -783,19 +793,18 @@ impl Timeline {
                 message,
             }
         })?;
-        let invalid = |line: Option<usize>, field: String, message: String| Error::Invalid {
+        let invalid = |place: Option<Place>, field: String, message: String| Error::Invalid {
             file: path.to_path_buf(),
-            line,
+            place,
             path: field,
             message,
         };
+        // A top-level field where it is written, else the timeline's `(`.
         let top = |field: &str, message: String| {
-            invalid(
-                line_of(text, &format!("{field}:"), 0),
-                field.to_string(),
-                message,
-            )
+            let place = spans::nearest(text, field).map(|(_, place)| place);
+            invalid(place, field.to_string(), message)
         };
+        let value = |field: &str, message: String| invalid_value(text, path, field, message);
 
         // Past a thousand frames a second no player or encoder keeps up
         // (ffmpeg's -framerate among them).
@@ -871,47 +880,31 @@ impl Timeline {
             } else {
                 map_path.clone()
             };
-            let field = "scene.effects.path_tracing.sky".to_string();
-            let line = line_of(text, "Environment", 0);
-            let bytes = std::fs::read(&resolved).map_err(|e| {
-                invalid(
-                    line,
-                    field.clone(),
-                    format!("cannot read {}: {e}", resolved.display()),
-                )
-            })?;
+            let field = "scene.effects.path_tracing.sky.path";
+            let bytes = std::fs::read(&resolved)
+                .map_err(|e| value(field, format!("cannot read {}: {e}", resolved.display())))?;
             use sha2::Digest;
             *digest = sha2::Sha256::digest(&bytes)
                 .iter()
                 .map(|b| format!("{b:02x}"))
                 .collect();
             crate::environment::cached(&resolved, digest)
-                .map_err(|e| invalid(line, field, format!("not a usable environment map: {e}")))?;
+                .map_err(|e| value(field, format!("not a usable environment map: {e}")))?;
             *map_path = resolved;
         }
         if let Err((field, message)) = validate_scene(&file.scene) {
-            // The field's own name; inside a list, the list's
-            // (`extra_lights[0].direction` is on the line of `extra_lights:`).
-            let listed = field.split_once('[').map(|(list, _)| list);
-            let name = listed.unwrap_or(&field).rsplit('.').next().unwrap_or("");
-            let line = line_of(text, &format!("{name}:"), 0);
-            return Err(invalid(line, format!("scene.{field}"), message));
+            return Err(value(&format!("scene.{field}"), message));
         }
 
         let mut tracks = Vec::new();
         for (name, spec) in &file.tracks {
-            let track_line = line_of(text, &format!("\"{name}\""), 0);
-            let at = |what: String, key: Option<usize>, message: String| {
-                let line = key
-                    .and_then(|k| nth_line_after(text, &format!("\"{name}\""), "time", k))
-                    .or(track_line);
-                invalid(line, format!("tracks[\"{name}\"]{what}"), message)
+            let at = |what: String, message: String| {
+                value(&format!("tracks[\"{name}\"]{what}"), message)
             };
             let Some(&(_, arity)) = PARAMETERS.iter().find(|(p, _)| p == name) else {
                 let known: Vec<&str> = PARAMETERS.iter().map(|(p, _)| *p).collect();
                 return Err(at(
                     String::new(),
-                    None,
                     format!(
                         "no such parameter; tracks can animate: {}",
                         known.join(", ")
@@ -925,17 +918,12 @@ impl Timeline {
                 if !file.scene.effects.enabled().contains(&effect) {
                     return Err(at(
                         String::new(),
-                        None,
                         format!("animates the {effect} effect, which the scene does not enable: add `{effect}: ()` to scene.effects"),
                     ));
                 }
             }
             if spec.keys.is_empty() {
-                return Err(at(
-                    ".keys".into(),
-                    None,
-                    "a track needs at least one key".into(),
-                ));
+                return Err(at(".keys".into(), "a track needs at least one key".into()));
             }
             let log_space = name == ZOOM_TRACK;
             let mut times = Vec::with_capacity(spec.keys.len());
@@ -944,7 +932,6 @@ impl Timeline {
                 if !key.time.is_finite() {
                     return Err(at(
                         format!(".keys[{k}].time"),
-                        Some(k),
                         format!(
                             "must be a finite number of seconds, got {}",
                             key.time.shown()
@@ -955,7 +942,6 @@ impl Timeline {
                     if key.time <= prev {
                         return Err(at(
                             format!(".keys[{k}].time"),
-                            Some(k),
                             format!("key times must increase: {} follows {prev}", key.time),
                         ));
                     }
@@ -972,21 +958,18 @@ impl Timeline {
                 if values.len() != arity {
                     return Err(at(
                         format!(".keys[{k}].value"),
-                        Some(k),
                         format!("{name} takes {}, got {}", shape(arity), shape(values.len())),
                     ));
                 }
                 if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
                     return Err(at(
                         format!(".keys[{k}].value"),
-                        Some(k),
                         format!("values must be finite, got {}", bad.shown()),
                     ));
                 }
                 if log_space && values[0] <= 0.0 {
                     return Err(at(
                         format!(".keys[{k}].value"),
-                        Some(k),
                         format!(
                             "a camera distance must be positive, got {}",
                             values[0].shown()
@@ -1006,9 +989,8 @@ impl Timeline {
             // The keys the splines go through: in a looping film, those of
             // one period, in [0, period).
             let (loop_times, loop_columns) = match period {
-                Some(period) => one_period(&times, columns, &spec.keys, period, file.fps).map_err(
-                    |(k, what, message)| at(format!(".keys[{k}].{what}"), Some(k), message),
-                )?,
+                Some(period) => one_period(&times, columns, &spec.keys, period, file.fps)
+                    .map_err(|(k, what, message)| at(format!(".keys[{k}].{what}"), message))?,
                 None => (times.clone(), columns),
             };
             let splines = loop_columns
@@ -1091,17 +1073,14 @@ impl Timeline {
                     })
                 });
                 if let Some((track, k, message)) = bad_key {
-                    let quoted = format!("\"{}\"", track.name);
-                    return Err(invalid(
-                        nth_line_after(text, &quoted, "time", k).or(line_of(text, &quoted, 0)),
-                        format!("tracks[{quoted}].keys[{k}].value"),
-                        message,
-                    ));
+                    let key = format!("tracks[\"{}\"].keys[{k}].value", track.name);
+                    return Err(value(&key, message));
                 }
                 let animated: Vec<String> =
                     culprits.iter().map(|t| format!("\"{}\"", t.name)).collect();
+                let track_place = |name: &String| spans::place_of(text, &format!("tracks[{name}]"));
                 return Err(invalid(
-                    animated.first().and_then(|n| line_of(text, n, 0)),
+                    animated.first().and_then(track_place),
                     format!("frame {frame} (t = {time:.4} s): scene.{field}"),
                     format!(
                         "{message}{}",
@@ -1562,37 +1541,25 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
     Ok(())
 }
 
-/// 1-based line of the first occurrence of `needle` at or after byte `from`.
-fn line_of(text: &str, needle: &str, from: usize) -> Option<usize> {
-    let at = from + text.get(from..)?.find(needle)?;
-    Some(text[..at].matches('\n').count() + 1)
-}
-
-/// Line of the `k`-th (0-based) `word` after the first `anchor`: locates a key
-/// inside a track. Words in comments do not count (`// at this time …`).
-fn nth_line_after(text: &str, anchor: &str, word: &str, k: usize) -> Option<usize> {
-    // The text with every comment character blanked, lines kept.
-    let code = code_columns(text);
-    let text: String = text
-        .lines()
-        .zip(&code)
-        .map(|(row, columns)| {
-            let blanked = row.chars().enumerate().map(|(i, c)| {
-                if columns.binary_search(&(i + 1)).is_ok() {
-                    c
-                } else {
-                    ' '
-                }
-            });
-            blanked.chain(['\n']).collect::<String>()
-        })
-        .collect();
-    let text = text.as_str();
-    let mut at = text.find(anchor)?;
-    for _ in 0..=k {
-        at += text[at..].find(word)? + word.len();
+/// The error for the value at `field`, a path into the file: at the
+/// value's line and column, or, where the file leaves the field to its
+/// default, at the block that would hold it, saying so.
+fn invalid_value(text: &str, file: &Path, field: &str, message: String) -> Error {
+    let steps = spans::steps(field);
+    let (place, message) = match spans::nearest(text, field) {
+        Some((found, place)) if found < steps.len() => {
+            let name = spans::path_of(&steps[found..]);
+            let note = format!(" (`{name}` is not given here, so it takes its default)");
+            (Some(place), message + &note)
+        }
+        found => (found.map(|(_, place)| place), message),
+    };
+    Error::Invalid {
+        file: file.to_path_buf(),
+        place,
+        path: field.to_string(),
+        message,
     }
-    line_of(text, word, at - word.len())
 }
 
 #[cfg(test)]
@@ -1757,14 +1724,14 @@ mod tests {
             "{e}"
         );
         let e = error_of("(fps: 24, frames: 3, size: (8, -6))");
-        assert!(e.contains("`size`: must be 0 or more"), "{e}");
+        assert!(e.contains("`size[1]`: must be 0 or more"), "{e}");
         let e = error_of("(fps: 24, frames: 99999999999, size: (8, 6))");
         assert!(
             e.ends_with("`frames`: too large: at most 4294967295"),
             "{e}"
         );
         let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: \"8\")))");
-        assert!(e.contains("`power`: Expected float"), "{e}");
+        assert!(e.contains("`scene.fractal.power`: Expected float"), "{e}");
         // Keys written as tuples, and our own type names.
         let e = error_of(&with_track("\"fractal.power\": (keys: [(0, 8)])"));
         assert!(
@@ -1900,7 +1867,7 @@ mod tests {
         let text = "(fps: 10, frames: 3, size: (8, 6), tracks: {\n  \"fractal.power\": (keys: [\n    (time: 0, value: 8),\n    (time: 1, value: 7),\n    (time: 1, value: 6),\n  ]),\n})";
         let e = error_of(text);
         assert!(
-            e.starts_with("test.ron:5: tracks[\"fractal.power\"].keys[2].time"),
+            e.starts_with("test.ron:5:12: tracks[\"fractal.power\"].keys[2].time"),
             "{e}"
         );
     }
@@ -1987,7 +1954,7 @@ mod tests {
         let past = looping(&ORBIT.replace("time: 6.0", "time: 6.5"));
         let e = error_of(&past);
         assert!(
-            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].time: a looping film's keys lie within its one period, 0 s to 6 s (frames / fps), got 6.5; the loop repeats them every 6 s"),
+            e.starts_with("test.ron:6:16: tracks[\"camera.position\"].keys[4].time: a looping film's keys lie within its one period, 0 s to 6 s (frames / fps), got 6.5; the loop repeats them every 6 s"),
             "{e}"
         );
         let before = looping(&ORBIT.replace("time: 0.0", "time: -0.5"));
@@ -2003,7 +1970,7 @@ mod tests {
         ));
         let e = error_of(&torn);
         assert!(
-            e.starts_with("test.ron:6: tracks[\"camera.position\"].keys[4].value: in a looping film the key at its end (6 s) is the key at 0 s again, so it must have the same value: (3, 0.8, 0) here, (3.1, 0.8, 0) at 0 s (or leave one of them out)"),
+            e.starts_with("test.ron:6:28: tracks[\"camera.position\"].keys[4].value: in a looping film the key at its end (6 s) is the key at 0 s again, so it must have the same value: (3, 0.8, 0) here, (3.1, 0.8, 0) at 0 s (or leave one of them out)"),
             "{e}"
         );
         // Without the loop, the same keys are fine.
@@ -2039,7 +2006,7 @@ mod tests {
         let text = "(fps: 10, frames: 3, size: (8, 6), tracks: {\n  \"fractal.power\": (keys: [\n    (time: 0, value: 8),\n    // at this time the bulb swells\n    (time: 1, value: 7),\n    (time: 1, value: 6),\n  ]),\n})";
         let e = error_of(text);
         assert!(
-            e.starts_with("test.ron:6: tracks[\"fractal.power\"].keys[2].time"),
+            e.starts_with("test.ron:6:12: tracks[\"fractal.power\"].keys[2].time"),
             "{e}"
         );
     }
@@ -2104,7 +2071,7 @@ mod tests {
         let e = error_of(&with_track(
             "\"camera.fov_degrees\": (keys: [(time: 0, value: 40), (time: 0.5, value: 175), (time: 0.7, value: 178), (time: 1, value: 60)]),\n\"camera.distance\": (keys: [(time: 0, value: 4), (time: 0.6, value: 3)])",
         ));
-        let frame = "test.ron:1: frame 6 (t = 0.6000 s): scene.camera.fov_degrees: must be from 1e-7 to below 179 degrees, got 187.1";
+        let frame = "test.ron:1:69: frame 6 (t = 0.6000 s): scene.camera.fov_degrees: must be from 1e-7 to below 179 degrees, got 187.1";
         assert!(e.starts_with(frame), "{e}");
         assert!(e.ends_with("(set by track \"camera.fov_degrees\")"), "{e}");
     }
@@ -2115,7 +2082,7 @@ mod tests {
         let text = "(fps: 24, frames: 24, size: (8, 6), tracks: {\n  \"fractal.power\": (interpolation: Linear, keys: [\n    (time: 0, value: 8),\n    (time: 0.5, value: 4),\n    (time: 1, value: 90),\n  ]),\n})";
         assert_eq!(
             error_of(text),
-            "test.ron:5: tracks[\"fractal.power\"].keys[2].value: must be between 1 and 64, got 90"
+            "test.ron:5:22: tracks[\"fractal.power\"].keys[2].value: must be between 1 and 64, got 90"
         );
     }
 
@@ -2262,9 +2229,10 @@ mod tests {
         let zoom = "\"camera.distance\": (keys: [(time: 0, value: 3), (time: 1, value: 2)])";
         for tracks in [position.to_string(), format!("\n{zoom},\n{position}")] {
             let text = with_track(&tracks).replace("size: (8, 6),", "size: (8, 6),\n");
-            let line = line_of(&text, "\"camera.position\"", 0).unwrap();
+            let at = spans::place_of(&text, "tracks[\"camera.position\"]").unwrap();
             let e = parse(&text).unwrap_err().to_string();
-            assert!(e.starts_with(&format!("test.ron:{line}: frame 0 ")), "{e}");
+            let want = format!("test.ron:{}:{}: frame 0 ", at.line, at.column);
+            assert!(e.starts_with(&want), "{e}");
             assert!(
                 e.contains("coincide") && e.contains("\"camera.position\""),
                 "{e}"
@@ -2274,7 +2242,7 @@ mod tests {
         let text = "(fps: 10, frames: 2, size: (8, 6),\n scene: (look: (\n extra_lights: [(direction: (1, 1, 1), colour: (1, 1, 1), intensity: -1)])))";
         let e = parse(text).unwrap_err().to_string();
         assert!(
-            e.starts_with("test.ron:3: scene.look.extra_lights[0]"),
+            e.starts_with("test.ron:3:17: scene.look.extra_lights[0]"),
             "{e}"
         );
     }
@@ -2287,7 +2255,7 @@ mod tests {
             .to_string();
         assert_eq!(
             e,
-            "test.ron:2:12: `size`: expected a whole number here, got 320.5"
+            "test.ron:2:12: `size[0]`: expected a whole number here, got 320.5"
         );
         let e = parse("(fps: 10, frames: 2.5, size: (8, 6))")
             .unwrap_err()

@@ -154,7 +154,7 @@ fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
 fn frame_rates_past_a_thousand_are_refused() {
     for fps in ["1e300", "4294967296", "1000.5"] {
         let text = tiny_timeline(2, 6.0).replace("fps: 24", &format!("fps: {fps}"));
-        rejected(&text, &[], 3, &["bad.ron:2: fps", "(0, 1000]"]);
+        rejected(&text, &[], 3, &["bad.ron:2:10: fps", "(0, 1000]"]);
     }
 }
 
@@ -208,7 +208,7 @@ fn zero_or_negative_fps_size_fov_are_rejected() {
         &tiny_timeline(2, 6.0).replace("fps: 24", "fps: 0"),
         &[],
         3,
-        &["bad.ron:2: fps"],
+        &["bad.ron:2:10: fps"],
     );
     rejected(
         &tiny_timeline(2, 6.0).replace("size: (48, 27)", "size: (0, 27)"),
@@ -342,6 +342,6 @@ fn a_blurred_frames_own_instant_is_checked_too() {
         \"fractal.bailout\": (interpolation: Linear, keys: [(time: 0, value: 4), (time: 1, value: 0.9), (time: 1.01, value: 4)]),
     },
 )";
-    let key = "bad.ron:7: tracks[\"fractal.bailout\"].keys[1].value: must be a finite number above 1, got 0.9";
+    let key = "bad.ron:7:97: tracks[\"fractal.bailout\"].keys[1].value: must be a finite number above 1, got 0.9";
     rejected(timeline, &[], 3, &[key]);
 }

@@ -1,0 +1,437 @@
+//! Where a value stands in a RON document, as RON's own parser reads it:
+//! the line and column of the value at a field path, and the field path of
+//! the value at a line and column. Each level is read as `RawValue`s, slices
+//! of the document's text, so comments and same-named fields elsewhere
+//! never match.
+
+use ron::value::RawValue;
+use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+
+/// One step of a field path: `.name`, `[3]` or `["camera.position"]`.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Step {
+    Field(String),
+    Index(usize),
+    Key(String),
+}
+
+/// A place in the text: 1-based line and column (columns count characters,
+/// as RON's do).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Place {
+    pub line: usize,
+    pub column: usize,
+}
+
+/// The steps of a field path as messages write them:
+/// `scene.extra_lights[0].direction`, `tracks["camera.position"].keys[3]`.
+/// A step that cannot be read ends the path there.
+pub fn steps(path: &str) -> Vec<Step> {
+    let mut steps = Vec::new();
+    let mut rest = path;
+    while !rest.is_empty() {
+        if let Some(quoted) = rest.strip_prefix("[\"") {
+            let Some(end) = quoted.find("\"]") else { break };
+            steps.push(Step::Key(quoted[..end].to_string()));
+            rest = &quoted[end + 2..];
+        } else if let Some(indexed) = rest.strip_prefix('[') {
+            let Some(end) = indexed.find(']') else { break };
+            let Ok(i) = indexed[..end].parse() else { break };
+            steps.push(Step::Index(i));
+            rest = &indexed[end + 1..];
+        } else {
+            let name = rest.strip_prefix('.').unwrap_or(rest);
+            let end = name.find(['.', '[']).unwrap_or(name.len());
+            steps.push(Step::Field(name[..end].to_string()));
+            rest = &name[end..];
+        }
+    }
+    steps
+}
+
+/// Writes steps back as a field path.
+pub fn path_of(steps: &[Step]) -> String {
+    let mut path = String::new();
+    for step in steps {
+        match step {
+            Step::Field(name) if path.is_empty() => path.push_str(name),
+            Step::Field(name) => {
+                path.push('.');
+                path.push_str(name);
+            }
+            Step::Index(i) => path.push_str(&format!("[{i}]")),
+            Step::Key(key) => path.push_str(&format!("[\"{key}\"]")),
+        }
+    }
+    path
+}
+
+/// Where the value at `path` starts, or `None` where the document does
+/// not give it (a default) or is not RON.
+pub fn place_of(text: &str, path: &str) -> Option<Place> {
+    let wanted = steps(path);
+    let (found, at) = deepest(text, &wanted)?;
+    (found == wanted.len()).then(|| place(text, at))
+}
+
+/// The deepest part of `path` the document gives: how many steps of it,
+/// and where that value starts (the whole document for none).
+pub fn nearest(text: &str, path: &str) -> Option<(usize, Place)> {
+    let (found, at) = deepest(text, &steps(path))?;
+    Some((found, place(text, at)))
+}
+
+/// The field path of the innermost value at `line`:`column`, where the
+/// document is RON (a value of the wrong shape for its field is still RON).
+/// White space and comments there count as the value after them.
+pub fn path_at(text: &str, line: usize, column: usize) -> Option<String> {
+    let offset = skip_blank(text, offset_of(text, line, column)?);
+    let mut node = Node::read(text)?;
+    let mut path = Vec::new();
+    loop {
+        let inside = |raw: &&str| {
+            let start = raw.as_ptr() as usize - text.as_ptr() as usize;
+            (start..start + raw.len()).contains(&offset)
+        };
+        let Some((step, raw)) = node.children.into_iter().find(|(_, raw)| inside(raw)) else {
+            return Some(path_of(&path));
+        };
+        path.push(step);
+        match Node::read(raw) {
+            Some(child) => node = child,
+            None => return Some(path_of(&path)),
+        }
+    }
+}
+
+/// `line`:`column` moved past white space and comments to the code after them.
+pub fn next_code(text: &str, line: usize, column: usize) -> Option<Place> {
+    Some(place(
+        text,
+        skip_blank(text, offset_of(text, line, column)?),
+    ))
+}
+
+/// How many of `wanted`'s steps the document gives, and the byte offset
+/// of the deepest value found.
+fn deepest(text: &str, wanted: &[Step]) -> Option<(usize, usize)> {
+    let mut raw = text;
+    if wanted.is_empty() {
+        Node::read(raw)?;
+    }
+    for (depth, step) in wanted.iter().enumerate() {
+        let Some(node) = Node::read(raw) else {
+            // Text that is not RON has no places; a leaf has no fields.
+            return (depth > 0).then(|| (depth, start_of(text, raw)));
+        };
+        let matches = |s: &Step| match (s, step) {
+            (Step::Index(a), Step::Index(b)) => a == b,
+            (Step::Field(a) | Step::Key(a), Step::Field(b) | Step::Key(b)) => a == b,
+            _ => false,
+        };
+        match node.children.into_iter().find(|(s, _)| matches(s)) {
+            Some((_, child)) => raw = child,
+            None => return Some((depth, start_of(text, raw))),
+        }
+    }
+    Some((wanted.len(), start_of(text, raw)))
+}
+
+/// The byte offset in `text` where the value `raw` (a slice of it) starts,
+/// past any comments RON kept in front of it.
+fn start_of(text: &str, raw: &str) -> usize {
+    skip_blank(text, raw.as_ptr() as usize - text.as_ptr() as usize)
+}
+
+/// `at` moved past white space and comments.
+fn skip_blank(text: &str, mut at: usize) -> usize {
+    loop {
+        let rest = &text[at..];
+        let trimmed = rest.trim_start();
+        at += rest.len() - trimmed.len();
+        if trimmed.starts_with("//") {
+            at += trimmed.find('\n').unwrap_or(trimmed.len());
+        } else if trimmed.starts_with("/*") {
+            at += block_comment_len(trimmed);
+        } else {
+            return at;
+        }
+    }
+}
+
+/// The length of the block comment `text` starts with (RON's nest).
+fn block_comment_len(text: &str) -> usize {
+    let mut depth = 0usize;
+    let mut i = 0;
+    let bytes = text.as_bytes();
+    while i < bytes.len() {
+        match (bytes[i], bytes.get(i + 1)) {
+            (b'/', Some(b'*')) => {
+                depth += 1;
+                i += 2;
+            }
+            (b'*', Some(b'/')) => {
+                depth -= 1;
+                i += 2;
+                if depth == 0 {
+                    return i;
+                }
+            }
+            _ => i += 1,
+        }
+    }
+    text.len()
+}
+
+fn place(text: &str, offset: usize) -> Place {
+    let before = &text[..offset];
+    let line_start = before.rfind('\n').map_or(0, |i| i + 1);
+    Place {
+        line: before.matches('\n').count() + 1,
+        column: before[line_start..].chars().count() + 1,
+    }
+}
+
+fn offset_of(text: &str, line: usize, column: usize) -> Option<usize> {
+    let line_start = if line <= 1 {
+        0
+    } else {
+        text.match_indices('\n').nth(line - 2)?.0 + 1
+    };
+    let row = &text[line_start..];
+    let within = row
+        .char_indices()
+        .nth(column.saturating_sub(1))
+        .map_or(row.len(), |(i, _)| i);
+    Some(line_start + within)
+}
+
+/// One level of a document: its children by step, each a slice of the text.
+struct Node<'a> {
+    children: Vec<(Step, &'a str)>,
+}
+
+impl<'a> Node<'a> {
+    /// `raw` read as one RON value; `None` where it is not RON.
+    fn read(raw: &'a str) -> Option<Node<'a>> {
+        let options = ron::Options::default()
+            .with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+        let braced = raw[skip_blank(raw, 0)..].starts_with('{');
+        let level: Level = options.from_str(raw).ok()?;
+        let children = match level {
+            Level::Fields(fields) => fields
+                .into_iter()
+                .map(|(name, value)| {
+                    let step = if braced {
+                        Step::Key(name)
+                    } else {
+                        Step::Field(name)
+                    };
+                    (step, value.get_ron())
+                })
+                .collect(),
+            Level::Items(items) => items
+                .into_iter()
+                .enumerate()
+                .map(|(i, value)| (Step::Index(i), value.get_ron()))
+                .collect(),
+            Level::Leaf => Vec::new(),
+        };
+        Some(Node { children })
+    }
+}
+
+/// A value read one level deep: named fields (a struct or map), items (a
+/// tuple or list), or a leaf. `Some(x)` is read as `x`, as the schema's
+/// paths name it.
+enum Level<'a> {
+    Fields(Vec<(String, &'a RawValue)>),
+    Items(Vec<&'a RawValue>),
+    Leaf,
+}
+
+impl<'de> Deserialize<'de> for Level<'de> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        d.deserialize_any(LevelVisitor)
+    }
+}
+
+struct LevelVisitor;
+
+impl<'de> Visitor<'de> for LevelVisitor {
+    type Value = Level<'de>;
+
+    fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        f.write_str("any RON value")
+    }
+
+    fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<Level<'de>, A::Error> {
+        let mut fields = Vec::new();
+        while let Some(Name(name)) = map.next_key()? {
+            fields.push((name, map.next_value()?));
+        }
+        Ok(Level::Fields(fields))
+    }
+
+    fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Level<'de>, A::Error> {
+        let mut items = Vec::new();
+        while let Some(item) = seq.next_element()? {
+            items.push(item);
+        }
+        Ok(Level::Items(items))
+    }
+
+    fn visit_some<D: Deserializer<'de>>(self, d: D) -> Result<Level<'de>, D::Error> {
+        Level::deserialize(d)
+    }
+
+    fn visit_enum<A: serde::de::EnumAccess<'de>>(self, _: A) -> Result<Level<'de>, A::Error> {
+        Ok(Level::Leaf)
+    }
+
+    fn visit_bool<E>(self, _: bool) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_i64<E>(self, _: i64) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_u64<E>(self, _: u64) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_i128<E>(self, _: i128) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_u128<E>(self, _: u128) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_f64<E>(self, _: f64) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_char<E>(self, _: char) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_str<E>(self, _: &str) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_bytes<E>(self, _: &[u8]) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_none<E>(self) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+    fn visit_unit<E>(self) -> Result<Level<'de>, E> {
+        Ok(Level::Leaf)
+    }
+}
+
+/// A field name or a map's key, whichever way RON hands it over.
+struct Name(String);
+
+impl<'de> Deserialize<'de> for Name {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Text;
+        impl Visitor<'_> for Text {
+            type Value = Name;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a field name or a string key")
+            }
+            fn visit_str<E>(self, s: &str) -> Result<Name, E> {
+                Ok(Name(s.to_string()))
+            }
+        }
+        d.deserialize_any(Text)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const DOC: &str = "// fps: 24 in a comment\n\
+        (\n\
+        \x20   size: (8, 8),\n\
+        \x20   fps: /* fps: 1 */ 24,\n\
+        \x20   scene: (\n\
+        \x20       camera: (aperture_radius: 0.1, up: Some((0, 0, 1))),\n\
+        \x20       effects: (ambient_occlusion: (radius: 0.2)),\n\
+        \x20   ),\n\
+        \x20   tracks: {\n\
+        \x20       \"camera.fov_degrees\": (keys: [\n\
+        \x20           (time: 0, value: 40),\n\
+        \x20           (time: 1, value: 30),\n\
+        \x20       ]),\n\
+        \x20   },\n\
+        )\n";
+
+    fn at(line: usize, column: usize) -> Option<Place> {
+        Some(Place { line, column })
+    }
+
+    #[test]
+    fn paths_read_back_as_written() {
+        for path in [
+            "fps",
+            "scene.extra_lights[0].direction",
+            "tracks[\"camera.position\"].keys[3].time",
+        ] {
+            assert_eq!(path_of(&steps(path)), path);
+        }
+        assert_eq!(
+            steps("tracks[\"a.b\"].keys[2]"),
+            vec![
+                Step::Field("tracks".into()),
+                Step::Key("a.b".into()),
+                Step::Field("keys".into()),
+                Step::Index(2)
+            ]
+        );
+    }
+
+    #[test]
+    fn a_value_is_found_where_it_stands_not_where_its_name_is_mentioned() {
+        assert_eq!(place_of(DOC, "fps"), at(4, 23));
+        assert_eq!(place_of(DOC, "size"), at(3, 11));
+        assert_eq!(place_of(DOC, "size[1]"), at(3, 15));
+        assert_eq!(place_of(DOC, "scene.camera.aperture_radius"), at(6, 35));
+        assert_eq!(place_of(DOC, "scene.camera.up[2]"), at(6, 56));
+        assert_eq!(
+            place_of(DOC, "scene.effects.ambient_occlusion.radius"),
+            at(7, 47)
+        );
+        assert_eq!(
+            place_of(DOC, "tracks[\"camera.fov_degrees\"].keys[1].value"),
+            at(12, 30)
+        );
+    }
+
+    #[test]
+    fn a_default_is_not_found_and_its_nearest_given_block_is() {
+        assert_eq!(
+            place_of(DOC, "scene.effects.ambient_occlusion.samples"),
+            None
+        );
+        assert_eq!(place_of(DOC, "scene.look"), None);
+        assert_eq!(
+            nearest(DOC, "scene.camera.position"),
+            Some((2, at(6, 17).unwrap()))
+        );
+        assert_eq!(nearest(DOC, "frames"), Some((0, at(2, 1).unwrap())));
+    }
+
+    #[test]
+    fn a_place_is_named_by_its_innermost_field() {
+        assert_eq!(path_at(DOC, 3, 15).as_deref(), Some("size[1]"));
+        assert_eq!(path_at(DOC, 4, 10).as_deref(), Some("fps"));
+        assert_eq!(
+            path_at(DOC, 12, 30).as_deref(),
+            Some("tracks[\"camera.fov_degrees\"].keys[1].value")
+        );
+        assert_eq!(path_at(DOC, 1, 5).as_deref(), Some(""));
+    }
+
+    #[test]
+    fn text_that_is_not_ron_has_no_places() {
+        assert_eq!(place_of("(fps: ", "fps"), None);
+        assert_eq!(path_at("(fps: ", 1, 2), None);
+    }
+}
