@@ -31,9 +31,14 @@ pub fn steps(path: &str) -> Vec<Step> {
     let mut rest = path;
     while !rest.is_empty() {
         if let Some(quoted) = rest.strip_prefix("[\"") {
-            let Some(end) = quoted.find("\"]") else { break };
-            steps.push(Step::Key(quoted[..end].to_string()));
-            rest = &quoted[end + 2..];
+            let Some((key, after)) = unquoted(quoted) else {
+                break;
+            };
+            steps.push(Step::Key(key));
+            let Some(after) = after.strip_prefix(']') else {
+                break;
+            };
+            rest = after;
         } else if let Some(indexed) = rest.strip_prefix('[') {
             let Some(end) = indexed.find(']') else { break };
             let Ok(i) = indexed[..end].parse() else { break };
@@ -49,6 +54,35 @@ pub fn steps(path: &str) -> Vec<Step> {
     steps
 }
 
+/// The key a path quotes as Rust's `{:?}` writes a string (its opening
+/// quote taken off already), and the text after its closing quote.
+fn unquoted(quoted: &str) -> Option<(String, &str)> {
+    let mut key = String::new();
+    let mut chars = quoted.char_indices();
+    while let Some((i, c)) = chars.next() {
+        match c {
+            '"' => return Some((key, &quoted[i + 1..])),
+            '\\' => match chars.next()?.1 {
+                'n' => key.push('\n'),
+                'r' => key.push('\r'),
+                't' => key.push('\t'),
+                '0' => key.push('\0'),
+                'u' => {
+                    let rest = &quoted[chars.next()?.0 + 1..];
+                    let end = rest.find('}')?;
+                    key.push(char::from_u32(u32::from_str_radix(&rest[..end], 16).ok()?)?);
+                    (0..=end).for_each(|_| {
+                        chars.next();
+                    });
+                }
+                other => key.push(other),
+            },
+            c => key.push(c),
+        }
+    }
+    None
+}
+
 /// Writes steps back as a field path.
 pub fn path_of(steps: &[Step]) -> String {
     let mut path = String::new();
@@ -60,7 +94,7 @@ pub fn path_of(steps: &[Step]) -> String {
                 path.push_str(name);
             }
             Step::Index(i) => path.push_str(&format!("[{i}]")),
-            Step::Key(key) => path.push_str(&format!("[\"{key}\"]")),
+            Step::Key(key) => path.push_str(&format!("[{key:?}]")),
         }
     }
     path
@@ -82,34 +116,41 @@ pub fn nearest(text: &str, path: &str) -> Option<(usize, Place)> {
 }
 
 /// The field path of the innermost value at `line`:`column`, where the
-/// document is RON (a value of the wrong shape for its field is still RON).
-/// White space and comments there count as the value after them.
-pub fn path_at(text: &str, line: usize, column: usize) -> Option<String> {
-    let offset = skip_blank(text, offset_of(text, line, column)?);
+/// document is RON (a value of the wrong shape for its field is still RON),
+/// and the place to show: the start of a value with nothing inside it, or
+/// of one that only white space separates from `line`:`column`.
+pub fn path_at(text: &str, line: usize, column: usize) -> Option<(String, Place)> {
+    let offset = offset_of(text, line, column)?;
     let mut node = Node::read(text)?;
-    let mut path = Vec::new();
+    let (mut path, mut shown) = (Vec::new(), offset);
+    let span = |raw: &str| {
+        let end = raw.as_ptr() as usize - text.as_ptr() as usize + raw.len();
+        start_of(text, raw)..end
+    };
+    let before = |start: usize| offset < start && text[offset..start].chars().all(is_blank);
     loop {
-        let inside = |raw: &&str| {
-            let start = raw.as_ptr() as usize - text.as_ptr() as usize;
-            (start..start + raw.len()).contains(&offset)
-        };
-        let Some((step, raw)) = node.children.into_iter().find(|(_, raw)| inside(raw)) else {
-            return Some(path_of(&path));
+        let found = node
+            .children
+            .into_iter()
+            .find(|(_, raw)| span(raw).contains(&offset) || before(span(raw).start));
+        let Some((step, raw)) = found else {
+            return Some((path_of(&path), place(text, shown)));
         };
         path.push(step);
+        let start = span(raw).start;
         match Node::read(raw) {
-            Some(child) => node = child,
-            None => return Some(path_of(&path)),
+            Some(child) if !child.children.is_empty() => {
+                node = child;
+                shown = shown.max(start);
+            }
+            _ => return Some((path_of(&path), place(text, start))),
         }
     }
 }
 
-/// `line`:`column` moved past white space and comments to the code after them.
-pub fn next_code(text: &str, line: usize, column: usize) -> Option<Place> {
-    Some(place(
-        text,
-        skip_blank(text, offset_of(text, line, column)?),
-    ))
+/// White space as RON skips it (Unicode's pattern white space).
+fn is_blank(c: char) -> bool {
+    c.is_whitespace() || matches!(c, '\u{200e}' | '\u{200f}')
 }
 
 /// How many of `wanted`'s steps the document gives, and the byte offset
@@ -147,7 +188,7 @@ fn start_of(text: &str, raw: &str) -> usize {
 fn skip_blank(text: &str, mut at: usize) -> usize {
     loop {
         let rest = &text[at..];
-        let trimmed = rest.trim_start();
+        let trimmed = rest.trim_start_matches(is_blank);
         at += rest.len() - trimmed.len();
         if trimmed.starts_with("//") {
             at += trimmed.find('\n').unwrap_or(trimmed.len());
@@ -420,18 +461,41 @@ mod tests {
 
     #[test]
     fn a_place_is_named_by_its_innermost_field() {
-        assert_eq!(path_at(DOC, 3, 15).as_deref(), Some("size[1]"));
-        assert_eq!(path_at(DOC, 4, 10).as_deref(), Some("fps"));
+        let named = |line, column| path_at(DOC, line, column).map(|(path, _)| path);
+        let fov_key = "tracks[\"camera.fov_degrees\"].keys[1].value";
+        assert_eq!(named(3, 15).as_deref(), Some("size[1]"));
+        assert_eq!(named(12, 30).as_deref(), Some(fov_key));
+        // Between fields, or in a comment: the block's.
+        assert_eq!(named(1, 5).as_deref(), Some(""));
+        assert_eq!(named(4, 10).as_deref(), Some(""));
+        // White space before a value is the value's, and its start is shown.
         assert_eq!(
-            path_at(DOC, 12, 30).as_deref(),
-            Some("tracks[\"camera.fov_degrees\"].keys[1].value")
+            path_at(DOC, 3, 10),
+            Some(("size".into(), at(3, 11).unwrap()))
         );
-        assert_eq!(path_at(DOC, 1, 5).as_deref(), Some(""));
+        assert_eq!(
+            path_at(DOC, 12, 29),
+            Some((fov_key.into(), at(12, 30).unwrap()))
+        );
+    }
+
+    #[test]
+    fn a_key_with_quotes_and_escapes_reads_back() {
+        let key = "a\"]b\u{200e}";
+        let path = path_of(&[Step::Field("tracks".into()), Step::Key(key.into())]);
+        assert_eq!(steps(&path)[1], Step::Key(key.into()));
+        let doc = "(tracks: {\"a\\\"]b\u{200e}\": (keys: [3]), \"//x\": 1})";
+        assert_eq!(place_of(doc, &format!("{path}.keys[0]")), at(1, 29));
+        // A place inside a key's string is not read as a comment.
+        let inside = path_at(doc, 1, 35).map(|(path, _)| path);
+        assert_eq!(inside.as_deref(), Some("tracks"));
     }
 
     #[test]
     fn text_that_is_not_ron_has_no_places() {
         assert_eq!(place_of("(fps: ", "fps"), None);
         assert_eq!(path_at("(fps: ", 1, 2), None);
+        // RON's invisible marks are white space before a value.
+        assert_eq!(place_of("(fps: \u{200e}1)", "fps"), at(1, 8));
     }
 }

@@ -241,35 +241,21 @@ fn code_columns(text: &str) -> Vec<Vec<usize>> {
 /// it starts, and our own types by what they are rather than their names.
 fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), String) {
     use ron::error::Error as Ron;
-    let (mut line, mut column) = (e.span.start.line, e.span.start.col);
+    let (line, column) = (e.span.start.line, e.span.start.col);
     let row = |line: usize| text.lines().nth(line.wrapping_sub(1)).unwrap_or("");
     let before = |line: usize, column: usize| -> String {
         row(line).chars().take(column.saturating_sub(1)).collect()
     };
-    // The field the error is in, by its path where the text is RON (a value
-    // of the wrong shape); else the `name:` before it on its line.
-    let typed = spans::path_at(text, line, column).filter(|path| !path.is_empty());
-    if let Some(at) = typed
+    // Where the text is RON (a value of the wrong shape, a field too many or
+    // missing), the field the error is in and the value at fault.
+    let typed = spans::path_at(text, line, column);
+    let shown = typed
         .as_ref()
-        .and_then(|_| spans::next_code(text, line, column))
-    {
-        // RON stops before the value of the wrong shape; point at the value.
-        (line, column) = (at.line, at.column);
-    }
-    let field = typed.map(|path| format!("`{path}`: ")).or_else(|| {
-        let head = before(line, column);
-        head.rfind(':').and_then(|colon| {
-            let name = head[..colon].trim_end().trim_end_matches('"');
-            let start = name
-                .char_indices()
-                .rev()
-                .find(|&(_, c)| !(c.is_alphanumeric() || c == '_' || c == '.'))
-                .map_or(0, |(i, c)| i + c.len_utf8());
-            Some(&name[start..])
-                .filter(|n| !n.is_empty())
-                .map(|n| format!("`{n}`: "))
-        })
-    });
+        .map_or((line, column), |(_, at)| (at.line, at.column));
+    let field = typed
+        .map(|(path, _)| path)
+        .filter(|path| !path.is_empty())
+        .map(|path| format!("`{path}`: "));
     let in_field = field.clone().unwrap_or_default();
     let named = |message: String| {
         // Our types as a timeline's author knows them.
@@ -347,16 +333,9 @@ fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usize, usize), 
         }
         Ron::SuggestRawIdentifier(found) => (
             (line, column),
-            format!("expected a field name here (`name: value`), got `{found}`"),
+            format!("{in_field}expected a field name here (`name: value`), got `{found}`"),
         ),
-        Ron::ExpectedFloat
-        | Ron::ExpectedInteger
-        | Ron::ExpectedBoolean
-        | Ron::ExpectedString
-        | Ron::InvalidValueForType { .. } => {
-            ((line, column), named(format!("{in_field}{}", e.code)))
-        }
-        code => ((line, column), named(format!("{in_field}{code}"))),
+        code => (shown, named(format!("{in_field}{code}"))),
     }
 }
 
@@ -898,9 +877,8 @@ impl Timeline {
 
         let mut tracks = Vec::new();
         for (name, spec) in &file.tracks {
-            let at = |what: String, message: String| {
-                value(&format!("tracks[\"{name}\"]{what}"), message)
-            };
+            let at =
+                |what: String, message: String| value(&format!("tracks[{name:?}]{what}"), message);
             let Some(&(_, arity)) = PARAMETERS.iter().find(|(p, _)| p == name) else {
                 let known: Vec<&str> = PARAMETERS.iter().map(|(p, _)| *p).collect();
                 return Err(at(
@@ -1073,11 +1051,11 @@ impl Timeline {
                     })
                 });
                 if let Some((track, k, message)) = bad_key {
-                    let key = format!("tracks[\"{}\"].keys[{k}].value", track.name);
+                    let key = format!("tracks[{:?}].keys[{k}].value", track.name);
                     return Err(value(&key, message));
                 }
                 let animated: Vec<String> =
-                    culprits.iter().map(|t| format!("\"{}\"", t.name)).collect();
+                    culprits.iter().map(|t| format!("{:?}", t.name)).collect();
                 let track_place = |name: &String| spans::place_of(text, &format!("tracks[{name}]"));
                 return Err(invalid(
                     animated.first().and_then(track_place),
@@ -1426,19 +1404,10 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                 )
             },
         )?;
-        check(
-            light.colour.is_finite()
-                && light.colour.min_element() >= 0.0
-                && light.intensity.is_finite()
-                && light.intensity >= 0.0,
-            &format!("look.extra_lights[{i}]"),
-            || {
-                format!(
-                    "colour and intensity must be finite and non-negative, got {} × {}",
-                    light.colour.shown(),
-                    light.intensity.shown()
-                )
-            },
+        colour(light.colour, &format!("look.extra_lights[{i}].colour"))?;
+        non_negative(
+            light.intensity,
+            &format!("look.extra_lights[{i}].intensity"),
         )?;
     }
     let e = &s.effects;
@@ -1498,7 +1467,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
             crate::shade::Sky::Constant(c) => colour(c, "effects.path_tracing.sky")?,
             crate::shade::Sky::Preetham { turbidity } => check(
                 turbidity.is_finite() && (1.7..=12.0).contains(&turbidity),
-                "effects.path_tracing.sky",
+                "effects.path_tracing.sky.turbidity",
                 || {
                     format!(
                         "Preetham turbidity must be 1.7..=12, got {}",
@@ -1510,7 +1479,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
                 rotation_degrees, ..
             } => check(
                 rotation_degrees.is_finite(),
-                "effects.path_tracing.sky",
+                "effects.path_tracing.sky.rotation_degrees",
                 || {
                     format!(
                         "Environment rotation_degrees must be finite, got {}",
@@ -1547,7 +1516,8 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
 fn invalid_value(text: &str, file: &Path, field: &str, message: String) -> Error {
     let steps = spans::steps(field);
     let (place, message) = match spans::nearest(text, field) {
-        Some((found, place)) if found < steps.len() => {
+        // A missing key or item is not a default: only a field has one.
+        Some((found, place)) if matches!(steps.get(found), Some(spans::Step::Field(_))) => {
             let name = spans::path_of(&steps[found..]);
             let note = format!(" (`{name}` is not given here, so it takes its default)");
             (Some(place), message + &note)
@@ -2242,7 +2212,9 @@ mod tests {
         let text = "(fps: 10, frames: 2, size: (8, 6),\n scene: (look: (\n extra_lights: [(direction: (1, 1, 1), colour: (1, 1, 1), intensity: -1)])))";
         let e = parse(text).unwrap_err().to_string();
         assert!(
-            e.starts_with("test.ron:3:17: scene.look.extra_lights[0]"),
+            e.starts_with(
+                "test.ron:3:70: scene.look.extra_lights[0].intensity: must be non-negative"
+            ),
             "{e}"
         );
     }

@@ -136,7 +136,11 @@ const BAD: &[(&str, &str, &str)] = &[
     ("effects.specular", "strength", "-1"),
     ("effects.fog", "colour", "(-1, 0, 0)"),
     ("effects.glow", "strength", "-1"),
+    (TRACK, "value", "90"),
 ];
+
+/// The bad block that is a track's second key (the power, which must be 1..=64).
+const TRACK: &str = "tracks[\"fractal.power\"].keys[1]";
 
 /// Marks where the bad value is written, to be found and taken out.
 const MARK: &str = "@@";
@@ -158,8 +162,8 @@ impl Choices {
         match self.next(4) {
             0 => ", ".into(),
             1 => ",\n   ".into(),
-            2 => format!(",\n   // {decoy}: 1\n   "),
-            _ => format!(", /* {decoy}: 2 */\n   "),
+            2 => format!(",\n   // é {decoy}: 1 \"\n   "),
+            _ => format!(", /* {decoy}: \"//\" /* {decoy}: 2 */ */\n   "),
         }
     }
 
@@ -203,14 +207,28 @@ fn timeline(bad: (&str, &str, &str), choices: &mut Choices) -> String {
     let separator = choices.separator(bad_field);
     scene.push(format!("effects: ({})", effects.join(&separator)));
     let scene = choices.shuffled(&scene).join(&choices.separator(bad_field));
+    let power = if bad_block == TRACK {
+        format!("{MARK}{bad_value}")
+    } else {
+        "9".into()
+    };
+    let keys = format!(
+        "(time: 0, value: 8),{}(time: 0.04, value: {power})",
+        choices.separator(bad_field).trim_start_matches(',')
+    );
     let top = [
         "fps: 24".to_string(),
         "frames: 2".to_string(),
         "size: (8, 6)".to_string(),
         format!("scene: ({scene})"),
+        format!("tracks: {{ \"fractal.power\": (keys: [{keys}]) }}"),
     ];
     let top = choices.shuffled(&top).join(&choices.separator(bad_field));
-    format!("// {bad_field}: 3 in a leading comment\n({top})\n")
+    let text = format!("// {bad_field}: 3 in a leading comment\n({top})\n");
+    match choices.next(2) {
+        0 => text,
+        _ => text.replace('\n', "\r\n"),
+    }
 }
 
 /// The 1-based line and column of `MARK` in `text`, and `text` without it.
@@ -234,8 +252,10 @@ proptest! {
             .expect_err("the timeline has a bad value")
             .to_string();
         let (block, field, _) = BAD[bad];
-        let wanted = format!("t.ron:{line}:{column}: scene.{block}.{field}: ");
+        let scene = if block == TRACK { "" } else { "scene." };
+        let wanted = format!("t.ron:{line}:{column}: {scene}{block}.{field}: ");
         prop_assert!(err.starts_with(&wanted), "{} not at the start of {}\n{}", wanted, err, text);
+        prop_assert!(!err.contains("is not given here"), "{}", err);
     }
 }
 
