@@ -12,6 +12,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// `println!` that returns an error instead of panicking when standard
@@ -57,7 +58,8 @@ pub const EXIT_INCOMPLETE: u8 = 4;
     version,
     about = "Render keyframed Mandelbulb timelines (RON) to numbered PNG/EXR frames",
     after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline,\n\
-                  4 (status only) the sequence is not complete.\n\
+                  4 (status only) the sequence is not complete; a render stopped by Ctrl-C or SIGTERM\n\
+                  cleans up, says what is done and ends by that signal (130 or 143 in a shell).\n\
                   Timeline format and examples: README.md and timelines/*.ron."
 )]
 pub struct Cli {
@@ -905,7 +907,20 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let message = format!("{} is a file, not a folder", out_dir.display());
         return Err(Error::usage("--out", message).into());
     }
-    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+    // From here on, Ctrl-C and SIGTERM clean up and say what is done. (Where
+    // they cannot be caught, they end the render as they always did.)
+    let _ = crate::interrupt::install();
+    let mine: Vec<u32> = plan
+        .range
+        .clone()
+        .filter(|f| shard.is_none_or(|(i, n)| f % n == i))
+        .collect();
+    let total = mine.len();
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let bars_drawn = Arc::new(std::sync::OnceLock::new());
+    let _reported = report_interrupt(&tally, &bars_drawn, total, shard);
+    // Removed again, when dropped, if the render ends having written nothing.
+    let scaffold = output::Scaffold::make(&out_dir)?;
     // Checked under the record's lock, so two renders started at once
     // cannot both pass it.
     let replacing = args.force || args.replace;
@@ -920,20 +935,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Until this render ends, `status` lists it as running.
     let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
 
-    let mine: Vec<u32> = plan
-        .range
-        .clone()
-        .filter(|f| shard.is_none_or(|(i, n)| f % n == i))
-        .collect();
     // Decide which frames need work, so the progress bar and ETA count only those.
     let mut todo = Vec::new();
     for &frame in &mine {
         let (scene, hash) = plan.frame(frame);
         if args.force || !plan.is_complete(frame, &hash) {
             todo.push((frame, scene, hash));
+        } else {
+            lock(&tally).complete += 1;
         }
     }
-    let total = mine.len();
+    lock(&tally).checked = true;
     let skipped = total - todo.len();
 
     let show_bars = !args.quiet && std::io::stderr().is_terminal();
@@ -958,6 +970,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             .expect("template is valid")
             .progress_chars("=> "),
     );
+    let _ = bars_drawn.set([overall.clone(), current.clone()]);
     // Lines printed above the bars when they show, plainly to stderr otherwise.
     let say = |line: String| {
         if show_bars {
@@ -1021,6 +1034,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let n = scene[0].samples_per_pixel.max(1);
         current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
+        lock(&tally).writing = plan
+            .formats
+            .iter()
+            .map(|&f| {
+                (
+                    plan.path(frame, f),
+                    f,
+                    output::stored_key(f, hash, &plan.aovs),
+                )
+            })
+            .collect();
         let stats = plan.render_frame(
             &mut film,
             frame,
@@ -1039,6 +1063,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 )),
             },
         )?;
+        {
+            let mut tally = lock(&tally);
+            tally.complete += 1;
+            tally.writing.clear();
+        }
         totals = totals + stats;
         if out_of_steps_matters(&stats) {
             short_of_steps.push(frame);
@@ -1095,6 +1124,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 }
                 if !args.force && plan.is_complete(*frame, hash) {
                     finished[k] = true;
+                    lock(&tally).complete += 1;
                     continue;
                 }
                 match crate::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
@@ -1102,6 +1132,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         // It may have been finished between the check and the claim.
                         if args.force || !plan.is_complete(*frame, hash) {
                             render_one(*frame, scene, hash)?;
+                        } else {
+                            lock(&tally).complete += 1;
                         }
                         finished[k] = true;
                         drop(claim);
@@ -1119,6 +1151,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             held.retain(|(k, _)| {
                 let (frame, _, hash) = &todo[*k];
                 finished[*k] = plan.is_complete(*frame, hash);
+                lock(&tally).complete += usize::from(finished[*k]);
                 !finished[*k]
             });
             if held.is_empty() {
@@ -1191,7 +1224,71 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             video_format
         )
     );
+    scaffold.keep();
     Ok(())
+}
+
+/// How far a render has got, for what an interrupt says (`report_interrupt`).
+#[derive(Default)]
+struct Tally {
+    /// Whether every frame of the render has been checked for being complete.
+    checked: bool,
+    /// Frames of this render's share complete: found so, or rendered.
+    complete: usize,
+    /// The files of the frame being rendered, and the key each will hold:
+    /// they may be in place a moment before `complete` counts the frame.
+    writing: Vec<(PathBuf, Format, String)>,
+}
+
+/// `tally`, locked (a panic elsewhere does not make its numbers wrong).
+fn lock(tally: &Mutex<Tally>) -> std::sync::MutexGuard<'_, Tally> {
+    tally.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// On Ctrl-C or SIGTERM, once the render's files are cleaned up (see
+/// `interrupt`): clears the progress bars and says how many of the `total`
+/// frames of this render (of its `shard`) are complete.
+fn report_interrupt(
+    tally: &Arc<Mutex<Tally>>,
+    bars: &Arc<std::sync::OnceLock<[ProgressBar; 2]>>,
+    total: usize,
+    shard: Option<(u32, u32)>,
+) -> crate::interrupt::Registered {
+    let (tally, bars) = (tally.clone(), bars.clone());
+    crate::interrupt::report_on_interrupt(move |stop| {
+        use std::io::Write as _;
+        if let Some(bars) = bars.get() {
+            if stop.echoed && !bars[0].is_hidden() {
+                // The `^C` went past the bars' last column, onto a line of
+                // its own: wipe it, and go back up to where they end.
+                let _ = write!(std::io::stderr(), "\r\x1b[2K\x1b[1A");
+            }
+            // As at the end of a render; rows still finishing draw nothing.
+            for bar in bars {
+                bar.finish_and_clear();
+            }
+        }
+        let tally = lock(&tally);
+        let written = !tally.writing.is_empty()
+            && tally.writing.iter().all(|(path, format, key)| {
+                output::file_state(path, *format, key, false) == output::FileState::Current
+            });
+        let share = match shard {
+            Some((i, n)) if n > 1 => format!(" (shard {i}/{n})"),
+            _ => String::new(),
+        };
+        let done = if tally.checked {
+            let complete = tally.complete + usize::from(written);
+            format!(": {complete} of {total} frames complete{share}")
+        } else {
+            format!(" while checking which of {total} frames are complete{share}")
+        };
+        // Not `eprintln!`, which panics if standard error is gone.
+        let _ = writeln!(
+            std::io::stderr(),
+            "interrupted{done}; the same command resumes"
+        );
+    })
 }
 
 /// What `Plan::render_frame` has to say while a frame renders.

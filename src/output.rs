@@ -395,7 +395,17 @@ pub fn write_atomic(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    // Created and renamed under the interrupt lock, so Ctrl-C removes
+    // every temporary file and none is renamed into place after it.
+    let (temp, _removed_on_interrupt) = {
+        let mut held = crate::interrupt::hold();
+        let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+        let temp_path = temp.path().to_path_buf();
+        let removal = held.on_interrupt(move || {
+            let _ = std::fs::remove_file(temp_path);
+        });
+        (temp, removal)
+    };
     let temp_path = temp.path().to_path_buf();
     // Written through the plain file: the temporary file's own writer
     // would add its path to every error, which `Error::io` names already.
@@ -406,7 +416,9 @@ pub fn write_atomic(
         .map_err(|e| Error::io(&temp_path, e.into_error()))?
         .sync_all()
         .map_err(|e| Error::io(&temp_path, e))?;
+    let held = crate::interrupt::hold();
     temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    drop(held);
     Ok(())
 }
 
@@ -808,12 +820,16 @@ impl JobRecord {
         // Read-only where another user made it (a lock needs no write
         // access), and none at all where it cannot be had.
         let lock_path = dir.join(JOB_LOCK);
+        // Under the interrupt lock: a render stopped before it wrote
+        // anything removes the lock file it made (`Scaffold`).
+        let held = crate::interrupt::hold();
         let lock = std::fs::OpenOptions::new()
             .create(true)
             .truncate(false)
             .write(true)
             .open(&lock_path)
             .or_else(|_| File::open(&lock_path));
+        drop(held);
         if let Ok(lock) = &lock {
             let _ = lock.lock();
         }
@@ -841,6 +857,100 @@ impl JobRecord {
             path,
             message: format!("not a mandelreel job record: {e}"),
         })
+    }
+}
+
+/// An output folder as a render set it up: the folders it created
+/// (outermost first) and the bookkeeping files that were not there yet
+/// (`JOB_LOCK`, `JOB_FILE`). A render that ends having written nothing
+/// (a disk full from the start, Ctrl-C during its first frame) removes
+/// them when this is dropped, or on an interrupt, unless `keep` was
+/// called: it leaves the disk as it found it.
+pub struct Scaffold {
+    made: Option<Made>,
+    _undone_on_interrupt: crate::interrupt::Registered,
+}
+
+#[derive(Clone)]
+struct Made {
+    dir: PathBuf,
+    dirs: Vec<PathBuf>,
+    files: Vec<&'static str>,
+}
+
+impl Scaffold {
+    /// Creates `dir` and its missing parents, noting what it made.
+    pub fn make(dir: &Path) -> Result<Scaffold> {
+        let mut dirs: Vec<PathBuf> = dir
+            .ancestors()
+            .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        dirs.reverse();
+        let mut held = crate::interrupt::hold();
+        let mut made = Made {
+            dir: dir.to_path_buf(),
+            dirs,
+            files: Vec::new(),
+        };
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            made.undo();
+            return Err(Error::io(dir, e));
+        }
+        made.files = [JOB_LOCK, JOB_FILE]
+            .into_iter()
+            .filter(|f| !dir.join(f).exists())
+            .collect();
+        let undo = made.clone();
+        let registered = held.on_interrupt(move || undo.undo());
+        drop(held);
+        Ok(Scaffold {
+            made: Some(made),
+            _undone_on_interrupt: registered,
+        })
+    }
+
+    /// The render wrote what it meant to: nothing is undone.
+    pub fn keep(mut self) {
+        self.made = None;
+    }
+}
+
+impl Drop for Scaffold {
+    fn drop(&mut self) {
+        if let Some(made) = &self.made {
+            made.undo();
+        }
+    }
+}
+
+impl Made {
+    /// Removes what was made, if the folder holds nothing else: no frame,
+    /// checkpoint, claim, or another render's record or files.
+    fn undo(&self) {
+        let Ok(entries) = std::fs::read_dir(&self.dir) else {
+            return self.remove_dirs();
+        };
+        let only_ours = entries
+            .map(|e| e.map(|e| e.file_name()))
+            .all(|name| name.is_ok_and(|n| self.files.iter().any(|f| n == *f)));
+        if only_ours {
+            for f in &self.files {
+                let _ = std::fs::remove_file(self.dir.join(f));
+            }
+            self.remove_dirs();
+        }
+    }
+
+    /// Removes the folders made, innermost first, while they are empty
+    /// (or were never made: `create_dir_all` may stop part-way).
+    fn remove_dirs(&self) {
+        for dir in self.dirs.iter().rev() {
+            match std::fs::remove_dir(dir) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return,
+                _ => {}
+            }
+        }
     }
 }
 

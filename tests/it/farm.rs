@@ -386,9 +386,9 @@ impl Drop for SmallDisk {
     }
 }
 
-#[test]
-fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
-    let d = Dir::new();
+/// A 48 KB tmpfs mounted on `disk` in `d`, or `None` (with a note) where
+/// mounting needs privileges this test does not have.
+fn small_disk(d: &Dir) -> Option<SmallDisk> {
     let mount = d.path().join("disk");
     std::fs::create_dir(&mount).unwrap();
     let mounted = std::process::Command::new("mount")
@@ -403,9 +403,17 @@ fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
             "cannot mount a tmpfs in CI"
         );
         eprintln!("skipping: cannot mount a small tmpfs here (not root?)");
-        return;
+        return None;
     }
-    let _disk = SmallDisk(mount.clone());
+    Some(SmallDisk(mount))
+}
+
+#[test]
+fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
+    let d = Dir::new();
+    let Some(_disk) = small_disk(&d) else {
+        return;
+    };
     // 40 frames of about 4 KB each cannot fit in 48 KB.
     d.write("t.ron", &tiny_timeline(40, 6.0));
     let out = d.run(&["render", "t.ron", "--out", "disk/seq", "--quiet"]);
@@ -430,4 +438,71 @@ fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
 /// reason; MANDELREEL_NO_MOUNT=1 lets such a CI skip it explicitly.
 fn ci_allows_skipping_mount() -> bool {
     std::env::var_os("MANDELREEL_NO_MOUNT").is_some()
+}
+
+#[test]
+fn a_disk_full_before_the_first_write_leaves_nothing_behind() {
+    // Nothing written: no folder, record or lock left (`status` would call
+    // such a folder "not a mandelreel output folder"); a folder that was
+    // there stays as it was.
+    let d = Dir::new();
+    let Some(_disk) = small_disk(&d) else {
+        return;
+    };
+    std::fs::create_dir(d.path().join("disk/empty")).unwrap();
+    let filler = vec![0u8; 4096];
+    let mut file = std::fs::File::create(d.path().join("disk/filler")).unwrap();
+    while std::io::Write::write_all(&mut file, &filler).is_ok() {}
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    for out in ["disk/new/seq", "disk/empty"] {
+        let run = d.run(&["render", "t.ron", "--out", out, "--quiet"]);
+        assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+        says(&run, "No space left");
+    }
+    assert!(
+        !d.path().join("disk/new").exists(),
+        "{:?}",
+        d.files("disk/new")
+    );
+    assert!(
+        d.files("disk/empty").is_empty(),
+        "{:?}",
+        d.files("disk/empty")
+    );
+}
+
+#[test]
+fn a_claim_worker_stopped_by_sigterm_releases_its_frame() {
+    // Its claim and run record go, so a worker on any machine takes the
+    // frame at once (from its checkpoint), and `status` lists no worker.
+    use std::os::unix::process::ExitStatusExt;
+    let d = Dir::new();
+    d.write("t.ron", &long_frames(1));
+    let args = [
+        "render",
+        "t.ron",
+        "--claim",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+    ];
+    let mut command = d.command(&args);
+    command.stderr(std::process::Stdio::piped());
+    let worker = d.spawn_command_until(command, "out/t", ".ckpt");
+    let out = crate::resume::interrupt(worker, nix::sys::signal::Signal::SIGTERM);
+    assert_eq!(out.status.signal(), Some(15), "{}", stderr(&out));
+    says(&out, "interrupted: 0 of 1 frames complete");
+    let left = d.files("out/t");
+    assert!(
+        !left
+            .iter()
+            .any(|f| f.ends_with(".claim") || f.starts_with(".mandelreel-run-")),
+        "claim or run record left: {left:?}"
+    );
+    let (_, status) = d.status_json(&["out/t"]);
+    assert_eq!(status["states"]["resumable"], serde_json::json!([0]));
+    assert_eq!(status["workers"], serde_json::json!([]));
+    let out = d.ok(&["render", "t.ron", "--claim"]);
+    says(&out, "resuming from a checkpoint");
 }
