@@ -449,6 +449,7 @@ pub fn ffmpeg_command(
 }
 
 /// A validated render job: what to render, how big, in which formats, where.
+#[derive(Clone)]
 struct Plan {
     timeline: Timeline,
     width: u32,
@@ -522,9 +523,9 @@ impl Plan {
         output::layers_for(&self.aovs)
     }
 
-    /// The plan an output folder records (see `output::JobRecord`), and
-    /// the record.
-    fn from_folder(dir: &Path) -> anyhow::Result<(Plan, output::JobRecord)> {
+    /// The plans an output folder records, one per format with its own
+    /// range, layers and samples (see `output::JobRecord`), and the record.
+    fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, output::JobRecord)> {
         if !dir.join(output::JOB_FILE).exists() {
             let preview = dir.join("preview");
             let hint = if preview.join(output::JOB_FILE).exists() {
@@ -539,26 +540,40 @@ impl Plan {
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
         let job = output::JobRecord::read(dir)?;
-        let timeline =
-            Timeline::parse(&job.timeline_text, &job.timeline_path)?.with_samples(job.samples);
-        let formats = job
-            .formats
-            .iter()
-            .map(|f| <Format as clap::ValueEnum>::from_str(f, true).map_err(|e| anyhow::anyhow!(e)))
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let plan = Plan {
-            width: job.width,
-            height: job.height,
-            range: job.frames.0..job.frames.1.min(timeline.frame_count),
-            formats,
-            out_dir: dir.to_path_buf(),
-            preview: job.preview,
-            aovs: job.aovs.clone(),
-            samples: job.samples,
-            verify: false,
-            timeline,
+        let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        let plan = |o: output::OutputRecord| -> anyhow::Result<Plan> {
+            let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
+                .map_err(|e| anyhow::anyhow!(e))?;
+            let timeline = timeline.clone().with_samples(o.samples);
+            Ok(Plan {
+                width: job.width,
+                height: job.height,
+                range: o.frames.0..o.frames.1.min(timeline.frame_count),
+                formats: vec![format],
+                out_dir: dir.to_path_buf(),
+                preview: job.preview,
+                aovs: o.aovs,
+                samples: o.samples,
+                verify: false,
+                timeline,
+            })
         };
-        Ok((plan, job))
+        let plans = job
+            .outputs()
+            .into_iter()
+            .map(plan)
+            .collect::<anyhow::Result<_>>()?;
+        Ok((plans, job))
+    }
+
+    /// This plan as one plan per format, so each format's frames can be
+    /// counted on their own.
+    fn per_format(&self) -> Vec<Plan> {
+        let one = |&format: &Format| Plan {
+            formats: vec![format],
+            ..self.clone()
+        };
+        self.formats.iter().map(one).collect()
     }
 
     /// Refuses a size whose frame would need more memory than this machine
@@ -612,6 +627,21 @@ impl Plan {
             preview: self.preview,
             aovs: self.aovs.clone(),
             samples: self.samples,
+            outputs: self
+                .formats
+                .iter()
+                .map(|&f| output::OutputRecord {
+                    format: f.extension().to_string(),
+                    frames: (self.range.start, self.range.end),
+                    // Only EXRs hold extra layers.
+                    aovs: if f == Format::Exr {
+                        self.aovs.clone()
+                    } else {
+                        Vec::new()
+                    },
+                    samples: self.samples,
+                })
+                .collect(),
         })
     }
 
@@ -1319,6 +1349,18 @@ pub enum FrameState {
 }
 
 impl FrameState {
+    /// A frame's state over the `states` of its formats: complete if each
+    /// is, else the one that says most of what is left (a live worker, a
+    /// checkpoint, a damaged file, a stale one, in that order).
+    fn of_formats(states: &[FrameState]) -> FrameState {
+        use FrameState::*;
+        let order = [InProgress, Resumable, Damaged, Stale, Missing];
+        order
+            .into_iter()
+            .find(|s| states.contains(s))
+            .unwrap_or(Complete)
+    }
+
     /// The state's name in `status --json` (`in progress` in the text).
     pub fn name(self) -> &'static str {
         match self {
@@ -1451,8 +1493,8 @@ fn ranges(frames: &[u32]) -> String {
 }
 
 fn status(args: StatusArgs) -> anyhow::Result<()> {
-    // The plan, and the folder's record: read once.
-    let (plan, job) = if args.target.is_dir() {
+    // One plan per format, and the folder's record: read once.
+    let (parts, job) = if args.target.is_dir() {
         let s = &args.sequence;
         // The folder records these; only the frames may be narrowed.
         let given = [
@@ -1474,23 +1516,39 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let (mut plan, job) = Plan::from_folder(&args.target)?;
-        if let Some(frames) = &s.frames {
-            plan.range = parse_frames(frames, plan.timeline.frame_count)?;
+        let (mut parts, job) = Plan::from_folder(&args.target)?;
+        for part in &mut parts {
+            if let Some(frames) = &s.frames {
+                part.range = parse_frames(frames, part.timeline.frame_count)?;
+            }
         }
-        (plan, Some(job))
+        (parts, Some(job))
     } else {
         let plan = Plan::new(&args.target, &args.sequence)?;
         let job = output::JobRecord::read(&plan.out_dir).ok();
-        (plan, job)
+        (plan.per_format(), job)
+    };
+    let parts: Vec<Plan> = parts
+        .into_iter()
+        .map(|part| Plan {
+            verify: args.verify,
+            ..part
+        })
+        .collect();
+    // What the formats share, over the span of their ranges.
+    let Some(first) = parts.first() else {
+        let message = format!("{} records no output format", output::JOB_FILE);
+        return Err(Error::usage(&args.target.display().to_string(), message).into());
     };
     let plan = Plan {
-        verify: args.verify,
-        ..plan
+        range: parts.iter().map(|p| p.range.start).min().unwrap_or(0)
+            ..parts.iter().map(|p| p.range.end).max().unwrap_or(0),
+        ..first.clone()
     };
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
+    let mut by_format = vec![std::collections::BTreeMap::new(); parts.len()];
     // Renders running on the folder (`claim::announce_run`), and below, any
     // other worker holding a claim.
     let mut workers: std::collections::BTreeSet<String> =
@@ -1499,39 +1557,35 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             .map(crate::claim::ClaimRecord::who)
             .collect();
     for frame in plan.range.clone() {
-        let (_, hash) = plan.frame(frame);
-        // Each file's header read once, and a file read whole only where
-        // its header records these inputs.
-        let files = plan.file_states(frame, &hash);
-        let state = if files.iter().all(|&s| s == output::FileState::Current) {
-            FrameState::Complete
-        } else if let Some(claim) =
-            crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
-                .filter(|c| crate::claim::is_live(c, args.claim_timeout))
-        {
-            workers.insert(claim.who());
-            FrameState::InProgress
-        } else if writing.contains(&frame) {
-            FrameState::InProgress
-        } else if output::checkpoint_is_for(
-            &output::checkpoint_path(&plan.out_dir, frame),
-            output::light_hash(&hash),
-            plan.width,
-            plan.height,
-            plan.layers(),
-        ) {
-            FrameState::Resumable
-        } else if files.contains(&output::FileState::Damaged) {
-            FrameState::Damaged
-        } else if files.contains(&output::FileState::Stale) {
-            FrameState::Stale
-        } else {
-            FrameState::Missing
-        };
-        by_state.entry(state).or_default().push(frame);
+        let mut states = Vec::new();
+        for (part, by_state) in parts.iter().zip(&mut by_format) {
+            if part.range.contains(&frame) {
+                let (state, worker) = frame_state(part, frame, &writing, args.claim_timeout);
+                workers.extend(worker);
+                by_state.entry(state).or_insert_with(Vec::new).push(frame);
+                states.push(state);
+            }
+        }
+        // A frame in a gap between formats' ranges is no format's to hold.
+        if !states.is_empty() {
+            by_state
+                .entry(FrameState::of_formats(&states))
+                .or_default()
+                .push(frame);
+        }
     }
-    let total = plan.range.len();
+    let total: usize = by_state.values().map(Vec::len).sum();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
+    let formats: std::collections::BTreeMap<&str, FormatStatus> = parts
+        .iter()
+        .zip(&by_format)
+        .map(|(part, by_state)| {
+            (
+                part.formats[0].extension(),
+                FormatStatus::of(part, by_state),
+            )
+        })
+        .collect();
     // A folder last rendered from another timeline file (with --force).
     let other_timeline = job
         .as_ref()
@@ -1561,6 +1615,8 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 /// The timeline the folder was last rendered from, where that
                 /// is another file.
                 folder_rendered_from: Option<&'a Path>,
+                /// Each format's frames, counted on their own.
+                formats: &'a std::collections::BTreeMap<&'a str, FormatStatus<'a>>,
             }
             out!(
                 "{}",
@@ -1575,6 +1631,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     workers: workers.iter().cloned().collect(),
                     timeline_changed_since_render: changed,
                     folder_rendered_from: other_timeline.as_deref(),
+                    formats: &formats,
                 })?
             );
         } else {
@@ -1593,6 +1650,23 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     state.name().replace('_', " "),
                     frames.len(),
                     ranges(frames)
+                );
+            }
+            // Several formats: each on its own line, with what it lacks.
+            for (name, f) in formats.iter().filter(|_| formats.len() > 1) {
+                let lacking: Vec<String> = (f.states.iter())
+                    .filter(|(state, _)| **state != FrameState::Complete.name())
+                    .map(|(state, frames)| {
+                        format!("; {} {}", state.replace('_', " "), ranges(frames))
+                    })
+                    .collect();
+                out!(
+                    "  {name}: {} of {} complete and current (frames {}..{}){}",
+                    f.complete,
+                    f.total,
+                    f.frames.0,
+                    f.frames.1,
+                    lacking.concat()
                 );
             }
             if !workers.is_empty() {
@@ -1634,6 +1708,67 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         Ok(())
     } else {
         Err(Incomplete { complete, total }.into())
+    }
+}
+
+/// The state of `frame` in the one format of `part`, and the worker
+/// holding its claim, if a live one does. `writing` holds the frames with
+/// a live writer's temporary file.
+fn frame_state(
+    part: &Plan,
+    frame: u32,
+    writing: &std::collections::HashSet<u32>,
+    claim_timeout: std::time::Duration,
+) -> (FrameState, Option<String>) {
+    let (_, hash) = part.frame(frame);
+    // Each file's header read once, and a file read whole only where
+    // its header records these inputs.
+    let files = part.file_states(frame, &hash);
+    if files.iter().all(|&s| s == output::FileState::Current) {
+        return (FrameState::Complete, None);
+    }
+    let claim = crate::claim::read_claim(&crate::claim::claim_path(&part.out_dir, frame))
+        .filter(|c| crate::claim::is_live(c, claim_timeout));
+    if let Some(claim) = claim {
+        return (FrameState::InProgress, Some(claim.who()));
+    }
+    let state = if writing.contains(&frame) {
+        FrameState::InProgress
+    } else if output::checkpoint_is_for(
+        &output::checkpoint_path(&part.out_dir, frame),
+        output::light_hash(&hash),
+        part.width,
+        part.height,
+        part.layers(),
+    ) {
+        FrameState::Resumable
+    } else if files.contains(&output::FileState::Damaged) {
+        FrameState::Damaged
+    } else if files.contains(&output::FileState::Stale) {
+        FrameState::Stale
+    } else {
+        FrameState::Missing
+    };
+    (state, None)
+}
+
+/// One format's frames in a `status` report.
+#[derive(Serialize)]
+struct FormatStatus<'a> {
+    frames: (u32, u32),
+    total: usize,
+    complete: usize,
+    states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
+}
+
+impl<'a> FormatStatus<'a> {
+    fn of(part: &Plan, by_state: &'a std::collections::BTreeMap<FrameState, Vec<u32>>) -> Self {
+        FormatStatus {
+            frames: (part.range.start, part.range.end),
+            total: by_state.values().map(Vec::len).sum(),
+            complete: by_state.get(&FrameState::Complete).map_or(0, Vec::len),
+            states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
+        }
     }
 }
 

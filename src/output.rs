@@ -776,6 +776,25 @@ pub struct JobRecord {
     /// timeline's.
     #[serde(default)]
     pub samples: Option<u32>,
+    /// Each format's own range, layers and samples (`outputs`); the fields
+    /// above are their union, and the last render's, for older readers.
+    #[serde(default)]
+    pub outputs: Vec<OutputRecord>,
+}
+
+/// What one format's frames in a folder were rendered with: a folder may
+/// hold PNGs of the whole film and EXRs of three frames, with other layers
+/// or samples, each complete on its own terms.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct OutputRecord {
+    /// `png` or `exr`.
+    pub format: String,
+    /// Half-open span of every range rendered in this format.
+    pub frames: (u32, u32),
+    #[serde(default)]
+    pub aovs: Vec<Aov>,
+    #[serde(default)]
+    pub samples: Option<u32>,
 }
 
 impl JobRecord {
@@ -816,6 +835,10 @@ impl JobRecord {
     /// under the same lock, and its error stops the write: so a render
     /// refused over another sequence's frames cannot slip in between
     /// another render's check and its write.
+    ///
+    /// Each format is merged on its own (`merge_outputs`): a render of a
+    /// few EXR frames into a folder of PNGs leaves the PNGs' range as it
+    /// was, and adds the EXRs'.
     pub fn record_in(self, dir: &Path, check: impl FnOnce(&JobRecord) -> Result<()>) -> Result<()> {
         // Read-only where another user made it (a lock needs no write
         // access), and none at all where it cannot be had.
@@ -838,16 +861,57 @@ impl JobRecord {
             check(old)?;
         }
         let record = match old {
-            Ok(old) if old.same_sequence(&self) => JobRecord {
-                frames: (
-                    old.frames.0.min(self.frames.0),
-                    old.frames.1.max(self.frames.1),
-                ),
-                ..self
-            },
+            Ok(old) if old.same_sequence(&self) => self.merge_outputs(&old),
             _ => self,
         };
         record.write(dir)
+    }
+
+    /// Each format's record: `outputs`, or for a record written before
+    /// them, one per format from the shared fields.
+    pub fn outputs(&self) -> Vec<OutputRecord> {
+        if !self.outputs.is_empty() {
+            return self.outputs.clone();
+        }
+        let output = |format: &String| OutputRecord {
+            format: format.clone(),
+            frames: self.frames,
+            aovs: if format == "exr" {
+                self.aovs.clone()
+            } else {
+                Vec::new()
+            },
+            samples: self.samples,
+        };
+        self.formats.iter().map(output).collect()
+    }
+
+    /// This record, keeping the formats of `old` (the same sequence) that
+    /// it does not render, and the span of its own formats' ranges there.
+    fn merge_outputs(self, old: &JobRecord) -> JobRecord {
+        let mut outputs = old.outputs();
+        for new in self.outputs() {
+            match outputs.iter_mut().find(|o| o.format == new.format) {
+                Some(o) => {
+                    *o = OutputRecord {
+                        frames: (o.frames.0.min(new.frames.0), o.frames.1.max(new.frames.1)),
+                        ..new
+                    }
+                }
+                None => outputs.push(new),
+            }
+        }
+        outputs.sort_by(|a, b| a.format.cmp(&b.format));
+        let span = |f: fn(&OutputRecord) -> u32| outputs.iter().map(f);
+        JobRecord {
+            formats: outputs.iter().map(|o| o.format.clone()).collect(),
+            frames: (
+                span(|o| o.frames.0).min().unwrap_or(self.frames.0),
+                span(|o| o.frames.1).max().unwrap_or(self.frames.1),
+            ),
+            outputs,
+            ..self
+        }
     }
 
     pub fn read(dir: &Path) -> Result<JobRecord> {
@@ -1581,7 +1645,57 @@ mod tests {
             preview: false,
             aovs: Vec::new(),
             samples: None,
+            outputs: Vec::new(),
         }
+    }
+
+    #[test]
+    fn each_format_keeps_its_own_range_layers_and_samples() {
+        let dir = tempfile::tempdir().unwrap();
+        // A record written before formats had their own: PNGs of 0..120.
+        record((0, 120)).write(dir.path()).unwrap();
+        let exr = OutputRecord {
+            format: "exr".into(),
+            frames: (0, 3),
+            aovs: vec![Aov::Normal],
+            samples: Some(2),
+        };
+        let few_exrs = JobRecord {
+            formats: vec!["exr".into()],
+            frames: (0, 3),
+            aovs: vec![Aov::Normal],
+            samples: Some(2),
+            outputs: vec![exr.clone()],
+            ..record((0, 3))
+        };
+        few_exrs.record_in(dir.path(), |_| Ok(())).unwrap();
+        let png = OutputRecord {
+            format: "png".into(),
+            frames: (0, 120),
+            aovs: Vec::new(),
+            samples: None,
+        };
+        let merged = JobRecord::read(dir.path()).unwrap();
+        assert_eq!(merged.outputs(), [exr.clone(), png.clone()]);
+        assert_eq!((merged.frames, merged.formats.len()), ((0, 120), 2));
+        // More EXRs widen the EXRs' span alone, and take the new samples.
+        let more = OutputRecord {
+            frames: (5, 8),
+            samples: None,
+            ..exr
+        };
+        JobRecord {
+            outputs: vec![more.clone()],
+            ..record((5, 8))
+        }
+        .record_in(dir.path(), |_| Ok(()))
+        .unwrap();
+        let merged = JobRecord::read(dir.path()).unwrap();
+        let widened = OutputRecord {
+            frames: (0, 8),
+            ..more
+        };
+        assert_eq!(merged.outputs(), [widened, png]);
     }
 
     #[test]

@@ -179,6 +179,39 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
 }
 
 #[test]
+fn status_of_a_folder_reports_each_format_it_holds() {
+    // A few EXR frames, with their own samples, rendered into a folder of
+    // complete PNGs: neither hides the other (the folder's status used to
+    // count the last render's format, range and samples alone).
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(6, 6.0));
+    d.ok(&["render", "t.ron", "--quiet"]);
+    let exr = ["--format", "exr", "--frames", "0..3", "--samples", "2"];
+    d.ok(&[&["render", "t.ron", "--quiet"][..], &exr].concat());
+    let out = d.ok(&["status", "out/t"]);
+    let text = stdout(&out);
+    assert!(text.contains("6 of 6 frames complete"), "{text}");
+    assert!(
+        text.contains("exr: 3 of 3 complete and current (frames 0..3)")
+            && text.contains("png: 6 of 6 complete and current (frames 0..6)"),
+        "{text}"
+    );
+    std::fs::remove_file(d.path().join("out/t/frame_00001.exr")).unwrap();
+    let (code, v) = d.status_json(&["out/t"]);
+    assert_eq!(code, Some(4), "{v}");
+    assert_eq!(v["states"]["missing"], serde_json::json!([1]), "{v}");
+    assert_eq!(v["formats"]["png"]["complete"], 6, "{v}");
+    assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([0, 3]));
+    assert_eq!(
+        v["formats"]["exr"]["states"]["missing"],
+        serde_json::json!([1])
+    );
+    // The timeline's status counts what its options name, format by format.
+    let text = stdout(&d.run(&[&["status", "t.ron"][..], &exr].concat()));
+    assert!(text.contains("2 of 3 frames complete"), "{text}");
+}
+
+#[test]
 fn shards_split_frames_by_index_and_from_the_scheduler() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(7, 6.0));
