@@ -663,6 +663,41 @@ impl Plan {
         self.out_dir.join(output::frame_file_name(frame, format))
     }
 
+    /// The format a video is encoded from: the PNGs, where rendered.
+    fn video_format(&self) -> Format {
+        if self.formats.contains(&Format::Png) {
+            Format::Png
+        } else {
+            Format::Exr
+        }
+    }
+
+    /// Whether `frame`'s file in `format` is whole and current (no hash
+    /// is computed where there is no file).
+    fn is_current_in(&self, frame: u32, format: Format) -> bool {
+        let path = self.path(frame, format);
+        if !path.exists() {
+            return false;
+        }
+        let (_, hash) = self.frame(frame);
+        let key = output::stored_key(format, &hash, &self.aovs);
+        output::file_state(&path, format, &key, self.verify) == output::FileState::Current
+    }
+
+    /// The ffmpeg command encoding `range` from its `format` files: into
+    /// `<name>.mp4` for the whole film, else `<name>_frames_<A>-<B>.mp4`
+    /// (`<name>_frame_<A>.mp4` for one).
+    fn video_command(&self, range: &std::ops::Range<u32>, format: Format) -> String {
+        let name = &self.timeline.name;
+        let movie = if *range == (0..self.timeline.frame_count) {
+            name.clone()
+        } else {
+            format!("{name}_{}", frames_text(range).replace(' ', "_"))
+        };
+        let fps = self.timeline.fps;
+        ffmpeg_command(&self.out_dir, &movie, fps, range, format)
+    }
+
     /// The state of each format's file of `frame` against these inputs
     /// (read whole with `--verify`).
     fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
@@ -1224,13 +1259,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
-        // A shard's frames are part of the sequence, and a --force claim
-        // worker makes one pass: the others' frames may still be coming.
-        if shard.is_some_and(|(_, n)| n > 1) || (args.claim && args.force) {
-            eprintln!("encode the video, once every worker has finished, with:");
-        } else {
-            eprintln!("encode the video with:");
-        }
     }
     if args.stats {
         eprintln!(
@@ -1238,24 +1266,85 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             totals.de_evaluations, totals.repaired_samples
         );
     }
-    // On stdout even with --quiet: scripts can run it.
-    let video_format = if plan.formats.contains(&Format::Png) {
-        Format::Png
+    // This render's frames are all complete now, but where a --force claim
+    // worker made its one pass: others may still hold some.
+    let known = if args.claim && args.force {
+        &[][..]
     } else {
-        Format::Exr
+        &mine
     };
-    out!(
-        "{}",
-        ffmpeg_command(
-            &out_dir,
-            &plan.timeline.name,
-            plan.timeline.fps,
-            &plan.range,
-            video_format
-        )
-    );
+    print_video_command(&plan, known, args.quiet)?;
     scaffold.keep();
     Ok(())
+}
+
+/// After a render: on stdout (scripts run it, so also with `--quiet`) the
+/// ffmpeg command for the whole film once every frame of it is complete;
+/// else for this render's range alone, under a name of its own so that no
+/// complete video is replaced, if that range is complete; and on stderr
+/// what is still missing. `known` frames are complete; the others are
+/// looked for on disk.
+fn print_video_command(plan: &Plan, known: &[u32], quiet: bool) -> anyhow::Result<()> {
+    let format = plan.video_format();
+    let known: std::collections::HashSet<u32> = known.iter().copied().collect();
+    let missing: Vec<u32> = (0..plan.timeline.frame_count)
+        .filter(|f| !known.contains(f) && !plan.is_current_in(*f, format))
+        .collect();
+    let say = |line: String| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    };
+    if missing.is_empty() {
+        say("encode the video with:".into());
+        out!(
+            "{}",
+            plan.video_command(&(0..plan.timeline.frame_count), format)
+        );
+        return Ok(());
+    }
+    let status = format!(
+        "mandelreel status {}",
+        shell_quote(&plan.out_dir.to_string_lossy())
+    );
+    let lacking = format!(
+        "frame(s) {} of the film are not complete yet",
+        frame_summary(&missing)
+    );
+    // Another worker's frames in this range: nothing to encode on its own.
+    if missing.iter().any(|f| plan.range.contains(f)) {
+        say(format!(
+            "{lacking}; once they are, {status} prints the command that encodes the video"
+        ));
+        return Ok(());
+    }
+    say(format!(
+        "{lacking} ({status} tells when, and prints the command for the whole video); \
+         to encode {} alone, leaving {}.mp4 as it is:",
+        frames_text(&plan.range),
+        plan.timeline.name
+    ));
+    out!("{}", plan.video_command(&plan.range, format));
+    Ok(())
+}
+
+/// `frame 5`, or `frames 0-2`, for a range of frames.
+fn frames_text(range: &std::ops::Range<u32>) -> String {
+    match range.len() {
+        1 => format!("frame {}", range.start),
+        _ => format!("frames {}-{}", range.start, range.end.saturating_sub(1)),
+    }
+}
+
+/// `ranges` of `frames`, its first few runs only for a long list:
+/// `1-7, 9-15, 17-23, 25-31, 33-39, … (1110 frames)`.
+fn frame_summary(frames: &[u32]) -> String {
+    let all = ranges(frames);
+    let runs: Vec<&str> = all.split(", ").collect();
+    if runs.len() <= 6 {
+        return all;
+    }
+    format!("{}, … ({} frames)", runs[..5].join(", "), frames.len())
 }
 
 /// How far a render has got, for what an interrupt says (`report_interrupt`).
@@ -1586,6 +1675,15 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             )
         })
         .collect();
+    // Once the video's frames are all there: the command that encodes them.
+    let video = parts
+        .iter()
+        .find(|p| p.formats[0] == plan.video_format())
+        .unwrap_or(first);
+    let video_command = formats
+        .get(video.formats[0].extension())
+        .filter(|f| f.total > 0 && f.complete == f.total)
+        .map(|_| video.video_command(&video.range, video.formats[0]));
     // A folder last rendered from another timeline file (with --force).
     let other_timeline = job
         .as_ref()
@@ -1617,6 +1715,9 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 folder_rendered_from: Option<&'a Path>,
                 /// Each format's frames, counted on their own.
                 formats: &'a std::collections::BTreeMap<&'a str, FormatStatus<'a>>,
+                /// The ffmpeg command for the frames counted, once they
+                /// are complete in the format a video is made from.
+                video_command: Option<&'a str>,
             }
             out!(
                 "{}",
@@ -1632,6 +1733,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     timeline_changed_since_render: changed,
                     folder_rendered_from: other_timeline.as_deref(),
                     formats: &formats,
+                    video_command: video_command.as_deref(),
                 })?
             );
         } else {
@@ -1699,6 +1801,9 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     other.display(),
                     plan.timeline.source.display()
                 );
+            }
+            if let Some(command) = &video_command {
+                out!("  encode: {command}");
             }
         }
         Ok(())
@@ -2311,6 +2416,15 @@ mod tests {
         assert!(e.contains("written with two dots: 0..3"), "{e}");
         let e = parse_frames("-3", 10).unwrap_err().to_string();
         assert!(!e.contains("two dots"), "{e}");
+    }
+
+    #[test]
+    fn a_long_list_of_missing_frames_is_cut_short() {
+        assert_eq!(frame_summary(&[1, 2, 3, 7]), "1-3, 7");
+        let every_other: Vec<u32> = (0..100).step_by(2).collect();
+        assert_eq!(frame_summary(&every_other), "0, 2, 4, 6, 8, … (50 frames)");
+        assert_eq!(frames_text(&(5..6)), "frame 5");
+        assert_eq!(frames_text(&(0..3)), "frames 0-2");
     }
 
     #[test]
