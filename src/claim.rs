@@ -15,6 +15,7 @@
 //! step (NTP), to well within the timeout.
 
 use crate::error::{Error, Result};
+use crate::interrupt::Registered;
 use serde::{Deserialize, Serialize};
 use std::fs::OpenOptions;
 use std::io::Write;
@@ -77,8 +78,17 @@ pub fn announce_run(dir: &Path, timeout: Duration) -> Result<Claim> {
     }
     let record = ClaimRecord::mine();
     let path = dir.join(format!("{RUN_PREFIX}{}", record.token));
+    // Registered first: an interrupt then removes it however far this got.
+    let release = released_on_interrupt(&path, &record.token, &[]);
     write_record(&path, &record)?;
-    Ok(Claim::start(path, record, timeout / 4, Vec::new(), false))
+    Ok(Claim::start(
+        path,
+        record,
+        timeout / 4,
+        Vec::new(),
+        false,
+        release,
+    ))
 }
 
 /// The renders running in `dir` (`announce_run`), by their records.
@@ -166,7 +176,8 @@ pub enum Attempt {
 }
 
 /// A held claim; a thread keeps its heartbeat fresh until it is dropped,
-/// which also removes the claim file.
+/// which also removes the claim file, as an interrupt (Ctrl-C) does: so
+/// another worker can take the frame at once.
 pub struct Claim {
     path: PathBuf,
     /// If it took a dead claim over: the marker it created, and the stale
@@ -175,6 +186,31 @@ pub struct Claim {
     token: String,
     stop: Arc<AtomicBool>,
     heartbeat: Option<std::thread::JoinHandle<()>>,
+    _released_on_interrupt: crate::interrupt::Registered,
+}
+
+/// Removes the claim at `path` if it still holds `token` (another worker
+/// may have taken it over), and the takeover `markers` it was won with.
+fn release(path: &Path, token: &str, markers: &[PathBuf]) {
+    if read_claim(path).is_some_and(|r| r.token == token) {
+        let _ = std::fs::remove_file(path);
+    }
+    // The markers of the dead claim this one replaced have served their
+    // purpose. (Only those: another may guard a takeover still going on.)
+    for marker in markers {
+        let _ = std::fs::remove_file(marker);
+    }
+}
+
+/// `release` of this claim, run on an interrupt (`interrupt::on_interrupt`).
+fn released_on_interrupt(path: &Path, token: &str, markers: &[PathBuf]) -> Registered {
+    crate::interrupt::hold().on_interrupt(releaser(path, token, markers))
+}
+
+/// A closure that runs `release` on copies of its arguments.
+fn releaser(path: &Path, token: &str, markers: &[PathBuf]) -> impl FnOnce() + Send + 'static {
+    let (path, token, markers) = (path.to_path_buf(), token.to_string(), markers.to_vec());
+    move || release(&path, &token, &markers)
 }
 
 impl Claim {
@@ -195,6 +231,7 @@ impl Claim {
         interval: Duration,
         markers: Vec<PathBuf>,
         contested: bool,
+        released_on_interrupt: Registered,
     ) -> Claim {
         let stop = Arc::new(AtomicBool::new(false));
         let heartbeat = {
@@ -222,6 +259,7 @@ impl Claim {
             token: record.token,
             stop,
             heartbeat: Some(heartbeat),
+            _released_on_interrupt: released_on_interrupt,
         }
     }
 }
@@ -232,14 +270,7 @@ impl Drop for Claim {
         if let Some(h) = self.heartbeat.take() {
             let _ = h.join();
         }
-        if read_claim(&self.path).is_some_and(|r| r.token == self.token) {
-            let _ = std::fs::remove_file(&self.path);
-        }
-        // The markers of the dead claim this one replaced have served their
-        // purpose. (Only those: another may guard a takeover still going on.)
-        for marker in &self.markers {
-            let _ = std::fs::remove_file(marker);
-        }
+        release(&self.path, &self.token, &self.markers);
     }
 }
 
@@ -250,8 +281,14 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
     let record = ClaimRecord::mine();
     let interval = timeout / 4;
     for _ in 0..3 {
-        match OpenOptions::new().write(true).create_new(true).open(&path) {
-            Ok(mut file) => {
+        // Created under the interrupt lock, with its release registered.
+        let created = {
+            let mut lock = crate::interrupt::hold();
+            let file = OpenOptions::new().write(true).create_new(true).open(&path);
+            file.map(|f| (f, lock.on_interrupt(releaser(&path, &record.token, &[]))))
+        };
+        match created {
+            Ok((mut file, release)) => {
                 let json = serde_json::to_string(&record).expect("serialises");
                 file.write_all(json.as_bytes())
                     .map_err(|e| Error::io(&path, e))?;
@@ -261,6 +298,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                     interval,
                     Vec::new(),
                     true,
+                    release,
                 )));
             }
             Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
@@ -300,14 +338,21 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
         // creates its marker first; a stale marker hands the decision to the
         // next generation's.
         let mut generation = 0;
-        let marker = loop {
+        let (marker, release) = loop {
             let marker = takeover_path(dir, frame_index, &held.token, generation);
+            let mut lock = crate::interrupt::hold();
             match OpenOptions::new()
                 .write(true)
                 .create_new(true)
                 .open(&marker)
             {
-                Ok(_) => break marker,
+                Ok(_) => {
+                    let markers: Vec<PathBuf> = (0..=generation)
+                        .map(|g| takeover_path(dir, frame_index, &held.token, g))
+                        .collect();
+                    let release = releaser(&path, &record.token, &markers);
+                    break (marker, lock.on_interrupt(release));
+                }
                 Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {
                     // Someone else is taking it over; their claim will show
                     // up live. Unless the marker is older than the timeout:
@@ -330,7 +375,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             .map(|g| takeover_path(dir, frame_index, &held.token, g))
             .collect();
         return Ok(Attempt::Claimed(Claim::start(
-            path, record, interval, markers, true,
+            path, record, interval, markers, true, release,
         )));
     }
     // The claim kept vanishing and reappearing: treat it as held this round.

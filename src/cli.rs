@@ -12,6 +12,7 @@ use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 /// `println!` that returns an error instead of panicking when standard
@@ -57,7 +58,8 @@ pub const EXIT_INCOMPLETE: u8 = 4;
     version,
     about = "Render keyframed Mandelbulb timelines (RON) to numbered PNG/EXR frames",
     after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline,\n\
-                  4 (status only) the sequence is not complete.\n\
+                  4 (status only) the sequence is not complete; a render stopped by Ctrl-C or SIGTERM\n\
+                  cleans up, says what is done and ends by that signal (130 or 143 in a shell).\n\
                   Timeline format and examples: README.md and timelines/*.ron."
 )]
 pub struct Cli {
@@ -447,6 +449,7 @@ pub fn ffmpeg_command(
 }
 
 /// A validated render job: what to render, how big, in which formats, where.
+#[derive(Clone)]
 struct Plan {
     timeline: Timeline,
     width: u32,
@@ -520,9 +523,9 @@ impl Plan {
         output::layers_for(&self.aovs)
     }
 
-    /// The plan an output folder records (see `output::JobRecord`), and
-    /// the record.
-    fn from_folder(dir: &Path) -> anyhow::Result<(Plan, output::JobRecord)> {
+    /// The plans an output folder records, one per format with its own
+    /// range, layers and samples (see `output::JobRecord`), and the record.
+    fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, output::JobRecord)> {
         if !dir.join(output::JOB_FILE).exists() {
             let preview = dir.join("preview");
             let hint = if preview.join(output::JOB_FILE).exists() {
@@ -537,26 +540,40 @@ impl Plan {
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
         let job = output::JobRecord::read(dir)?;
-        let timeline =
-            Timeline::parse(&job.timeline_text, &job.timeline_path)?.with_samples(job.samples);
-        let formats = job
-            .formats
-            .iter()
-            .map(|f| <Format as clap::ValueEnum>::from_str(f, true).map_err(|e| anyhow::anyhow!(e)))
-            .collect::<anyhow::Result<Vec<_>>>()?;
-        let plan = Plan {
-            width: job.width,
-            height: job.height,
-            range: job.frames.0..job.frames.1.min(timeline.frame_count),
-            formats,
-            out_dir: dir.to_path_buf(),
-            preview: job.preview,
-            aovs: job.aovs.clone(),
-            samples: job.samples,
-            verify: false,
-            timeline,
+        let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        let plan = |o: output::OutputRecord| -> anyhow::Result<Plan> {
+            let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
+                .map_err(|e| anyhow::anyhow!(e))?;
+            let timeline = timeline.clone().with_samples(o.samples);
+            Ok(Plan {
+                width: job.width,
+                height: job.height,
+                range: o.frames.0..o.frames.1.min(timeline.frame_count),
+                formats: vec![format],
+                out_dir: dir.to_path_buf(),
+                preview: job.preview,
+                aovs: o.aovs,
+                samples: o.samples,
+                verify: false,
+                timeline,
+            })
         };
-        Ok((plan, job))
+        let plans = job
+            .outputs()
+            .into_iter()
+            .map(plan)
+            .collect::<anyhow::Result<_>>()?;
+        Ok((plans, job))
+    }
+
+    /// This plan as one plan per format, so each format's frames can be
+    /// counted on their own.
+    fn per_format(&self) -> Vec<Plan> {
+        let one = |&format: &Format| Plan {
+            formats: vec![format],
+            ..self.clone()
+        };
+        self.formats.iter().map(one).collect()
     }
 
     /// Refuses a size whose frame would need more memory than this machine
@@ -610,6 +627,21 @@ impl Plan {
             preview: self.preview,
             aovs: self.aovs.clone(),
             samples: self.samples,
+            outputs: self
+                .formats
+                .iter()
+                .map(|&f| output::OutputRecord {
+                    format: f.extension().to_string(),
+                    frames: (self.range.start, self.range.end),
+                    // Only EXRs hold extra layers.
+                    aovs: if f == Format::Exr {
+                        self.aovs.clone()
+                    } else {
+                        Vec::new()
+                    },
+                    samples: self.samples,
+                })
+                .collect(),
         })
     }
 
@@ -629,6 +661,41 @@ impl Plan {
 
     fn path(&self, frame: u32, format: Format) -> PathBuf {
         self.out_dir.join(output::frame_file_name(frame, format))
+    }
+
+    /// The format a video is encoded from: the PNGs, where rendered.
+    fn video_format(&self) -> Format {
+        if self.formats.contains(&Format::Png) {
+            Format::Png
+        } else {
+            Format::Exr
+        }
+    }
+
+    /// Whether `frame`'s file in `format` is whole and current (no hash
+    /// is computed where there is no file).
+    fn is_current_in(&self, frame: u32, format: Format) -> bool {
+        let path = self.path(frame, format);
+        if !path.exists() {
+            return false;
+        }
+        let (_, hash) = self.frame(frame);
+        let key = output::stored_key(format, &hash, &self.aovs);
+        output::file_state(&path, format, &key, self.verify) == output::FileState::Current
+    }
+
+    /// The ffmpeg command encoding `range` from its `format` files: into
+    /// `<name>.mp4` for the whole film, else `<name>_frames_<A>-<B>.mp4`
+    /// (`<name>_frame_<A>.mp4` for one).
+    fn video_command(&self, range: &std::ops::Range<u32>, format: Format) -> String {
+        let name = &self.timeline.name;
+        let movie = if *range == (0..self.timeline.frame_count) {
+            name.clone()
+        } else {
+            format!("{name}_{}", frames_text(range).replace(' ', "_"))
+        };
+        let fps = self.timeline.fps;
+        ffmpeg_command(&self.out_dir, &movie, fps, range, format)
     }
 
     /// The state of each format's file of `frame` against these inputs
@@ -905,7 +972,20 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let message = format!("{} is a file, not a folder", out_dir.display());
         return Err(Error::usage("--out", message).into());
     }
-    std::fs::create_dir_all(&out_dir).map_err(|e| Error::io(&out_dir, e))?;
+    // From here on, Ctrl-C and SIGTERM clean up and say what is done. (Where
+    // they cannot be caught, they end the render as they always did.)
+    let _ = crate::interrupt::install();
+    let mine: Vec<u32> = plan
+        .range
+        .clone()
+        .filter(|f| shard.is_none_or(|(i, n)| f % n == i))
+        .collect();
+    let total = mine.len();
+    let tally = Arc::new(Mutex::new(Tally::default()));
+    let bars_drawn = Arc::new(std::sync::OnceLock::new());
+    let _reported = report_interrupt(&tally, &bars_drawn, total, shard);
+    // Removed again, when dropped, if the render ends having written nothing.
+    let scaffold = output::Scaffold::make(&out_dir)?;
     // Checked under the record's lock, so two renders started at once
     // cannot both pass it.
     let replacing = args.force || args.replace;
@@ -920,20 +1000,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Until this render ends, `status` lists it as running.
     let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
 
-    let mine: Vec<u32> = plan
-        .range
-        .clone()
-        .filter(|f| shard.is_none_or(|(i, n)| f % n == i))
-        .collect();
     // Decide which frames need work, so the progress bar and ETA count only those.
     let mut todo = Vec::new();
     for &frame in &mine {
         let (scene, hash) = plan.frame(frame);
         if args.force || !plan.is_complete(frame, &hash) {
             todo.push((frame, scene, hash));
+        } else {
+            lock(&tally).complete += 1;
         }
     }
-    let total = mine.len();
+    lock(&tally).checked = true;
     let skipped = total - todo.len();
 
     let show_bars = !args.quiet && std::io::stderr().is_terminal();
@@ -958,6 +1035,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             .expect("template is valid")
             .progress_chars("=> "),
     );
+    let _ = bars_drawn.set([overall.clone(), current.clone()]);
     // Lines printed above the bars when they show, plainly to stderr otherwise.
     let say = |line: String| {
         if show_bars {
@@ -1021,6 +1099,17 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let t0 = Instant::now();
         let n = scene[0].samples_per_pixel.max(1);
         current.set_length(height as u64 * n.div_ceil(wave_size(n)) as u64);
+        lock(&tally).writing = plan
+            .formats
+            .iter()
+            .map(|&f| {
+                (
+                    plan.path(frame, f),
+                    f,
+                    output::stored_key(f, hash, &plan.aovs),
+                )
+            })
+            .collect();
         let stats = plan.render_frame(
             &mut film,
             frame,
@@ -1039,6 +1128,11 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 )),
             },
         )?;
+        {
+            let mut tally = lock(&tally);
+            tally.complete += 1;
+            tally.writing.clear();
+        }
         totals = totals + stats;
         if out_of_steps_matters(&stats) {
             short_of_steps.push(frame);
@@ -1095,6 +1189,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 }
                 if !args.force && plan.is_complete(*frame, hash) {
                     finished[k] = true;
+                    lock(&tally).complete += 1;
                     continue;
                 }
                 match crate::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
@@ -1102,6 +1197,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         // It may have been finished between the check and the claim.
                         if args.force || !plan.is_complete(*frame, hash) {
                             render_one(*frame, scene, hash)?;
+                        } else {
+                            lock(&tally).complete += 1;
                         }
                         finished[k] = true;
                         drop(claim);
@@ -1119,6 +1216,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             held.retain(|(k, _)| {
                 let (frame, _, hash) = &todo[*k];
                 finished[*k] = plan.is_complete(*frame, hash);
+                lock(&tally).complete += usize::from(finished[*k]);
                 !finished[*k]
             });
             if held.is_empty() {
@@ -1161,13 +1259,6 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             elapsed / rendered.max(1) as f64,
             out_dir.display()
         );
-        // A shard's frames are part of the sequence, and a --force claim
-        // worker makes one pass: the others' frames may still be coming.
-        if shard.is_some_and(|(_, n)| n > 1) || (args.claim && args.force) {
-            eprintln!("encode the video, once every worker has finished, with:");
-        } else {
-            eprintln!("encode the video with:");
-        }
     }
     if args.stats {
         eprintln!(
@@ -1175,23 +1266,148 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             totals.de_evaluations, totals.repaired_samples
         );
     }
-    // On stdout even with --quiet: scripts can run it.
-    let video_format = if plan.formats.contains(&Format::Png) {
-        Format::Png
+    // This render's frames are all complete now, but where a --force claim
+    // worker made its one pass: others may still hold some.
+    let known = if args.claim && args.force {
+        &[][..]
     } else {
-        Format::Exr
+        &mine
     };
-    out!(
-        "{}",
-        ffmpeg_command(
-            &out_dir,
-            &plan.timeline.name,
-            plan.timeline.fps,
-            &plan.range,
-            video_format
-        )
-    );
+    print_video_command(&plan, known, args.quiet)?;
+    scaffold.keep();
     Ok(())
+}
+
+/// After a render: on stdout (scripts run it, so also with `--quiet`) the
+/// ffmpeg command for the whole film once every frame of it is complete;
+/// else for this render's range alone, under a name of its own so that no
+/// complete video is replaced, if that range is complete; and on stderr
+/// what is still missing. `known` frames are complete; the others are
+/// looked for on disk.
+fn print_video_command(plan: &Plan, known: &[u32], quiet: bool) -> anyhow::Result<()> {
+    let format = plan.video_format();
+    let known: std::collections::HashSet<u32> = known.iter().copied().collect();
+    let missing: Vec<u32> = (0..plan.timeline.frame_count)
+        .filter(|f| !known.contains(f) && !plan.is_current_in(*f, format))
+        .collect();
+    let say = |line: String| {
+        if !quiet {
+            eprintln!("{line}");
+        }
+    };
+    if missing.is_empty() {
+        say("encode the video with:".into());
+        out!(
+            "{}",
+            plan.video_command(&(0..plan.timeline.frame_count), format)
+        );
+        return Ok(());
+    }
+    let status = format!(
+        "mandelreel status {}",
+        shell_quote(&plan.out_dir.to_string_lossy())
+    );
+    let lacking = format!(
+        "frame(s) {} of the film are not complete yet",
+        frame_summary(&missing)
+    );
+    // Another worker's frames in this range: nothing to encode on its own.
+    if missing.iter().any(|f| plan.range.contains(f)) {
+        say(format!(
+            "{lacking}; once they are, {status} prints the command that encodes the video"
+        ));
+        return Ok(());
+    }
+    say(format!(
+        "{lacking} ({status} tells when, and prints the command for the whole video); \
+         to encode {} alone, leaving {}.mp4 as it is:",
+        frames_text(&plan.range),
+        plan.timeline.name
+    ));
+    out!("{}", plan.video_command(&plan.range, format));
+    Ok(())
+}
+
+/// `frame 5`, or `frames 0-2`, for a range of frames.
+fn frames_text(range: &std::ops::Range<u32>) -> String {
+    match range.len() {
+        1 => format!("frame {}", range.start),
+        _ => format!("frames {}-{}", range.start, range.end.saturating_sub(1)),
+    }
+}
+
+/// `ranges` of `frames`, its first few runs only for a long list:
+/// `1-7, 9-15, 17-23, 25-31, 33-39, … (1110 frames)`.
+fn frame_summary(frames: &[u32]) -> String {
+    let all = ranges(frames);
+    let runs: Vec<&str> = all.split(", ").collect();
+    if runs.len() <= 6 {
+        return all;
+    }
+    format!("{}, … ({} frames)", runs[..5].join(", "), frames.len())
+}
+
+/// How far a render has got, for what an interrupt says (`report_interrupt`).
+#[derive(Default)]
+struct Tally {
+    /// Whether every frame of the render has been checked for being complete.
+    checked: bool,
+    /// Frames of this render's share complete: found so, or rendered.
+    complete: usize,
+    /// The files of the frame being rendered, and the key each will hold:
+    /// they may be in place a moment before `complete` counts the frame.
+    writing: Vec<(PathBuf, Format, String)>,
+}
+
+/// `tally`, locked (a panic elsewhere does not make its numbers wrong).
+fn lock(tally: &Mutex<Tally>) -> std::sync::MutexGuard<'_, Tally> {
+    tally.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// On Ctrl-C or SIGTERM, once the render's files are cleaned up (see
+/// `interrupt`): clears the progress bars and says how many of the `total`
+/// frames of this render (of its `shard`) are complete.
+fn report_interrupt(
+    tally: &Arc<Mutex<Tally>>,
+    bars: &Arc<std::sync::OnceLock<[ProgressBar; 2]>>,
+    total: usize,
+    shard: Option<(u32, u32)>,
+) -> crate::interrupt::Registered {
+    let (tally, bars) = (tally.clone(), bars.clone());
+    crate::interrupt::report_on_interrupt(move |stop| {
+        use std::io::Write as _;
+        if let Some(bars) = bars.get() {
+            if stop.echoed && !bars[0].is_hidden() {
+                // The `^C` went past the bars' last column, onto a line of
+                // its own: wipe it, and go back up to where they end.
+                let _ = write!(std::io::stderr(), "\r\x1b[2K\x1b[1A");
+            }
+            // As at the end of a render; rows still finishing draw nothing.
+            for bar in bars {
+                bar.finish_and_clear();
+            }
+        }
+        let tally = lock(&tally);
+        let written = !tally.writing.is_empty()
+            && tally.writing.iter().all(|(path, format, key)| {
+                output::file_state(path, *format, key, false) == output::FileState::Current
+            });
+        let share = match shard {
+            Some((i, n)) if n > 1 => format!(" (shard {i}/{n})"),
+            _ => String::new(),
+        };
+        let done = if tally.checked {
+            let complete = tally.complete + usize::from(written);
+            format!(": {complete} of {total} frames complete{share}")
+        } else {
+            format!(" while checking which of {total} frames are complete{share}")
+        };
+        // Not `eprintln!`, which panics if standard error is gone.
+        let _ = writeln!(
+            std::io::stderr(),
+            "interrupted{done}; the same command resumes"
+        );
+    })
 }
 
 /// What `Plan::render_frame` has to say while a frame renders.
@@ -1222,6 +1438,18 @@ pub enum FrameState {
 }
 
 impl FrameState {
+    /// A frame's state over the `states` of its formats: complete if each
+    /// is, else the one that says most of what is left (a live worker, a
+    /// checkpoint, a damaged file, a stale one, in that order).
+    fn of_formats(states: &[FrameState]) -> FrameState {
+        use FrameState::*;
+        let order = [InProgress, Resumable, Damaged, Stale, Missing];
+        order
+            .into_iter()
+            .find(|s| states.contains(s))
+            .unwrap_or(Complete)
+    }
+
     /// The state's name in `status --json` (`in progress` in the text).
     pub fn name(self) -> &'static str {
         match self {
@@ -1354,8 +1582,8 @@ fn ranges(frames: &[u32]) -> String {
 }
 
 fn status(args: StatusArgs) -> anyhow::Result<()> {
-    // The plan, and the folder's record: read once.
-    let (plan, job) = if args.target.is_dir() {
+    // One plan per format, and the folder's record: read once.
+    let (parts, job) = if args.target.is_dir() {
         let s = &args.sequence;
         // The folder records these; only the frames may be narrowed.
         let given = [
@@ -1377,23 +1605,39 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             )
             .into());
         }
-        let (mut plan, job) = Plan::from_folder(&args.target)?;
-        if let Some(frames) = &s.frames {
-            plan.range = parse_frames(frames, plan.timeline.frame_count)?;
+        let (mut parts, job) = Plan::from_folder(&args.target)?;
+        for part in &mut parts {
+            if let Some(frames) = &s.frames {
+                part.range = parse_frames(frames, part.timeline.frame_count)?;
+            }
         }
-        (plan, Some(job))
+        (parts, Some(job))
     } else {
         let plan = Plan::new(&args.target, &args.sequence)?;
         let job = output::JobRecord::read(&plan.out_dir).ok();
-        (plan, job)
+        (plan.per_format(), job)
+    };
+    let parts: Vec<Plan> = parts
+        .into_iter()
+        .map(|part| Plan {
+            verify: args.verify,
+            ..part
+        })
+        .collect();
+    // What the formats share, over the span of their ranges.
+    let Some(first) = parts.first() else {
+        let message = format!("{} records no output format", output::JOB_FILE);
+        return Err(Error::usage(&args.target.display().to_string(), message).into());
     };
     let plan = Plan {
-        verify: args.verify,
-        ..plan
+        range: parts.iter().map(|p| p.range.start).min().unwrap_or(0)
+            ..parts.iter().map(|p| p.range.end).max().unwrap_or(0),
+        ..first.clone()
     };
     // Fresh temporary files, by frame: a writer is finishing that frame.
     let writing = output::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
+    let mut by_format = vec![std::collections::BTreeMap::new(); parts.len()];
     // Renders running on the folder (`claim::announce_run`), and below, any
     // other worker holding a claim.
     let mut workers: std::collections::BTreeSet<String> =
@@ -1402,39 +1646,44 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
             .map(crate::claim::ClaimRecord::who)
             .collect();
     for frame in plan.range.clone() {
-        let (_, hash) = plan.frame(frame);
-        // Each file's header read once, and a file read whole only where
-        // its header records these inputs.
-        let files = plan.file_states(frame, &hash);
-        let state = if files.iter().all(|&s| s == output::FileState::Current) {
-            FrameState::Complete
-        } else if let Some(claim) =
-            crate::claim::read_claim(&crate::claim::claim_path(&plan.out_dir, frame))
-                .filter(|c| crate::claim::is_live(c, args.claim_timeout))
-        {
-            workers.insert(claim.who());
-            FrameState::InProgress
-        } else if writing.contains(&frame) {
-            FrameState::InProgress
-        } else if output::checkpoint_is_for(
-            &output::checkpoint_path(&plan.out_dir, frame),
-            output::light_hash(&hash),
-            plan.width,
-            plan.height,
-            plan.layers(),
-        ) {
-            FrameState::Resumable
-        } else if files.contains(&output::FileState::Damaged) {
-            FrameState::Damaged
-        } else if files.contains(&output::FileState::Stale) {
-            FrameState::Stale
-        } else {
-            FrameState::Missing
-        };
-        by_state.entry(state).or_default().push(frame);
+        let mut states = Vec::new();
+        for (part, by_state) in parts.iter().zip(&mut by_format) {
+            if part.range.contains(&frame) {
+                let (state, worker) = frame_state(part, frame, &writing, args.claim_timeout);
+                workers.extend(worker);
+                by_state.entry(state).or_insert_with(Vec::new).push(frame);
+                states.push(state);
+            }
+        }
+        // A frame in a gap between formats' ranges is no format's to hold.
+        if !states.is_empty() {
+            by_state
+                .entry(FrameState::of_formats(&states))
+                .or_default()
+                .push(frame);
+        }
     }
-    let total = plan.range.len();
+    let total: usize = by_state.values().map(Vec::len).sum();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
+    let formats: std::collections::BTreeMap<&str, FormatStatus> = parts
+        .iter()
+        .zip(&by_format)
+        .map(|(part, by_state)| {
+            (
+                part.formats[0].extension(),
+                FormatStatus::of(part, by_state),
+            )
+        })
+        .collect();
+    // Once the video's frames are all there: the command that encodes them.
+    let video = parts
+        .iter()
+        .find(|p| p.formats[0] == plan.video_format())
+        .unwrap_or(first);
+    let video_command = formats
+        .get(video.formats[0].extension())
+        .filter(|f| f.total > 0 && f.complete == f.total)
+        .map(|_| video.video_command(&video.range, video.formats[0]));
     // A folder last rendered from another timeline file (with --force).
     let other_timeline = job
         .as_ref()
@@ -1464,6 +1713,11 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                 /// The timeline the folder was last rendered from, where that
                 /// is another file.
                 folder_rendered_from: Option<&'a Path>,
+                /// Each format's frames, counted on their own.
+                formats: &'a std::collections::BTreeMap<&'a str, FormatStatus<'a>>,
+                /// The ffmpeg command for the frames counted, once they
+                /// are complete in the format a video is made from.
+                video_command: Option<&'a str>,
             }
             out!(
                 "{}",
@@ -1478,6 +1732,8 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     workers: workers.iter().cloned().collect(),
                     timeline_changed_since_render: changed,
                     folder_rendered_from: other_timeline.as_deref(),
+                    formats: &formats,
+                    video_command: video_command.as_deref(),
                 })?
             );
         } else {
@@ -1496,6 +1752,23 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     state.name().replace('_', " "),
                     frames.len(),
                     ranges(frames)
+                );
+            }
+            // Several formats: each on its own line, with what it lacks.
+            for (name, f) in formats.iter().filter(|_| formats.len() > 1) {
+                let lacking: Vec<String> = (f.states.iter())
+                    .filter(|(state, _)| **state != FrameState::Complete.name())
+                    .map(|(state, frames)| {
+                        format!("; {} {}", state.replace('_', " "), ranges(frames))
+                    })
+                    .collect();
+                out!(
+                    "  {name}: {} of {} complete and current (frames {}..{}){}",
+                    f.complete,
+                    f.total,
+                    f.frames.0,
+                    f.frames.1,
+                    lacking.concat()
                 );
             }
             if !workers.is_empty() {
@@ -1529,6 +1802,9 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
                     plan.timeline.source.display()
                 );
             }
+            if let Some(command) = &video_command {
+                out!("  encode: {command}");
+            }
         }
         Ok(())
     };
@@ -1537,6 +1813,67 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         Ok(())
     } else {
         Err(Incomplete { complete, total }.into())
+    }
+}
+
+/// The state of `frame` in the one format of `part`, and the worker
+/// holding its claim, if a live one does. `writing` holds the frames with
+/// a live writer's temporary file.
+fn frame_state(
+    part: &Plan,
+    frame: u32,
+    writing: &std::collections::HashSet<u32>,
+    claim_timeout: std::time::Duration,
+) -> (FrameState, Option<String>) {
+    let (_, hash) = part.frame(frame);
+    // Each file's header read once, and a file read whole only where
+    // its header records these inputs.
+    let files = part.file_states(frame, &hash);
+    if files.iter().all(|&s| s == output::FileState::Current) {
+        return (FrameState::Complete, None);
+    }
+    let claim = crate::claim::read_claim(&crate::claim::claim_path(&part.out_dir, frame))
+        .filter(|c| crate::claim::is_live(c, claim_timeout));
+    if let Some(claim) = claim {
+        return (FrameState::InProgress, Some(claim.who()));
+    }
+    let state = if writing.contains(&frame) {
+        FrameState::InProgress
+    } else if output::checkpoint_is_for(
+        &output::checkpoint_path(&part.out_dir, frame),
+        output::light_hash(&hash),
+        part.width,
+        part.height,
+        part.layers(),
+    ) {
+        FrameState::Resumable
+    } else if files.contains(&output::FileState::Damaged) {
+        FrameState::Damaged
+    } else if files.contains(&output::FileState::Stale) {
+        FrameState::Stale
+    } else {
+        FrameState::Missing
+    };
+    (state, None)
+}
+
+/// One format's frames in a `status` report.
+#[derive(Serialize)]
+struct FormatStatus<'a> {
+    frames: (u32, u32),
+    total: usize,
+    complete: usize,
+    states: std::collections::BTreeMap<&'a str, &'a Vec<u32>>,
+}
+
+impl<'a> FormatStatus<'a> {
+    fn of(part: &Plan, by_state: &'a std::collections::BTreeMap<FrameState, Vec<u32>>) -> Self {
+        FormatStatus {
+            frames: (part.range.start, part.range.end),
+            total: by_state.values().map(Vec::len).sum(),
+            complete: by_state.get(&FrameState::Complete).map_or(0, Vec::len),
+            states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
+        }
     }
 }
 
@@ -2079,6 +2416,15 @@ mod tests {
         assert!(e.contains("written with two dots: 0..3"), "{e}");
         let e = parse_frames("-3", 10).unwrap_err().to_string();
         assert!(!e.contains("two dots"), "{e}");
+    }
+
+    #[test]
+    fn a_long_list_of_missing_frames_is_cut_short() {
+        assert_eq!(frame_summary(&[1, 2, 3, 7]), "1-3, 7");
+        let every_other: Vec<u32> = (0..100).step_by(2).collect();
+        assert_eq!(frame_summary(&every_other), "0, 2, 4, 6, 8, … (50 frames)");
+        assert_eq!(frames_text(&(5..6)), "frame 5");
+        assert_eq!(frames_text(&(0..3)), "frames 0-2");
     }
 
     #[test]

@@ -1,7 +1,8 @@
 //! mandelreel: keyframed Mandelbulb films from RON timelines.
 //!
 //! Layers, each depending only on those after it:
-//! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`.
+//! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`;
+//! `interrupt` (what Ctrl-C cleans up) sits under `output` and `claim`.
 
 #![forbid(unsafe_code)]
 
@@ -12,6 +13,7 @@ pub mod cli;
 pub mod environment;
 pub mod error;
 pub mod fractal;
+pub mod interrupt;
 pub mod march;
 pub mod math;
 pub mod output;

@@ -395,7 +395,17 @@ pub fn write_atomic(
         use std::os::unix::fs::PermissionsExt;
         builder.permissions(std::fs::Permissions::from_mode(0o644));
     }
-    let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+    // Created and renamed under the interrupt lock, so Ctrl-C removes
+    // every temporary file and none is renamed into place after it.
+    let (temp, _removed_on_interrupt) = {
+        let mut held = crate::interrupt::hold();
+        let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+        let temp_path = temp.path().to_path_buf();
+        let removal = held.on_interrupt(move || {
+            let _ = std::fs::remove_file(temp_path);
+        });
+        (temp, removal)
+    };
     let temp_path = temp.path().to_path_buf();
     // Written through the plain file: the temporary file's own writer
     // would add its path to every error, which `Error::io` names already.
@@ -406,7 +416,9 @@ pub fn write_atomic(
         .map_err(|e| Error::io(&temp_path, e.into_error()))?
         .sync_all()
         .map_err(|e| Error::io(&temp_path, e))?;
+    let held = crate::interrupt::hold();
     temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    drop(held);
     Ok(())
 }
 
@@ -764,6 +776,25 @@ pub struct JobRecord {
     /// timeline's.
     #[serde(default)]
     pub samples: Option<u32>,
+    /// Each format's own range, layers and samples (`outputs`); the fields
+    /// above are their union, and the last render's, for older readers.
+    #[serde(default)]
+    pub outputs: Vec<OutputRecord>,
+}
+
+/// What one format's frames in a folder were rendered with: a folder may
+/// hold PNGs of the whole film and EXRs of three frames, with other layers
+/// or samples, each complete on its own terms.
+#[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
+pub struct OutputRecord {
+    /// `png` or `exr`.
+    pub format: String,
+    /// Half-open span of every range rendered in this format.
+    pub frames: (u32, u32),
+    #[serde(default)]
+    pub aovs: Vec<Aov>,
+    #[serde(default)]
+    pub samples: Option<u32>,
 }
 
 impl JobRecord {
@@ -804,16 +835,24 @@ impl JobRecord {
     /// under the same lock, and its error stops the write: so a render
     /// refused over another sequence's frames cannot slip in between
     /// another render's check and its write.
+    ///
+    /// Each format is merged on its own (`merge_outputs`): a render of a
+    /// few EXR frames into a folder of PNGs leaves the PNGs' range as it
+    /// was, and adds the EXRs'.
     pub fn record_in(self, dir: &Path, check: impl FnOnce(&JobRecord) -> Result<()>) -> Result<()> {
         // Read-only where another user made it (a lock needs no write
         // access), and none at all where it cannot be had.
         let lock_path = dir.join(JOB_LOCK);
+        // Under the interrupt lock: a render stopped before it wrote
+        // anything removes the lock file it made (`Scaffold`).
+        let held = crate::interrupt::hold();
         let lock = std::fs::OpenOptions::new()
             .create(true)
             .truncate(false)
             .write(true)
             .open(&lock_path)
             .or_else(|_| File::open(&lock_path));
+        drop(held);
         if let Ok(lock) = &lock {
             let _ = lock.lock();
         }
@@ -822,16 +861,57 @@ impl JobRecord {
             check(old)?;
         }
         let record = match old {
-            Ok(old) if old.same_sequence(&self) => JobRecord {
-                frames: (
-                    old.frames.0.min(self.frames.0),
-                    old.frames.1.max(self.frames.1),
-                ),
-                ..self
-            },
+            Ok(old) if old.same_sequence(&self) => self.merge_outputs(&old),
             _ => self,
         };
         record.write(dir)
+    }
+
+    /// Each format's record: `outputs`, or for a record written before
+    /// them, one per format from the shared fields.
+    pub fn outputs(&self) -> Vec<OutputRecord> {
+        if !self.outputs.is_empty() {
+            return self.outputs.clone();
+        }
+        let output = |format: &String| OutputRecord {
+            format: format.clone(),
+            frames: self.frames,
+            aovs: if format == "exr" {
+                self.aovs.clone()
+            } else {
+                Vec::new()
+            },
+            samples: self.samples,
+        };
+        self.formats.iter().map(output).collect()
+    }
+
+    /// This record, keeping the formats of `old` (the same sequence) that
+    /// it does not render, and the span of its own formats' ranges there.
+    fn merge_outputs(self, old: &JobRecord) -> JobRecord {
+        let mut outputs = old.outputs();
+        for new in self.outputs() {
+            match outputs.iter_mut().find(|o| o.format == new.format) {
+                Some(o) => {
+                    *o = OutputRecord {
+                        frames: (o.frames.0.min(new.frames.0), o.frames.1.max(new.frames.1)),
+                        ..new
+                    }
+                }
+                None => outputs.push(new),
+            }
+        }
+        outputs.sort_by(|a, b| a.format.cmp(&b.format));
+        let span = |f: fn(&OutputRecord) -> u32| outputs.iter().map(f);
+        JobRecord {
+            formats: outputs.iter().map(|o| o.format.clone()).collect(),
+            frames: (
+                span(|o| o.frames.0).min().unwrap_or(self.frames.0),
+                span(|o| o.frames.1).max().unwrap_or(self.frames.1),
+            ),
+            outputs,
+            ..self
+        }
     }
 
     pub fn read(dir: &Path) -> Result<JobRecord> {
@@ -841,6 +921,100 @@ impl JobRecord {
             path,
             message: format!("not a mandelreel job record: {e}"),
         })
+    }
+}
+
+/// An output folder as a render set it up: the folders it created
+/// (outermost first) and the bookkeeping files that were not there yet
+/// (`JOB_LOCK`, `JOB_FILE`). A render that ends having written nothing
+/// (a disk full from the start, Ctrl-C during its first frame) removes
+/// them when this is dropped, or on an interrupt, unless `keep` was
+/// called: it leaves the disk as it found it.
+pub struct Scaffold {
+    made: Option<Made>,
+    _undone_on_interrupt: crate::interrupt::Registered,
+}
+
+#[derive(Clone)]
+struct Made {
+    dir: PathBuf,
+    dirs: Vec<PathBuf>,
+    files: Vec<&'static str>,
+}
+
+impl Scaffold {
+    /// Creates `dir` and its missing parents, noting what it made.
+    pub fn make(dir: &Path) -> Result<Scaffold> {
+        let mut dirs: Vec<PathBuf> = dir
+            .ancestors()
+            .take_while(|d| !d.as_os_str().is_empty() && !d.exists())
+            .map(Path::to_path_buf)
+            .collect();
+        dirs.reverse();
+        let mut held = crate::interrupt::hold();
+        let mut made = Made {
+            dir: dir.to_path_buf(),
+            dirs,
+            files: Vec::new(),
+        };
+        if let Err(e) = std::fs::create_dir_all(dir) {
+            made.undo();
+            return Err(Error::io(dir, e));
+        }
+        made.files = [JOB_LOCK, JOB_FILE]
+            .into_iter()
+            .filter(|f| !dir.join(f).exists())
+            .collect();
+        let undo = made.clone();
+        let registered = held.on_interrupt(move || undo.undo());
+        drop(held);
+        Ok(Scaffold {
+            made: Some(made),
+            _undone_on_interrupt: registered,
+        })
+    }
+
+    /// The render wrote what it meant to: nothing is undone.
+    pub fn keep(mut self) {
+        self.made = None;
+    }
+}
+
+impl Drop for Scaffold {
+    fn drop(&mut self) {
+        if let Some(made) = &self.made {
+            made.undo();
+        }
+    }
+}
+
+impl Made {
+    /// Removes what was made, if the folder holds nothing else: no frame,
+    /// checkpoint, claim, or another render's record or files.
+    fn undo(&self) {
+        let Ok(entries) = std::fs::read_dir(&self.dir) else {
+            return self.remove_dirs();
+        };
+        let only_ours = entries
+            .map(|e| e.map(|e| e.file_name()))
+            .all(|name| name.is_ok_and(|n| self.files.iter().any(|f| n == *f)));
+        if only_ours {
+            for f in &self.files {
+                let _ = std::fs::remove_file(self.dir.join(f));
+            }
+            self.remove_dirs();
+        }
+    }
+
+    /// Removes the folders made, innermost first, while they are empty
+    /// (or were never made: `create_dir_all` may stop part-way).
+    fn remove_dirs(&self) {
+        for dir in self.dirs.iter().rev() {
+            match std::fs::remove_dir(dir) {
+                Err(e) if e.kind() != std::io::ErrorKind::NotFound => return,
+                _ => {}
+            }
+        }
     }
 }
 
@@ -1471,7 +1645,57 @@ mod tests {
             preview: false,
             aovs: Vec::new(),
             samples: None,
+            outputs: Vec::new(),
         }
+    }
+
+    #[test]
+    fn each_format_keeps_its_own_range_layers_and_samples() {
+        let dir = tempfile::tempdir().unwrap();
+        // A record written before formats had their own: PNGs of 0..120.
+        record((0, 120)).write(dir.path()).unwrap();
+        let exr = OutputRecord {
+            format: "exr".into(),
+            frames: (0, 3),
+            aovs: vec![Aov::Normal],
+            samples: Some(2),
+        };
+        let few_exrs = JobRecord {
+            formats: vec!["exr".into()],
+            frames: (0, 3),
+            aovs: vec![Aov::Normal],
+            samples: Some(2),
+            outputs: vec![exr.clone()],
+            ..record((0, 3))
+        };
+        few_exrs.record_in(dir.path(), |_| Ok(())).unwrap();
+        let png = OutputRecord {
+            format: "png".into(),
+            frames: (0, 120),
+            aovs: Vec::new(),
+            samples: None,
+        };
+        let merged = JobRecord::read(dir.path()).unwrap();
+        assert_eq!(merged.outputs(), [exr.clone(), png.clone()]);
+        assert_eq!((merged.frames, merged.formats.len()), ((0, 120), 2));
+        // More EXRs widen the EXRs' span alone, and take the new samples.
+        let more = OutputRecord {
+            frames: (5, 8),
+            samples: None,
+            ..exr
+        };
+        JobRecord {
+            outputs: vec![more.clone()],
+            ..record((5, 8))
+        }
+        .record_in(dir.path(), |_| Ok(()))
+        .unwrap();
+        let merged = JobRecord::read(dir.path()).unwrap();
+        let widened = OutputRecord {
+            frames: (0, 8),
+            ..more
+        };
+        assert_eq!(merged.outputs(), [widened, png]);
     }
 
     #[test]

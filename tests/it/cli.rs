@@ -53,6 +53,50 @@ fn frame_range_is_half_open_and_size_overrides() {
 }
 
 #[test]
+fn only_a_complete_film_gets_the_command_that_writes_its_video() {
+    // A part of the film gets a command naming that part's own video, and
+    // is told what the whole one lacks; a shard whose range others are
+    // still rendering gets none; once every frame is there, the render and
+    // `status` print the command for <name>.mp4.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(5, 6.0));
+    let out = d.ok(&["render", "t.ron", "--frames", "1..3"]);
+    let cmd = stdout(&out);
+    assert!(
+        cmd.contains("-start_number 1 -i out/t/frame_%05d.png -frames:v 2")
+            && cmd.trim_end().ends_with(" out/t/t_frames_1-2.mp4"),
+        "{cmd}"
+    );
+    says(&out, "frame(s) 0, 3-4 of the film are not complete yet");
+    let cmd = stdout(&d.ok(&["render", "t.ron", "--frames", "4"]));
+    assert!(cmd.trim_end().ends_with(" out/t/t_frame_4.mp4"), "{cmd}");
+    let out = d.ok(&["render", "t.ron", "--shard", "0/2"]);
+    assert_eq!(
+        stdout(&out),
+        "",
+        "frame 3 is another shard's, still missing"
+    );
+    says(
+        &out,
+        "once they are, mandelreel status out/t prints the command",
+    );
+    assert!(!stdout(&d.run(&["status", "out/t"])).contains("encode:"));
+    let cmd = stdout(&d.ok(&["render", "t.ron", "--quiet"]));
+    assert!(
+        cmd.contains("-start_number 0 -i out/t/frame_%05d.png -frames:v 5")
+            && cmd.trim_end().ends_with(" out/t/t.mp4"),
+        "{cmd}"
+    );
+    let status = stdout(&d.ok(&["status", "out/t"]));
+    assert!(
+        status.contains(&format!("encode: {}", cmd.trim())),
+        "{status}"
+    );
+    let (_, v) = d.status_json(&["out/t"]);
+    assert_eq!(v["video_command"], cmd.trim(), "{v}");
+}
+
+#[test]
 fn samples_on_the_command_line_render_what_the_timeline_would() {
     // `--samples 4` gives the very frames of a timeline that says
     // samples_per_pixel: 4, and the folder records it for `status`.

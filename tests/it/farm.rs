@@ -179,6 +179,39 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
 }
 
 #[test]
+fn status_of_a_folder_reports_each_format_it_holds() {
+    // A few EXR frames, with their own samples, rendered into a folder of
+    // complete PNGs: neither hides the other (the folder's status used to
+    // count the last render's format, range and samples alone).
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(6, 6.0));
+    d.ok(&["render", "t.ron", "--quiet"]);
+    let exr = ["--format", "exr", "--frames", "0..3", "--samples", "2"];
+    d.ok(&[&["render", "t.ron", "--quiet"][..], &exr].concat());
+    let out = d.ok(&["status", "out/t"]);
+    let text = stdout(&out);
+    assert!(text.contains("6 of 6 frames complete"), "{text}");
+    assert!(
+        text.contains("exr: 3 of 3 complete and current (frames 0..3)")
+            && text.contains("png: 6 of 6 complete and current (frames 0..6)"),
+        "{text}"
+    );
+    std::fs::remove_file(d.path().join("out/t/frame_00001.exr")).unwrap();
+    let (code, v) = d.status_json(&["out/t"]);
+    assert_eq!(code, Some(4), "{v}");
+    assert_eq!(v["states"]["missing"], serde_json::json!([1]), "{v}");
+    assert_eq!(v["formats"]["png"]["complete"], 6, "{v}");
+    assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([0, 3]));
+    assert_eq!(
+        v["formats"]["exr"]["states"]["missing"],
+        serde_json::json!([1])
+    );
+    // The timeline's status counts what its options name, format by format.
+    let text = stdout(&d.run(&[&["status", "t.ron"][..], &exr].concat()));
+    assert!(text.contains("2 of 3 frames complete"), "{text}");
+}
+
+#[test]
 fn shards_split_frames_by_index_and_from_the_scheduler() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(7, 6.0));
@@ -386,9 +419,9 @@ impl Drop for SmallDisk {
     }
 }
 
-#[test]
-fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
-    let d = Dir::new();
+/// A 48 KB tmpfs mounted on `disk` in `d`, or `None` (with a note) where
+/// mounting needs privileges this test does not have.
+fn small_disk(d: &Dir) -> Option<SmallDisk> {
     let mount = d.path().join("disk");
     std::fs::create_dir(&mount).unwrap();
     let mounted = std::process::Command::new("mount")
@@ -403,9 +436,17 @@ fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
             "cannot mount a tmpfs in CI"
         );
         eprintln!("skipping: cannot mount a small tmpfs here (not root?)");
-        return;
+        return None;
     }
-    let _disk = SmallDisk(mount.clone());
+    Some(SmallDisk(mount))
+}
+
+#[test]
+fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
+    let d = Dir::new();
+    let Some(_disk) = small_disk(&d) else {
+        return;
+    };
     // 40 frames of about 4 KB each cannot fit in 48 KB.
     d.write("t.ron", &tiny_timeline(40, 6.0));
     let out = d.run(&["render", "t.ron", "--out", "disk/seq", "--quiet"]);
@@ -430,4 +471,71 @@ fn a_full_disk_fails_clearly_and_keeps_earlier_frames() {
 /// reason; MANDELREEL_NO_MOUNT=1 lets such a CI skip it explicitly.
 fn ci_allows_skipping_mount() -> bool {
     std::env::var_os("MANDELREEL_NO_MOUNT").is_some()
+}
+
+#[test]
+fn a_disk_full_before_the_first_write_leaves_nothing_behind() {
+    // Nothing written: no folder, record or lock left (`status` would call
+    // such a folder "not a mandelreel output folder"); a folder that was
+    // there stays as it was.
+    let d = Dir::new();
+    let Some(_disk) = small_disk(&d) else {
+        return;
+    };
+    std::fs::create_dir(d.path().join("disk/empty")).unwrap();
+    let filler = vec![0u8; 4096];
+    let mut file = std::fs::File::create(d.path().join("disk/filler")).unwrap();
+    while std::io::Write::write_all(&mut file, &filler).is_ok() {}
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    for out in ["disk/new/seq", "disk/empty"] {
+        let run = d.run(&["render", "t.ron", "--out", out, "--quiet"]);
+        assert_eq!(run.status.code(), Some(1), "{}", stderr(&run));
+        says(&run, "No space left");
+    }
+    assert!(
+        !d.path().join("disk/new").exists(),
+        "{:?}",
+        d.files("disk/new")
+    );
+    assert!(
+        d.files("disk/empty").is_empty(),
+        "{:?}",
+        d.files("disk/empty")
+    );
+}
+
+#[test]
+fn a_claim_worker_stopped_by_sigterm_releases_its_frame() {
+    // Its claim and run record go, so a worker on any machine takes the
+    // frame at once (from its checkpoint), and `status` lists no worker.
+    use std::os::unix::process::ExitStatusExt;
+    let d = Dir::new();
+    d.write("t.ron", &long_frames(1));
+    let args = [
+        "render",
+        "t.ron",
+        "--claim",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+    ];
+    let mut command = d.command(&args);
+    command.stderr(std::process::Stdio::piped());
+    let worker = d.spawn_command_until(command, "out/t", ".ckpt");
+    let out = crate::resume::interrupt(worker, nix::sys::signal::Signal::SIGTERM);
+    assert_eq!(out.status.signal(), Some(15), "{}", stderr(&out));
+    says(&out, "interrupted: 0 of 1 frames complete");
+    let left = d.files("out/t");
+    assert!(
+        !left
+            .iter()
+            .any(|f| f.ends_with(".claim") || f.starts_with(".mandelreel-run-")),
+        "claim or run record left: {left:?}"
+    );
+    let (_, status) = d.status_json(&["out/t"]);
+    assert_eq!(status["states"]["resumable"], serde_json::json!([0]));
+    assert_eq!(status["workers"], serde_json::json!([]));
+    let out = d.ok(&["render", "t.ron", "--claim"]);
+    says(&out, "resuming from a checkpoint");
 }

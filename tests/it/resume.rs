@@ -383,3 +383,74 @@ fn status_lists_a_running_render_and_forgets_a_killed_one() {
     d.ok(&["render", "t.ron", "--quiet"]);
     assert_eq!(records(&d), 0, "the next render clears it, and its own");
 }
+
+/// Sends `signal` to the running `child` and waits for it: its stderr and
+/// exit status.
+pub fn interrupt(
+    child: std::process::Child,
+    signal: nix::sys::signal::Signal,
+) -> std::process::Output {
+    let pid = nix::unistd::Pid::from_raw(child.id() as i32);
+    nix::sys::signal::kill(pid, signal).unwrap();
+    child.wait_with_output().unwrap()
+}
+
+#[test]
+fn ctrl_c_says_what_is_done_leaves_no_record_and_the_same_command_resumes() {
+    use std::os::unix::process::ExitStatusExt;
+    let d = Dir::new();
+    d.write("t.ron", &long_frames(2));
+    let args = [
+        "render",
+        "t.ron",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+    ];
+    let mut command = d.command(&args);
+    command.stderr(std::process::Stdio::piped());
+    // Frame 0 done, frame 1 part-way: its first checkpoint saved.
+    let child = d.spawn_command_until(command, "out/t", "00001.ckpt");
+    let out = interrupt(child, nix::sys::signal::Signal::SIGINT);
+    // Ended by the signal itself, as a shell sees it (130), so a script's
+    // loop stops too.
+    assert_eq!(out.status.signal(), Some(2), "{}", stderr(&out));
+    says(
+        &out,
+        "interrupted: 1 of 2 frames complete; the same command resumes",
+    );
+    let left = d.files("out/t");
+    assert!(
+        !left
+            .iter()
+            .any(|f| f.starts_with(".mandelreel-run-") || f.ends_with(".partial")),
+        "run record or temporary file left: {left:?}"
+    );
+    assert!(left.contains(&".frame_00001.ckpt".to_string()), "{left:?}");
+    let out = d.ok(&["render", "t.ron"]);
+    says(&out, "1 of 2 frames already complete");
+    says(&out, "frame 1: resuming from a checkpoint");
+    d.ok(&[
+        "render", "t.ron", "--frames", "1", "--out", "clean", "--quiet",
+    ]);
+    assert!(
+        d.bytes("out/t/frame_00001.png") == d.bytes("clean/frame_00001.png"),
+        "the interrupted frame differs from an uninterrupted one"
+    );
+}
+
+#[test]
+fn a_render_interrupted_before_it_wrote_anything_leaves_nothing() {
+    // No frame finished and no checkpoint saved (not due for 60 s): the
+    // folders it made, its record and its lock go too.
+    let d = Dir::new();
+    d.write("t.ron", &long_frames(1));
+    let args = ["render", "t.ron", "--out", "new/seq", "--threads", "1"];
+    let mut command = d.command(&args);
+    command.stderr(std::process::Stdio::piped());
+    let child = d.spawn_command_until(command, "new/seq", "mandelreel-job.json");
+    let out = interrupt(child, nix::sys::signal::Signal::SIGINT);
+    says(&out, "interrupted");
+    assert!(!d.path().join("new").exists(), "{:?}", d.files("new/seq"));
+}
