@@ -7,6 +7,7 @@ mod bench;
 mod cli;
 mod farm;
 mod formats;
+mod fuzz;
 mod resume;
 mod stability;
 mod validation;
