@@ -65,6 +65,15 @@ impl EnvironmentMap {
         let is_exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+        // The size the header claims, checked before the pixels are
+        // allocated for it: a header of a few bytes can claim gigabytes.
+        let (width, height) = header_size(path, is_exr).map_err(&bad)?;
+        if width.saturating_mul(height) > MAX_MAP_PIXELS {
+            return Err(bad(format!(
+                "{width}×{height} pixels, more than the {MAX_MAP_PIXELS} (4096×2048) an \
+                 environment map may have: scale it down"
+            )));
+        }
         if is_exr {
             use exr::prelude::*;
             let image = read_first_rgba_layer_from_file(
@@ -159,6 +168,27 @@ impl EnvironmentMap {
     }
 }
 
+/// The most pixels an environment map may have, 4096×2048: loaded, with
+/// its sampling tables, it takes 20 bytes a pixel (170 MB here), and a
+/// timeline must be answered within 300 MB.
+pub const MAX_MAP_PIXELS: usize = 4096 * 2048;
+
+/// Width and height from the file's header, without reading its pixels
+/// (an EXR's largest layer).
+fn header_size(path: &Path, is_exr: bool) -> std::result::Result<(usize, usize), String> {
+    if is_exr {
+        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
+        let sizes = meta.headers.iter().map(|h| h.layer_size);
+        Ok(sizes
+            .max_by_key(|s| s.area())
+            .map_or((0, 0), |s| (s.0, s.1)))
+    } else {
+        let reader = image::ImageReader::open(path).map_err(|e| e.to_string())?;
+        let (width, height) = reader.into_dimensions().map_err(|e| e.to_string())?;
+        Ok((width as usize, height as usize))
+    }
+}
+
 /// Replaces non-finite or negative texels (some HDR files hold them) by black.
 fn sanitise(pixels: Vec<Vec3>) -> Vec<Vec3> {
     pixels
@@ -204,6 +234,49 @@ mod tests {
             }
         }
         EnvironmentMap::from_pixels(w, h, pixels)
+    }
+
+    /// A small EXR map whose header is changed to claim `width` columns
+    /// of its 2048 rows: a damaged or hostile file, a few hundred bytes.
+    fn claiming_exr(path: &Path, width: i32) {
+        let white = |_, _| (1.0f32, 1.0f32, 1.0f32, 1.0f32);
+        exr::prelude::write_rgba_file(path, 2, 2048, white).expect("write a map");
+        let mut bytes = std::fs::read(path).expect("read it back");
+        for name in [&b"dataWindow\0box2i\0"[..], b"displayWindow\0box2i\0"] {
+            let found = bytes.windows(name.len()).position(|w| w == name);
+            // Past the name, the type and the size: x min, y min, x max, y max.
+            let at = found.expect("a window attribute") + name.len() + 4;
+            bytes[at + 8..at + 12].copy_from_slice(&(width - 1).to_le_bytes());
+        }
+        std::fs::write(path, bytes).expect("write the map");
+    }
+
+    #[test]
+    fn a_map_claiming_more_pixels_than_the_limit_is_refused_unread() {
+        let dir = tempfile::tempdir().expect("temporary folder");
+        let limit = "more than the 8388608 (4096×2048)";
+        let exr = dir.path().join("vast.exr");
+        claiming_exr(&exr, 4097);
+        let message = EnvironmentMap::load(&exr).unwrap_err().to_string();
+        assert!(
+            message.contains(&format!("4097×2048 pixels, {limit}")),
+            "{message}"
+        );
+        // At the limit the size passes, and the missing pixels fail.
+        claiming_exr(&exr, 4096);
+        let message = EnvironmentMap::load(&exr).unwrap_err().to_string();
+        assert!(!message.contains(limit), "{message}");
+        let hdr = dir.path().join("vast.hdr");
+        std::fs::write(
+            &hdr,
+            "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2048 +X 4097\n",
+        )
+        .unwrap();
+        let message = EnvironmentMap::load(&hdr).unwrap_err().to_string();
+        assert!(
+            message.contains(&format!("4097×2048 pixels, {limit}")),
+            "{message}"
+        );
     }
 
     #[test]

@@ -7,6 +7,7 @@ mod bench;
 mod cli;
 mod farm;
 mod formats;
+mod fuzz;
 mod locations;
 mod resume;
 mod stability;
