@@ -141,8 +141,10 @@ fn now_ms() -> u64 {
 /// Reads a claim file; `None` if it is missing or unreadable (a claim being
 /// replaced is renamed into place whole, so a reader never sees half of one).
 pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
-    let text = std::fs::read_to_string(path).ok()?;
-    serde_json::from_str(&text).ok()
+    // A claim is a line of JSON; a FIFO or a huge file in its place is none.
+    let file = crate::input::open_regular(path).ok()?;
+    let text = crate::input::read_at_most(file, 1 << 16).ok()?;
+    serde_json::from_slice(&text).ok()
 }
 
 /// Whether a claim's worker may still be at work: its heartbeat is younger

@@ -9,6 +9,7 @@ use crate::render::FrameStats;
 use crate::timeline::{Timeline, Track, ZOOM_TRACK};
 use clap::{Parser, Subcommand};
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
 use serde::Serialize;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -484,6 +485,18 @@ impl Plan {
             );
         }
         let timeline = timeline.with_samples(args.samples);
+        if args.samples.is_some() && timeline.base.effects.motion_blur.is_some() {
+            // Under motion blur the samples are instants, each checked.
+            timeline
+                .check_scene_count()
+                .map_err(|(_, message)| Error::usage("--samples", message))?;
+            let failing = timeline.first_invalid_frame();
+            let failure = failing.and_then(|f| Some((f, timeline.invalid_instant(f)?)));
+            if let Some((frame, (time, (field, message)))) = failure {
+                let message = format!("frame {frame} (t = {time:.4} s): scene.{field}: {message}");
+                return Err(Error::usage("--samples", message).into());
+            }
+        }
         let (mut width, mut height) = match &args.size {
             Some(s) => parse_size("--size", s)?,
             None => (timeline.width, timeline.height),
@@ -581,11 +594,8 @@ impl Plan {
     /// is written: a frame too large would otherwise fail part-way, or be
     /// killed with the machine short of memory.
     fn check_memory(&self, size_given: bool) -> anyhow::Result<()> {
-        let many_samples = !self.preview
-            && self
-                .range
-                .clone()
-                .any(|frame| self.timeline.scene_at(frame).samples_per_pixel > 1);
+        // No track animates the sample count: the base scene has it.
+        let many_samples = !self.preview && self.timeline.base.samples_per_pixel > 1;
         let exr = self.formats.contains(&Format::Exr);
         let (w, h) = (self.width, self.height);
         let need = crate::render::frame_bytes(w, h, self.layers(), exr, many_samples);
@@ -956,10 +966,11 @@ fn refuse_other_sequence(
 }
 
 fn render(args: RenderArgs) -> anyhow::Result<()> {
+    // Before the timeline, whose frames are checked on the thread pool.
+    set_threads(args.threads)?;
     // Everything is checked before the output folder is touched.
     let mut plan = Plan::new(&args.timeline, &args.sequence)?;
     plan.verify = args.verify;
-    set_threads(args.threads)?;
     let shard = args
         .shard
         .as_deref()
@@ -1000,12 +1011,14 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // Until this render ends, `status` lists it as running.
     let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
 
-    // Decide which frames need work, so the progress bar and ETA count only those.
+    // Decide which frames need work, so the progress bar and ETA count only
+    // those. Their scenes are built again as each renders: kept, a long
+    // film's (a scene per sample under motion blur) would fill the memory.
     let mut todo = Vec::new();
     for &frame in &mine {
-        let (scene, hash) = plan.frame(frame);
+        let (_, hash) = plan.frame(frame);
         if args.force || !plan.is_complete(frame, &hash) {
-            todo.push((frame, scene, hash));
+            todo.push((frame, hash));
         } else {
             lock(&tally).complete += 1;
         }
@@ -1044,11 +1057,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             eprintln!("{line}");
         }
     };
-    // The scenes the frames to do were planned with.
-    let planned: Vec<(u32, &crate::scene::Scene)> = todo
-        .iter()
-        .map(|(frame, scenes, _)| (*frame, &scenes[0]))
-        .collect();
+    let planned: Vec<u32> = todo.iter().map(|(frame, _)| *frame).collect();
     for warning in warnings(&plan.timeline, &planned, !plan.preview) {
         say(format!("warning: {warning}"));
     }
@@ -1089,10 +1098,9 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let mut short_of_steps = Vec::new();
     let mut rendered = 0usize;
     let mut film = crate::render::Film::default();
-    let mut render_one = |frame: u32,
-                          scene: &[crate::scene::Scene],
-                          hash: &str|
-     -> anyhow::Result<()> {
+    let mut render_one = |frame: u32, hash: &str| -> anyhow::Result<()> {
+        let (scene, _) = plan.frame(frame);
+        let scene = &scene[..];
         current.reset();
         current.set_prefix(format!("#{frame}"));
         current.set_message(format!("{width}x{height}"));
@@ -1183,7 +1191,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         let mut finished = vec![false; todo.len()];
         loop {
             let mut held = Vec::new();
-            for (k, (frame, scene, hash)) in todo.iter().enumerate() {
+            for (k, (frame, hash)) in todo.iter().enumerate() {
                 if finished[k] {
                     continue;
                 }
@@ -1196,7 +1204,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                     crate::claim::Attempt::Claimed(claim) => {
                         // It may have been finished between the check and the claim.
                         if args.force || !plan.is_complete(*frame, hash) {
-                            render_one(*frame, scene, hash)?;
+                            render_one(*frame, hash)?;
                         } else {
                             lock(&tally).complete += 1;
                         }
@@ -1214,7 +1222,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             }
             // Frames held when this pass came to them may be done by now.
             held.retain(|(k, _)| {
-                let (frame, _, hash) = &todo[*k];
+                let (frame, hash) = &todo[*k];
                 finished[*k] = plan.is_complete(*frame, hash);
                 lock(&tally).complete += usize::from(finished[*k]);
                 !finished[*k]
@@ -1238,8 +1246,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
             std::thread::sleep(poll);
         }
     } else {
-        for (frame, scene, hash) in &todo {
-            render_one(*frame, scene, hash)?;
+        for (frame, hash) in &todo {
+            render_one(*frame, hash)?;
         }
     }
     current.finish_and_clear();
@@ -1463,14 +1471,21 @@ impl FrameState {
     }
 }
 
-/// What is allowed but likely not what the author meant, in the `scenes`
-/// of frames of `timeline`: `render` and `info` print these. `samples_matter` is false
-/// for previews, which take one sample whatever the timeline says.
-fn warnings(
-    timeline: &Timeline,
-    scenes: &[(u32, &crate::scene::Scene)],
-    samples_matter: bool,
-) -> Vec<String> {
+/// Orbit iterations (`iteration_weight`) the camera-inside check of
+/// `warnings` may spend, about a fifth of a second on two cores: beyond,
+/// it checks frames evenly spread.
+const INSIDE_CHECK_ITERATIONS: u64 = 10_000_000;
+
+/// Seconds after which the camera-inside check stops where it is: where
+/// orbits are slower than their weight says (a camera on a power's pole
+/// axis, where whole powers take the trigonometric form too).
+const INSIDE_CHECK_SECONDS: f64 = 0.4;
+
+/// What is allowed but likely not what the author meant, in `frames` of
+/// `timeline`: `render` and `info` print these. `samples_matter` is false
+/// for previews, which take one sample whatever the timeline says. Nothing
+/// is kept per frame but its number where a warning names it.
+fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Vec<String> {
     let mut said = Vec::new();
     // Keys all on one side of the film: the track never changes a frame.
     let end = timeline.time_of(timeline.frame_count - 1);
@@ -1494,35 +1509,40 @@ fn warnings(
             track.name
         ));
     }
-    let which = |needs: &dyn Fn(&crate::scene::Scene) -> bool| -> Vec<u32> {
-        scenes
-            .iter()
-            .filter(|(_, s)| needs(s))
-            .map(|(f, _)| *f)
-            .collect()
-    };
-    // Not an error (a fly-through may pass through the surface), but those
-    // frames show only the inside: every ray starts in the set.
-    let inside = which(&|s| s.fractal.contains(s.camera.position));
-    if !inside.is_empty() {
-        said.push(format!(
-            "the camera is inside the fractal in {} frame(s) ({}); they render as a flat inside colour",
-            inside.len(),
-            ranges(&inside)
-        ));
+    if let Some(message) = camera_inside(timeline, frames) {
+        said.push(message);
     }
     // Effects that need several samples a pixel, declared with too few:
     // not an error (a test render may want it), but not what they look like.
+    // No track animates the samples or the shutter; one may open the lens.
     if samples_matter {
         use crate::scene::{LENS_SAMPLES, MOTION_BLUR_SAMPLES};
-        let lens = which(&|s| s.camera.frame().has_lens() && s.samples_per_pixel < LENS_SAMPLES);
-        let blur = which(&|s| {
-            s.effects.motion_blur.is_some() && s.samples_per_pixel < MOTION_BLUR_SAMPLES
-        });
+        let base = &timeline.base;
+        let lens = timeline.with_tracks(|name| name == "camera.aperture_radius");
+        let short_for_lens: Vec<u32> = if base.samples_per_pixel < LENS_SAMPLES {
+            frames
+                .par_iter()
+                .copied()
+                .filter(|&f| lens.scene_at(f).camera.frame().has_lens())
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let short_for_blur =
+            if base.effects.motion_blur.is_some() && base.samples_per_pixel < MOTION_BLUR_SAMPLES {
+                frames.to_vec()
+            } else {
+                Vec::new()
+            };
         let needs = [
-            (lens, "depth of field", LENS_SAMPLES, "to be smooth"),
             (
-                blur,
+                short_for_lens,
+                "depth of field",
+                LENS_SAMPLES,
+                "to be smooth",
+            ),
+            (
+                short_for_blur,
                 "motion blur",
                 MOTION_BLUR_SAMPLES,
                 "to blur rather than ghost",
@@ -1538,6 +1558,122 @@ fn warnings(
         }
     }
     said
+}
+
+/// The warning for `frames` of `timeline` whose camera is inside the
+/// fractal, if any: not an error (a fly-through may pass through the
+/// surface), but those frames show only the inside, since every ray starts
+/// in the set. A point inside costs the full iterations to tell, so past
+/// `INSIDE_CHECK_ITERATIONS` in all, frames evenly spread are checked.
+fn camera_inside(timeline: &Timeline, frames: &[u32]) -> Option<String> {
+    // Scenes with only the tracks that matter are quicker to build.
+    let counting =
+        timeline.with_tracks(|name| ["fractal.iterations", "fractal.power"].contains(&name));
+    let cost: u64 = frames
+        .par_iter()
+        .map(|&f| {
+            let fractal = counting.scene_at(f).fractal;
+            fractal.iterations as u64 * iteration_weight(&fractal)
+        })
+        .sum();
+    let moving = ["camera.position", "camera.target", ZOOM_TRACK];
+    let timeline =
+        &timeline.with_tracks(|name| moving.contains(&name) || name.starts_with("fractal."));
+    let stride = cost.div_ceil(INSIDE_CHECK_ITERATIONS).max(1) as usize;
+    let checked: Vec<u32> = frames.iter().step_by(stride).copied().collect();
+    let (inside, done) = frames_inside(timeline, &checked);
+    if inside.is_empty() {
+        return None;
+    }
+    let which = if stride == 1 && done == checked.len() {
+        let frames: Vec<u32> = inside.iter().map(|&k| checked[k]).collect();
+        format!("{} frame(s) ({})", frames.len(), ranges(&frames))
+    } else {
+        // Runs of frames checked one after another, each from its first
+        // frame to its last.
+        let mut runs: Vec<(usize, usize)> = Vec::new();
+        for &k in &inside {
+            match runs.last_mut() {
+                Some((_, last)) if *last + 1 == k => *last = k,
+                _ => runs.push((k, k)),
+            }
+        }
+        let shown: Vec<String> = runs
+            .iter()
+            .map(|&(a, b)| match (checked[a], checked[b]) {
+                (a, b) if a == b => a.to_string(),
+                (a, b) => format!("{a}-{b}"),
+            })
+            .collect();
+        let spread = if stride > 1 {
+            format!(", one in {stride} of {}", frames.len())
+        } else {
+            String::new()
+        };
+        let stopped = if done < checked.len() {
+            format!(
+                ", up to frame {}: slow to check for this fractal",
+                checked[done - 1]
+            )
+        } else {
+            String::new()
+        };
+        format!(
+            "{} of the {done} frames checked{spread}{stopped} ({})",
+            inside.len(),
+            shown.join(", ")
+        )
+    };
+    Some(format!(
+        "the camera is inside the fractal in {which}; they render as a flat inside colour"
+    ))
+}
+
+/// Which of `frames` (their indices) have the camera inside the fractal,
+/// and how many were checked: all of them, unless `INSIDE_CHECK_SECONDS`
+/// ran out first. A frame whose camera and fractal are those of the frame
+/// before is not checked again.
+fn frames_inside(timeline: &Timeline, frames: &[u32]) -> (Vec<usize>, usize) {
+    let started = Instant::now();
+    let (mut inside, mut done) = (Vec::new(), 0);
+    for block in frames.chunks(256) {
+        let found: Vec<bool> = block
+            .par_chunks(16)
+            .flat_map_iter(|run| {
+                let mut last: Option<(crate::scene::Scene, bool)> = None;
+                run.iter().map(move |&f| {
+                    let s = timeline.scene_at(f);
+                    let same = |(l, _): &&(crate::scene::Scene, bool)| {
+                        l.camera.position == s.camera.position && l.fractal == s.fractal
+                    };
+                    if let Some((_, was)) = last.as_ref().filter(same) {
+                        return *was;
+                    }
+                    let is = s.fractal.contains(s.camera.position);
+                    last = Some((s, is));
+                    is
+                })
+            })
+            .collect();
+        let found = found.iter().enumerate().filter(|(_, &is)| is);
+        inside.extend(found.map(|(k, _)| done + k));
+        done += block.len();
+        if started.elapsed().as_secs_f64() > INSIDE_CHECK_SECONDS {
+            break;
+        }
+    }
+    (inside, done)
+}
+
+/// What an orbit iteration of `fractal` costs, in iterations of a whole
+/// power (complex squaring): other powers take the trigonometric form,
+/// about eight times as long.
+fn iteration_weight(fractal: &crate::fractal::Fractal) -> u64 {
+    if crate::fractal::whole_power(fractal.power).is_some() {
+        1
+    } else {
+        8
+    }
 }
 
 /// Whether enough of a frame's camera rays ran out of steps to say so: 1%.
@@ -2045,39 +2181,33 @@ fn info(path: &Path) -> anyhow::Result<()> {
         base.samples_per_pixel,
         base.samples_per_pixel
     );
-    // Measured, not guessed: frame 0 as a 64-pixel-wide thumbnail, as declared
-    // and with every effect off (same samples), counting the estimates.
-    let probe_w = 64u32;
-    let probe_h = ((probe_w as u64 * t.height as u64) / t.width as u64).max(1) as u32;
-    let scenes = t.scenes_for_frame(0);
-    let plain: Vec<_> = scenes
-        .iter()
-        .map(|s| crate::scene::Scene {
-            effects: crate::shade::Effects {
-                motion_blur: s.effects.motion_blur.clone(),
-                ..Default::default()
+    // Measured, not guessed: frame 0 as a thumbnail, as declared and with
+    // every effect off, counting the estimates.
+    let probe = cost_probe(&t);
+    match &probe {
+        Some(p) => out!(
+            "cost:     frame 0 at {}x{}{}: {} estimates, {:.2}x the same frame without effects ({})",
+            p.width,
+            p.height,
+            if p.samples < base.samples_per_pixel {
+                format!(" with {} of its {} samples per pixel", p.samples, base.samples_per_pixel)
+            } else {
+                String::new()
             },
-            ..s.clone()
-        })
-        .collect();
-    let layers = crate::render::Layers::default();
-    let probe = |scenes: &[crate::scene::Scene]| {
-        let mut film = crate::render::Film::default();
-        crate::render::render_frame_into(&mut film, scenes, 0, probe_w, probe_h, layers, &|| {});
-        film
-    };
-    let (with, without) = (probe(&scenes), probe(&plain));
-    let probe_short = out_of_steps_matters(&with.stats);
-    out!(
-        "cost:     frame 0 at {probe_w}x{probe_h}: {} estimates, {:.2}x the same frame without effects ({})",
-        with.stats.de_evaluations,
-        with.stats.de_evaluations as f64 / without.stats.de_evaluations.max(1) as f64,
-        without.stats.de_evaluations
-    );
+            p.with.de_evaluations,
+            p.with.de_evaluations as f64 / p.without.de_evaluations.max(1) as f64,
+            p.without.de_evaluations
+        ),
+        None => out!(
+            "cost:     not measured: one sample of frame 0 could compute {} orbits of {} \
+             iterations (every march to quality.max_steps); render it with --frames 0 --stats",
+            worst_orbits_per_sample(base),
+            base.fractal.iterations
+        ),
+    }
+    let probe_short = probe.is_some_and(|p| out_of_steps_matters(&p.with));
     out!("output:   out/{}/ by default", t.name);
-    let all: Vec<(u32, crate::scene::Scene)> =
-        (0..t.frame_count).map(|f| (f, t.scene_at(f))).collect();
-    let all: Vec<(u32, &crate::scene::Scene)> = all.iter().map(|(f, s)| (*f, s)).collect();
+    let all: Vec<u32> = (0..t.frame_count).collect();
     for warning in warnings(&t, &all, true) {
         out!("warning:  {warning}");
     }
@@ -2088,6 +2218,140 @@ fn info(path: &Path) -> anyhow::Result<()> {
         );
     }
     Ok(())
+}
+
+/// The side of the largest thumbnail `info` measures a frame's cost on.
+const PROBE_SIDE: u32 = 64;
+/// The most samples per pixel a thumbnail takes.
+const PROBE_SAMPLES: u32 = 16;
+/// Orbit iterations the first thumbnail may take at the very worst (every
+/// march to its last step, every orbit to its last iteration): under a
+/// second on one core.
+const PROBE_WORST_ITERATIONS: u64 = 25_000_000;
+/// Orbit iterations a larger thumbnail may be expected to take, from the
+/// orbits the one before it took: about half a second on two cores.
+const PROBE_ITERATIONS: u64 = 30_000_000;
+/// Seconds a thumbnail may take for the next, four times as large, to be
+/// rendered: where orbits are slower than their weight says.
+const PROBE_STAGE_SECONDS: f64 = 0.1;
+
+/// Frame 0 rendered small by `cost_probe`, as declared (`with`) and with
+/// every effect off.
+struct Probe {
+    width: u32,
+    height: u32,
+    samples: u32,
+    with: FrameStats,
+    without: FrameStats,
+}
+
+/// A frame's size scaled to fit in `side`×`side` pixels, aspect kept, at
+/// least 1×1 (a tall, narrow frame makes a tall, narrow thumbnail, not a
+/// 64-pixel-wide one thousands of pixels high).
+fn thumbnail_size(width: u32, height: u32, side: u32) -> (u32, u32) {
+    let long = width.max(height) as u64;
+    let scale = |n: u32| ((n as u64 * side as u64) / long).max(1) as u32;
+    (scale(width), scale(height))
+}
+
+/// The most orbits one camera sample of `s` can compute: its march to the
+/// last step and bisection (about 1 100 at most) and a normal; each
+/// light's shadow march; every occlusion sample; each bounce's march,
+/// normal and march towards each light. Gradient estimators take five
+/// orbits an estimate.
+fn worst_orbits_per_sample(s: &crate::scene::Scene) -> u64 {
+    let march = s.quality.max_steps as u64 + 1_200 + 6;
+    let lights = 1 + s.look.extra_lights.len() as u64;
+    let e = &s.effects;
+    let shadows = e
+        .shadows
+        .as_ref()
+        .map_or(0, |sh| lights * sh.max_steps as u64);
+    let occlusion = e
+        .ambient_occlusion
+        .as_ref()
+        .map_or(0, |ao| ao.samples as u64);
+    let bounces = e
+        .path_tracing
+        .as_ref()
+        .map_or(0, |pt| pt.max_bounces as u64 * (1 + lights) * march);
+    let orbits = match s.fractal.de {
+        crate::fractal::DeMethod::Analytic | crate::fractal::DeMethod::Jacobian => 1,
+        _ => 5,
+    };
+    (march + shadows + occlusion + bounces) * orbits
+}
+
+/// Frame 0 of `t` as thumbnails of growing size, so that `info` answers
+/// at once whatever the timeline asks: the first small enough that even
+/// its worst case stays within `PROBE_WORST_ITERATIONS`, then each twice
+/// as wide while the orbits the last one took, scaled up, stay within
+/// `PROBE_ITERATIONS`, up to `PROBE_SIDE`. None if one sample alone could
+/// take more.
+fn cost_probe(t: &Timeline) -> Option<Probe> {
+    let mut samples = t.base.samples_per_pixel.min(PROBE_SAMPLES);
+    let scenes = |samples: u32| t.clone().with_samples(Some(samples)).scenes_for_frame(0);
+    let first = &scenes(1)[0];
+    let iterations = first.fractal.iterations as u64 * iteration_weight(&first.fractal);
+    let per_sample = worst_orbits_per_sample(first) * iterations;
+    let pixels = |side: u32| {
+        let (w, h) = thumbnail_size(t.width, t.height, side);
+        w as u64 * h as u64
+    };
+    let mut side = 8;
+    while side > 1 && pixels(side) * samples as u64 * per_sample > PROBE_WORST_ITERATIONS {
+        side /= 2;
+    }
+    while samples > 1 && samples as u64 * per_sample > PROBE_WORST_ITERATIONS {
+        samples /= 2;
+    }
+    if per_sample > PROBE_WORST_ITERATIONS {
+        return None;
+    }
+    // Frame 0's instants and iterations (a track may animate them) at the
+    // thumbnail's samples.
+    let scenes = scenes(samples);
+    let iterations = scenes
+        .iter()
+        .map(|s| s.fractal.iterations as u64 * iteration_weight(&s.fractal))
+        .max()?;
+    let render = |scenes: &[crate::scene::Scene], side: u32| {
+        let (w, h) = thumbnail_size(t.width, t.height, side);
+        let mut film = crate::render::Film::default();
+        let layers = crate::render::Layers::default();
+        crate::render::render_frame_into(&mut film, scenes, 0, w, h, layers, &|| {});
+        film.stats
+    };
+    let mut started = Instant::now();
+    let mut with = render(&scenes, side);
+    while side < PROBE_SIDE {
+        let grown = with.de_evaluations * pixels(side * 2) / pixels(side).max(1);
+        let slow = started.elapsed().as_secs_f64() > PROBE_STAGE_SECONDS;
+        if slow || grown.saturating_mul(iterations) > PROBE_ITERATIONS {
+            break;
+        }
+        side *= 2;
+        started = Instant::now();
+        with = render(&scenes, side);
+    }
+    let plain: Vec<_> = scenes
+        .iter()
+        .map(|s| crate::scene::Scene {
+            effects: crate::shade::Effects {
+                motion_blur: s.effects.motion_blur.clone(),
+                ..Default::default()
+            },
+            ..s.clone()
+        })
+        .collect();
+    let (width, height) = thumbnail_size(t.width, t.height, side);
+    Some(Probe {
+        width,
+        height,
+        samples,
+        with,
+        without: render(&plain, side),
+    })
 }
 
 #[derive(Serialize)]
@@ -2233,6 +2497,8 @@ fn set_threads(threads: Option<usize>) -> Result<()> {
 }
 
 fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
+    // Before the timeline, whose frames are checked on the thread pool.
+    set_threads(args.threads)?;
     let t = Timeline::load(&args.timeline)?.with_samples(args.samples);
     let (width, height) = match &args.size {
         Some(s) => parse_size("--size", s)?,
@@ -2245,7 +2511,6 @@ fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
         }
     };
     check_frame(&t, args.frame)?;
-    set_threads(args.threads)?;
     let out_dir = args
         .out
         .clone()
@@ -2425,6 +2690,21 @@ mod tests {
         assert_eq!(frame_summary(&every_other), "0, 2, 4, 6, 8, … (50 frames)");
         assert_eq!(frames_text(&(5..6)), "frame 5");
         assert_eq!(frames_text(&(0..3)), "frames 0-2");
+    }
+
+    #[test]
+    fn cost_thumbnails_keep_the_aspect_within_64_pixels_a_side() {
+        // A tall, narrow frame made a thumbnail 64 wide and two million
+        // high; now no frame's has more than 64×64 pixels.
+        assert_eq!(thumbnail_size(320, 180, 64), (64, 36));
+        assert_eq!(thumbnail_size(48, 27, 64), (64, 36));
+        assert_eq!(thumbnail_size(1, 32_768, 64), (1, 64));
+        assert_eq!(thumbnail_size(1, 135, 64), (1, 64));
+        assert_eq!(thumbnail_size(32_768, 1, 8), (8, 1));
+        for (w, h) in [(1, 1), (3, 32_768), (32_768, 32_768), (777, 5)] {
+            let (tw, th) = thumbnail_size(w, h, PROBE_SIDE);
+            assert!((1..=PROBE_SIDE).contains(&tw) && (1..=PROBE_SIDE).contains(&th));
+        }
     }
 
     #[test]

@@ -9,6 +9,8 @@ use crate::error::{Error, Result};
 use crate::math::{DVec3, Real, Vec3};
 use std::collections::HashMap;
 use std::f64::consts::PI;
+use std::fs::File;
+use std::io::{Seek, SeekFrom};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex, OnceLock};
 
@@ -56,8 +58,15 @@ impl EnvironmentMap {
         }
     }
 
-    /// Reads an equirectangular map from an OpenEXR (.exr) or Radiance (.hdr) file.
+    /// Reads an equirectangular map from an OpenEXR (.exr) or Radiance (.hdr)
+    /// file: a regular file of at most `MAX_MAP_BYTES` and `MAX_MAP_PIXELS`.
     pub fn load(path: &Path) -> Result<EnvironmentMap> {
+        EnvironmentMap::read(path, std::io::BufReader::new(open(path)?))
+    }
+
+    /// Decodes the map in `file` (named `path`), refusing one of more than
+    /// `MAX_MAP_PIXELS` from its header, before its pixels are allocated.
+    fn read(path: &Path, mut file: std::io::BufReader<File>) -> Result<EnvironmentMap> {
         let bad = |message: String| Error::Image {
             path: path.to_path_buf(),
             message,
@@ -65,42 +74,54 @@ impl EnvironmentMap {
         let is_exr = path
             .extension()
             .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-        // The size the header claims, checked before the pixels are
-        // allocated for it: a header of a few bytes can claim gigabytes.
-        let (width, height) = header_size(path, is_exr).map_err(&bad)?;
-        if width.saturating_mul(height) > MAX_MAP_PIXELS {
-            return Err(bad(format!(
-                "{width}×{height} pixels, more than the {MAX_MAP_PIXELS} (4096×2048) an \
-                 environment map may have: scale it down"
-            )));
-        }
         if is_exr {
             use exr::prelude::*;
-            let image = read_first_rgba_layer_from_file(
-                path,
-                |resolution, _| {
-                    (
-                        resolution.width(),
-                        vec![Vec3::ZERO; resolution.width() * resolution.height()],
-                    )
-                },
-                |(width, pixels), position, (r, g, b, _a): (f32, f32, f32, f32)| {
-                    pixels[position.y() * *width + position.x()] = Vec3::new(r, g, b);
-                },
-            )
-            .map_err(|e| bad(e.to_string()))?;
+            let meta = exr::meta::MetaData::read_from_buffered(&mut file, false)
+                .map_err(|e| bad(e.to_string()))?;
+            for header in &meta.headers {
+                check_size(header.layer_size.0, header.layer_size.1).map_err(bad)?;
+            }
+            // (exr's prelude has an `Error` of its own.)
+            file.seek(SeekFrom::Start(0))
+                .map_err(|e| crate::error::Error::io(path, e))?;
+            let image = read()
+                .no_deep_data()
+                .largest_resolution_level()
+                .rgba_channels(
+                    |resolution, _| {
+                        (
+                            resolution.width(),
+                            vec![Vec3::ZERO; resolution.width() * resolution.height()],
+                        )
+                    },
+                    |(width, pixels): &mut (usize, Vec<Vec3>),
+                     position,
+                     (r, g, b, _a): (f32, f32, f32, f32)| {
+                        pixels[position.y() * *width + position.x()] = Vec3::new(r, g, b);
+                    },
+                )
+                .first_valid_layer()
+                .all_attributes()
+                .from_buffered(file)
+                .map_err(|e| bad(e.to_string()))?;
             let (width, pixels) = image.layer_data.channel_data.pixels;
             let height = pixels.len() / width.max(1);
             Ok(EnvironmentMap::from_pixels(width, height, sanitise(pixels)))
         } else {
-            let image = image::open(path)
+            use image::ImageDecoder as _;
+            let mut reader = image::ImageReader::new(file);
+            reader.set_format(image::ImageFormat::from_path(path).map_err(|e| bad(e.to_string()))?);
+            let decoder = reader.into_decoder().map_err(|e| bad(e.to_string()))?;
+            let (width, height) = decoder.dimensions();
+            check_size(width as usize, height as usize).map_err(bad)?;
+            let image = image::DynamicImage::from_decoder(decoder)
                 .map_err(|e| bad(e.to_string()))?
-                .to_rgb32f();
+                .into_rgb32f();
             let (width, height) = (image.width() as usize, image.height() as usize);
-            let pixels = image
-                .pixels()
-                .map(|p| Vec3::new(p[0], p[1], p[2]))
-                .collect();
+            // The decoded floats become the map's texels in place where
+            // they can (a map at the limit is 100 MB a copy).
+            let pixels = bytemuck::allocation::try_cast_vec(image.into_raw())
+                .unwrap_or_else(|(_, raw)| raw.chunks_exact(3).map(Vec3::from_slice).collect());
             Ok(EnvironmentMap::from_pixels(width, height, sanitise(pixels)))
         }
     }
@@ -168,27 +189,6 @@ impl EnvironmentMap {
     }
 }
 
-/// The most pixels an environment map may have, 4096×2048: loaded, with
-/// its sampling tables, it takes 20 bytes a pixel (170 MB here), and a
-/// timeline must be answered within 300 MB.
-pub const MAX_MAP_PIXELS: usize = 4096 * 2048;
-
-/// Width and height from the file's header, without reading its pixels
-/// (an EXR's largest layer).
-fn header_size(path: &Path, is_exr: bool) -> std::result::Result<(usize, usize), String> {
-    if is_exr {
-        let meta = exr::meta::MetaData::read_from_file(path, false).map_err(|e| e.to_string())?;
-        let sizes = meta.headers.iter().map(|h| h.layer_size);
-        Ok(sizes
-            .max_by_key(|s| s.area())
-            .map_or((0, 0), |s| (s.0, s.1)))
-    } else {
-        let reader = image::ImageReader::open(path).map_err(|e| e.to_string())?;
-        let (width, height) = reader.into_dimensions().map_err(|e| e.to_string())?;
-        Ok((width as usize, height as usize))
-    }
-}
-
 /// Replaces non-finite or negative texels (some HDR files hold them) by black.
 fn sanitise(pixels: Vec<Vec3>) -> Vec<Vec3> {
     pixels
@@ -197,15 +197,55 @@ fn sanitise(pixels: Vec<Vec3>) -> Vec<Vec3> {
         .collect()
 }
 
+/// The most texels a map may have: 4096×2048, an equirectangular map a
+/// texel to a 0.09° of longitude. Its texels and sampling tables take 20
+/// bytes a texel (168 MB at the limit).
+pub const MAX_MAP_PIXELS: usize = 4096 * 2048;
+
+/// The longest map file read: a map at `MAX_MAP_PIXELS` as uncompressed
+/// 32-bit RGBA OpenEXR is 134 MB.
+pub const MAX_MAP_BYTES: u64 = 256 << 20;
+
+/// A map's size refused when past `MAX_MAP_PIXELS` (or empty).
+fn check_size(width: usize, height: usize) -> std::result::Result<(), String> {
+    let pixels = (width as u64).saturating_mul(height as u64);
+    if pixels == 0 || pixels > MAX_MAP_PIXELS as u64 {
+        return Err(format!(
+            "{width}x{height} texels; an environment map may have from 1 to {MAX_MAP_PIXELS} \
+             (4096x2048): scale it down"
+        ));
+    }
+    Ok(())
+}
+
+/// Opens a map file: a regular file (a FIFO is refused, not waited on) of
+/// at most `MAX_MAP_BYTES`.
+fn open(path: &Path) -> Result<File> {
+    let file = crate::input::open_regular(path).map_err(|e| Error::io(path, e))?;
+    let length = file.metadata().map_err(|e| Error::io(path, e))?.len();
+    if length > MAX_MAP_BYTES {
+        let message = format!(
+            "{length} bytes, more than the {} an environment map may have",
+            crate::input::bytes_shown(MAX_MAP_BYTES)
+        );
+        let cause = std::io::Error::new(std::io::ErrorKind::FileTooLarge, message);
+        return Err(Error::io(path, cause));
+    }
+    Ok(file)
+}
+
 /// Loaded maps, by file and content digest.
 type MapCache = Mutex<HashMap<(PathBuf, String), Arc<EnvironmentMap>>>;
 
+fn cache() -> &'static MapCache {
+    static CACHE: OnceLock<MapCache> = OnceLock::new();
+    CACHE.get_or_init(Default::default)
+}
+
 /// Maps by file and content digest, loaded once per process.
 pub fn cached(path: &Path, digest: &str) -> Result<Arc<EnvironmentMap>> {
-    static CACHE: OnceLock<MapCache> = OnceLock::new();
-    let cache = CACHE.get_or_init(Default::default);
     let key = (path.to_path_buf(), digest.to_string());
-    if let Some(map) = cache
+    if let Some(map) = cache()
         .lock()
         .expect("cache lock is never poisoned")
         .get(&key)
@@ -213,16 +253,75 @@ pub fn cached(path: &Path, digest: &str) -> Result<Arc<EnvironmentMap>> {
         return Ok(map.clone());
     }
     let map = Arc::new(EnvironmentMap::load(path)?);
-    cache
+    cache()
         .lock()
         .expect("cache lock is never poisoned")
         .insert(key, map.clone());
     Ok(map)
 }
 
+/// The map at `path`, loaded and checked once per process, and the
+/// SHA-256 of its bytes (frames re-render when it changes). The file is
+/// opened once: the bytes hashed are the bytes decoded.
+pub fn load_fingerprinted(path: &Path) -> Result<(String, Arc<EnvironmentMap>)> {
+    use sha2::Digest as _;
+    let mut file = open(path)?;
+    let mut hasher = sha2::Sha256::new();
+    std::io::copy(&mut file, &mut hasher).map_err(|e| Error::io(path, e))?;
+    let digest: String = hasher
+        .finalize()
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let key = (path.to_path_buf(), digest.clone());
+    if let Some(map) = cache()
+        .lock()
+        .expect("cache lock is never poisoned")
+        .get(&key)
+    {
+        return Ok((digest, map.clone()));
+    }
+    file.seek(SeekFrom::Start(0))
+        .map_err(|e| Error::io(path, e))?;
+    let map = Arc::new(EnvironmentMap::read(path, std::io::BufReader::new(file))?);
+    cache()
+        .lock()
+        .expect("cache lock is never poisoned")
+        .insert(key, map.clone());
+    Ok((digest, map))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_map_past_the_texel_limit_is_refused_from_its_header() {
+        // A 2×2 EXR whose header is made to say 4097×2048: refused from the
+        // header, where its texels were allocated first (100 MB here, and
+        // as much as any header claims).
+        use exr::prelude::*;
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("sky.exr");
+        let pixels = SpecificChannels::rgba(|_| (0.5f32, 0.5f32, 0.5f32, 1.0f32));
+        Image::from_channels((2, 2), pixels)
+            .write()
+            .to_file(&path)
+            .unwrap();
+        let mut bytes = std::fs::read(&path).unwrap();
+        let name = b"dataWindow\0box2i\0";
+        let at = bytes.windows(name.len()).position(|w| w == name).unwrap() + name.len() + 4;
+        bytes[at + 8..at + 16].copy_from_slice(&[0, 16, 0, 0, 255, 7, 0, 0]);
+        std::fs::write(&path, &bytes).unwrap();
+        let e = EnvironmentMap::load(&path).unwrap_err().to_string();
+        assert!(
+            e.ends_with(
+                "sky.exr: 4097x2048 texels; an environment map may have from 1 to \
+                 8388608 (4096x2048): scale it down"
+            ),
+            "{e}"
+        );
+    }
 
     /// A dim sky with one small, very bright patch: the case importance sampling is for.
     fn spotlit() -> EnvironmentMap {
@@ -254,12 +353,12 @@ mod tests {
     #[test]
     fn a_map_claiming_more_pixels_than_the_limit_is_refused_unread() {
         let dir = tempfile::tempdir().expect("temporary folder");
-        let limit = "more than the 8388608 (4096×2048)";
+        let limit = "may have from 1 to 8388608 (4096x2048)";
         let exr = dir.path().join("vast.exr");
         claiming_exr(&exr, 4097);
         let message = EnvironmentMap::load(&exr).unwrap_err().to_string();
         assert!(
-            message.contains(&format!("4097×2048 pixels, {limit}")),
+            message.contains("4097x2048 texels") && message.contains(limit),
             "{message}"
         );
         // At the limit the size passes, and the missing pixels fail.
@@ -274,7 +373,7 @@ mod tests {
         .unwrap();
         let message = EnvironmentMap::load(&hdr).unwrap_err().to_string();
         assert!(
-            message.contains(&format!("4097×2048 pixels, {limit}")),
+            message.contains("4097x2048 texels") && message.contains(limit),
             "{message}"
         );
     }

@@ -3,6 +3,7 @@
 //! Layers, each depending only on those after it:
 //! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`;
 //! `interrupt` (what Ctrl-C cleans up) sits under `output` and `claim`.
+//! `input` (reading the files a user names) sits below them all.
 
 #![forbid(unsafe_code)]
 
@@ -13,6 +14,7 @@ pub mod cli;
 pub mod environment;
 pub mod error;
 pub mod fractal;
+pub mod input;
 pub mod interrupt;
 pub mod march;
 pub mod math;

@@ -180,7 +180,8 @@ pub enum FileState {
 /// CRC, every EXR chunk read, not decompressed), which also finds a
 /// damaged byte inside a PNG, at the cost of reading the whole file.
 pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> FileState {
-    let file = match File::open(path) {
+    // Regular files only: a FIFO under a frame's name would block the open.
+    let file = match crate::input::open_regular(path) {
         Ok(file) => std::io::BufReader::new(file),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return FileState::Missing,
         Err(_) => return FileState::Damaged,
@@ -222,7 +223,7 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
             // Thorough reading adds every chunk read whole to the end check
             // (pedantic reading refuses bytes after the last).
             let every_chunk = || {
-                let file = std::io::BufReader::new(File::open(path).ok()?);
+                let file = std::io::BufReader::new(crate::input::open_regular(path).ok()?);
                 let chunks = exr::block::read(file, true).ok()?.all_chunks(true).ok()?;
                 Some(chunks.into_iter().all(|chunk| chunk.is_ok()))
             };
@@ -242,7 +243,7 @@ fn png_ends_with_iend(path: &Path) -> bool {
     use std::io::{Read, Seek, SeekFrom};
     const IEND: [u8; 12] = [0, 0, 0, 0, b'I', b'E', b'N', b'D', 0xAE, 0x42, 0x60, 0x82];
     let mut tail = [0u8; 12];
-    File::open(path)
+    crate::input::open_regular(path)
         .and_then(|mut f| {
             f.seek(SeekFrom::End(-12))?;
             f.read_exact(&mut tail)
@@ -297,7 +298,8 @@ fn png_is_whole(path: &Path) -> bool {
     use std::io::Read;
     const SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', b'\r', b'\n', 0x1a, b'\n'];
     let walk = || -> std::io::Result<bool> {
-        let mut file = std::io::BufReader::with_capacity(1 << 16, File::open(path)?);
+        let mut file =
+            std::io::BufReader::with_capacity(1 << 16, crate::input::open_regular(path)?);
         let mut signature = [0u8; 8];
         file.read_exact(&mut signature)?;
         if signature != SIGNATURE {
@@ -842,16 +844,17 @@ impl JobRecord {
     pub fn record_in(self, dir: &Path, check: impl FnOnce(&JobRecord) -> Result<()>) -> Result<()> {
         // Read-only where another user made it (a lock needs no write
         // access), and none at all where it cannot be had.
+        // A lock file that is not a regular file (a FIFO would block the
+        // open) is none.
         let lock_path = dir.join(JOB_LOCK);
         // Under the interrupt lock: a render stopped before it wrote
         // anything removes the lock file it made (`Scaffold`).
         let held = crate::interrupt::hold();
         let lock = std::fs::OpenOptions::new()
-            .create(true)
-            .truncate(false)
+            .create_new(true)
             .write(true)
             .open(&lock_path)
-            .or_else(|_| File::open(&lock_path));
+            .or_else(|_| crate::input::open_regular(&lock_path));
         drop(held);
         if let Ok(lock) = &lock {
             let _ = lock.lock();
@@ -914,10 +917,13 @@ impl JobRecord {
         }
     }
 
+    /// The record in `dir`: a regular file of at most `MAX_JOB_BYTES`.
     pub fn read(dir: &Path) -> Result<JobRecord> {
         let path = dir.join(JOB_FILE);
-        let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-        serde_json::from_str(&text).map_err(|e| Error::Image {
+        let text = crate::input::open_regular(&path)
+            .and_then(|file| crate::input::read_at_most(file, MAX_JOB_BYTES))
+            .map_err(|e| Error::io(&path, e))?;
+        serde_json::from_slice(&text).map_err(|e| Error::Image {
             path,
             message: format!("not a mandelreel job record: {e}"),
         })
@@ -1017,6 +1023,9 @@ impl Made {
         }
     }
 }
+/// The longest job record read: it holds the timeline's text (at most
+/// 1 MiB), which JSON may write up to six bytes a byte.
+const MAX_JOB_BYTES: u64 = 8 << 20;
 
 /// `.frame_00042.ckpt`: the saved accumulation of a frame still rendering.
 pub fn checkpoint_path(dir: &Path, frame_index: u32) -> PathBuf {
@@ -1110,7 +1119,7 @@ fn checkpoint_header(
     layers: crate::render::Layers,
 ) -> Option<(std::io::BufReader<File>, CheckpointHeader)> {
     use std::io::{BufRead, Read};
-    let mut file = std::io::BufReader::new(File::open(path).ok()?);
+    let mut file = std::io::BufReader::new(crate::input::open_regular(path).ok()?);
     let mut magic = vec![0; CHECKPOINT_MAGIC.len()];
     file.read_exact(&mut magic).ok()?;
     if magic != CHECKPOINT_MAGIC {

@@ -10,6 +10,7 @@ use crate::error::{Error, Result};
 use crate::math::{DVec3, Real, Vec3};
 use crate::scene::Scene;
 use crate::spans::{self, Place};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use splines::{Key, Spline};
 use std::collections::BTreeMap;
@@ -539,34 +540,37 @@ impl Track {
     /// The parameter's value at `time_seconds`; held constant outside the
     /// keys, or in a looping film the same every period.
     pub fn sample(&self, time_seconds: Real) -> Vec<Real> {
+        self.sample_components(time_seconds)[..self.splines.len()].to_vec()
+    }
+
+    /// `sample` without allocating (every scene of every frame is checked):
+    /// the value's components first, at most three.
+    fn sample_components(&self, time_seconds: Real) -> [Real; 3] {
         let first = self.key_times[0];
         let last = self.key_times[self.key_times.len() - 1];
-        let raw: Vec<Real> = if let Some(period) = self.period {
+        let mut raw = [0.0; 3];
+        let values = raw.iter_mut().zip(&self.splines).zip(&self.ends.0);
+        if let Some(period) = self.period {
             // Into [0, period): a tiny negative time's remainder can round
             // up to the period itself.
             let t = time_seconds.rem_euclid(period);
             let t = if t < period { t } else { 0.0 };
-            self.splines
-                .iter()
-                .zip(&self.ends.0)
-                .map(|(s, &fallback)| s.sample(t).unwrap_or(fallback))
-                .collect()
+            for ((v, s), &fallback) in values {
+                *v = s.sample(t).unwrap_or(fallback);
+            }
         } else if time_seconds <= first {
-            self.ends.0.clone()
+            raw[..self.ends.0.len()].copy_from_slice(&self.ends.0);
         } else if time_seconds >= last {
-            self.ends.1.clone()
+            raw[..self.ends.1.len()].copy_from_slice(&self.ends.1);
         } else {
-            self.splines
-                .iter()
-                .zip(&self.ends.0)
-                .map(|(s, &fallback)| s.sample(time_seconds).unwrap_or(fallback))
-                .collect()
-        };
-        if self.log_space {
-            raw.into_iter().map(Real::exp).collect()
-        } else {
-            raw
+            for ((v, s), &fallback) in values {
+                *v = s.sample(time_seconds).unwrap_or(fallback);
+            }
         }
+        if self.log_space {
+            raw = raw.map(Real::exp);
+        }
+        raw
     }
 }
 
@@ -692,33 +696,102 @@ pub struct Timeline {
     pub looping: bool,
 }
 
-/// The longest file read as a timeline: real ones are a few kilobytes, and
-/// a file past this (`/dev/zero`) is refused before it fills the memory.
-const MAX_TIMELINE_BYTES: u64 = 16 << 20;
+/// The most frames a timeline may have: 11.6 hours at 24 fps, longer than
+/// any film.
+pub const MAX_FRAMES: u32 = 1_000_000;
 
-/// A timeline file's text: at most `MAX_TIMELINE_BYTES`, UTF-8 (a byte that
-/// is not is a syntax error at its line and column), a leading byte-order
-/// mark dropped.
+/// What the frame limit's messages suggest.
+const FRAMES_HINT: &str = "split a longer film into timelines of its parts";
+
+/// The most instants a timeline's frames may show: with motion blur each
+/// sample of a frame sees the timeline at its own instant. Every one's scene
+/// is checked before a frame renders (`Timeline::invalid_instant`), a
+/// quarter of a second a million on two cores.
+pub const MAX_INSTANTS: u64 = 2_000_000;
+
+/// The most track values sampled in checking every instant (each animated
+/// value, a component of a track's parameter, at every instant): from 0.2
+/// to 1 s a ten million on two cores, as the tracks' keys grow.
+pub const MAX_SAMPLED_VALUES: u64 = 10_000_000;
+
+/// The most keys a timeline's tracks may have in all: a key a frame for
+/// an hour at 24 fps, on one track or spread over several.
+pub const MAX_KEYS: usize = 100_000;
+
+/// Too many scenes to check: the field to blame (`scene.samples_per_pixel`
+/// or `tracks`) and why.
+pub type TooMany = (&'static str, String);
+
+/// Whether the instants `frame_count` frames of `scene` show (one each, or
+/// one per sample with motion blur), and the `values` a timeline's tracks
+/// animate sampled at each, stay within `MAX_INSTANTS` and
+/// `MAX_SAMPLED_VALUES`.
+pub fn check_scene_count(
+    scene: &Scene,
+    frame_count: u32,
+    values: usize,
+) -> std::result::Result<(), TooMany> {
+    let samples = scene.samples_per_pixel as u64;
+    let (instants, shown) = match scene.effects.motion_blur {
+        Some(_) => (
+            frame_count as u64 * samples,
+            format!("{frame_count} frames × {samples} motion-blurred samples"),
+        ),
+        None => (frame_count as u64, format!("{frame_count} frames")),
+    };
+    if instants > MAX_INSTANTS {
+        return Err((
+            "scene.samples_per_pixel",
+            format!(
+                "with motion blur each of a frame's samples sees the timeline at its own \
+                 instant: {shown} = {instants} instants, more than the {MAX_INSTANTS} a \
+                 timeline may have; take fewer frames or samples"
+            ),
+        ));
+    }
+    let sampled = instants * values as u64;
+    if sampled > MAX_SAMPLED_VALUES {
+        return Err((
+            "tracks",
+            format!(
+                "every instant's scene is checked before rendering: {values} animated values \
+                 (the tracks' components) × {shown} = {sampled} track samples, more than the \
+                 {MAX_SAMPLED_VALUES} checked at most; take fewer frames, samples or tracks"
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// The longest file read as a timeline: real ones are a few kilobytes, and
+/// a file past this (`/dev/zero`) is refused before it fills the memory. At
+/// 1 MiB an error's place is found within a second (`spans` reads the text
+/// once per level of the field path, and RON reads about 5 MB/s untyped).
+const MAX_TIMELINE_BYTES: u64 = 1 << 20;
+
+/// A timeline file's text: a regular file (a FIFO is refused, not waited
+/// on), at most `MAX_TIMELINE_BYTES`, UTF-8 (a byte that is not is a syntax
+/// error at its line and column), a leading byte-order mark dropped.
 pub fn read_text(path: &Path) -> Result<String> {
-    use std::io::Read as _;
-    let mut bytes = Vec::new();
-    std::fs::File::open(path)
-        .and_then(|file| file.take(MAX_TIMELINE_BYTES + 1).read_to_end(&mut bytes))
-        .map_err(|e| Error::io(path, e))?;
     let syntax = |line, column, message: String| Error::Syntax {
         file: path.to_path_buf(),
         line,
         column,
         message,
     };
-    if bytes.len() as u64 > MAX_TIMELINE_BYTES {
-        let mib = MAX_TIMELINE_BYTES >> 20;
-        return Err(syntax(
-            1,
-            1,
-            format!("longer than {mib} MiB: not a timeline"),
-        ));
-    }
+    let read = crate::input::open_regular(path)
+        .and_then(|file| crate::input::read_at_most(file, MAX_TIMELINE_BYTES));
+    let bytes = match read {
+        Err(e) if e.kind() == std::io::ErrorKind::FileTooLarge => {
+            let mib = MAX_TIMELINE_BYTES >> 20;
+            return Err(syntax(
+                1,
+                1,
+                format!("longer than {mib} MiB: not a timeline"),
+            ));
+        }
+        read => read.map_err(|e| Error::io(path, e))?,
+    };
     let text = String::from_utf8(bytes).map_err(|e| {
         let before = &e.as_bytes()[..e.utf8_error().valid_up_to()];
         let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
@@ -751,6 +824,30 @@ impl Timeline {
             self.base.samples_per_pixel = n;
         }
         self
+    }
+
+    /// Whether checking every scene this timeline's frames show stays
+    /// within bounds (`check_scene_count`), with `--samples` applied.
+    pub fn check_scene_count(&self) -> std::result::Result<(), TooMany> {
+        let values = self.tracks.iter().map(|t| t.splines.len()).sum();
+        check_scene_count(&self.base, self.frame_count, values)
+    }
+
+    /// This timeline with only the tracks `keep` names: its scenes are
+    /// quicker to build where only some parameters matter.
+    pub fn with_tracks(&self, keep: impl Fn(&str) -> bool) -> Timeline {
+        Timeline {
+            source: self.source.clone(),
+            name: self.name.clone(),
+            base: self.base.clone(),
+            tracks: self
+                .tracks
+                .iter()
+                .filter(|t| keep(&t.name))
+                .cloned()
+                .collect(),
+            ..*self
+        }
     }
 
     /// Reads, parses and validates a timeline file.
@@ -814,6 +911,12 @@ impl Timeline {
             }
             (None, None) => return Err(top("frames", "give frames or duration_seconds".into())),
             (Some(0), None) => return Err(top("frames", "must be at least 1".into())),
+            (Some(n), None) if n > MAX_FRAMES => {
+                return Err(top(
+                    "frames",
+                    format!("at most {MAX_FRAMES}, got {n}: {FRAMES_HINT}"),
+                ))
+            }
             (Some(n), None) => n,
             (None, Some(d)) => {
                 let n = d * file.fps;
@@ -827,14 +930,14 @@ impl Timeline {
                         ),
                     ));
                 }
-                if n.round() > u32::MAX as Real {
+                if n.round() > MAX_FRAMES as Real {
                     return Err(top(
                         "duration_seconds",
                         format!(
-                            "gives {} frames at {} fps, more than the {} a timeline may have",
+                            "gives {} frames at {} fps, more than the {MAX_FRAMES} a timeline \
+                             may have: {FRAMES_HINT}",
                             n.round().shown(),
                             file.fps,
-                            u32::MAX
                         ),
                     ));
                 }
@@ -860,20 +963,25 @@ impl Timeline {
                 map_path.clone()
             };
             let field = "scene.effects.path_tracing.sky.path";
-            let bytes = std::fs::read(&resolved)
-                .map_err(|e| value(field, format!("cannot read {}: {e}", resolved.display())))?;
-            use sha2::Digest;
-            *digest = sha2::Sha256::digest(&bytes)
-                .iter()
-                .map(|b| format!("{b:02x}"))
-                .collect();
-            crate::environment::cached(&resolved, digest)
-                .map_err(|e| value(field, format!("not a usable environment map: {e}")))?;
+            let (fingerprint, _) =
+                crate::environment::load_fingerprinted(&resolved).map_err(|e| {
+                    let message = match e {
+                        Error::Io { .. } => format!("cannot read {e}"),
+                        e => format!("not a usable environment map: {e}"),
+                    };
+                    value(field, message)
+                })?;
+            *digest = fingerprint;
             *map_path = resolved;
         }
         if let Err((field, message)) = validate_scene(&file.scene) {
             return Err(value(&format!("scene.{field}"), message));
         }
+        // Too many instants to check, or too many track values at them.
+        let too_many = |(field, message): TooMany| value(field, message);
+        check_scene_count(&file.scene, frame_count, 0).map_err(too_many)?;
+        let all_keys: usize = file.tracks.values().map(|t| t.keys.len()).sum();
+        let mut keys_so_far = 0;
 
         let mut tracks = Vec::new();
         for (name, spec) in &file.tracks {
@@ -902,6 +1010,16 @@ impl Timeline {
             }
             if spec.keys.is_empty() {
                 return Err(at(".keys".into(), "a track needs at least one key".into()));
+            }
+            keys_so_far += spec.keys.len();
+            if keys_so_far > MAX_KEYS {
+                return Err(at(
+                    ".keys".into(),
+                    format!(
+                        "the tracks have {all_keys} keys in all, more than the {MAX_KEYS} a \
+                         timeline may have"
+                    ),
+                ));
             }
             let log_space = name == ZOOM_TRACK;
             let mut times = Vec::with_capacity(spec.keys.len());
@@ -987,6 +1105,8 @@ impl Timeline {
         }
         // The zoom distance acts on the animated position and target, so it goes last.
         tracks.sort_by_key(|t| t.name == ZOOM_TRACK);
+        let values = tracks.iter().map(|t| t.splines.len()).sum();
+        check_scene_count(&file.scene, frame_count, values).map_err(too_many)?;
 
         let name = path
             .file_stem()
@@ -1004,21 +1124,9 @@ impl Timeline {
             looping: file.looping,
         };
         // Splines can overshoot their keys: check every scene the frames
-        // render, motion blur's instants between frames included, and each
-        // frame's own instant (what previews, `info`, `pick` and `accuracy`
-        // show of it).
-        for frame in 0..frame_count {
-            let mut times = timeline.sample_times(frame);
-            if timeline.base.effects.motion_blur.is_some() {
-                times.insert(0, timeline.time_of(frame));
-            }
-            let failure = times.into_iter().find_map(|time| {
-                timeline
-                    .scene_built(time, true)
-                    .and_then(|scene| validate_scene(&scene))
-                    .err()
-                    .map(|e| (time, e))
-            });
+        // render; the first frame that fails is told.
+        if let Some(frame) = timeline.first_invalid_frame() {
+            let failure = timeline.invalid_instant(frame);
             if let Some((time, (field, message))) = failure {
                 // The tracks that set the field; else those of its group
                 // (a camera.position track can make the target coincide).
@@ -1074,6 +1182,31 @@ impl Timeline {
         Ok(timeline)
     }
 
+    /// The first frame with an instant whose scene fails `validate_scene`
+    /// (`invalid_instant`): every frame checked on every core, nothing kept
+    /// per frame.
+    pub fn first_invalid_frame(&self) -> Option<u32> {
+        (0..self.frame_count)
+            .into_par_iter()
+            .find_first(|&frame| self.invalid_instant(frame).is_some())
+    }
+
+    /// The first instant of frame `frame_index` whose scene fails
+    /// `validate_scene`, with the field and the problem: the frame's own
+    /// instant (what previews, `info`, `pick` and `accuracy` show of it),
+    /// then with motion blur each sample's between it and the next frame.
+    pub fn invalid_instant(&self, frame_index: u32) -> Option<(Real, (String, String))> {
+        let blurred = self.base.effects.motion_blur.is_some();
+        let own = blurred.then(|| self.time_of(frame_index));
+        let mut times = own.into_iter().chain(self.sample_times(frame_index));
+        times.find_map(|time| {
+            self.scene_built(time, true)
+                .and_then(|scene| validate_scene(&scene))
+                .err()
+                .map(|e| (time, e))
+        })
+    }
+
     /// Time in seconds of frame `frame_index`.
     pub fn time_of(&self, frame_index: u32) -> Real {
         frame_index as Real / self.fps
@@ -1116,7 +1249,8 @@ impl Timeline {
                     ));
                 }
             }
-            apply(&mut scene, &track.name, &track.sample(time_seconds));
+            let values = track.sample_components(time_seconds);
+            apply(&mut scene, &track.name, &values[..track.splines.len()]);
         }
         Ok(scene)
     }
@@ -1558,6 +1692,66 @@ mod tests {
     fn duration_gives_frame_count() {
         let t = parse("(fps: 24, duration_seconds: 2.5, size: (8, 6))").unwrap();
         assert_eq!(t.frame_count, 60);
+    }
+
+    #[test]
+    fn frames_instants_and_keys_past_their_limits_are_refused_by_name() {
+        // Just past each limit. Before, each was taken, and every frame's
+        // scene checked: 4e9 frames would have taken hours.
+        let e = error_of("(fps: 24, frames: 1000001, size: (8, 6))");
+        assert_eq!(
+            e,
+            "test.ron:1:19: frames: at most 1000000, got 1000001: split a longer film into \
+             timelines of its parts"
+        );
+        let e = error_of("(fps: 24,\n duration_seconds: 41667, size: (8, 6))");
+        assert!(
+            e.starts_with(
+                "test.ron:2:20: duration_seconds: gives 1.000008e6 frames at 24 fps, \
+                 more than the 1000000 a timeline may have"
+            ),
+            "{e}"
+        );
+        // Motion blur: every sample of every frame is an instant of its own.
+        let blur = "(fps: 24, frames: 1000, size: (8, 6),\n scene: (samples_per_pixel: 4096, \
+                    effects: (motion_blur: ())))";
+        let e = error_of(blur);
+        assert!(
+            e.starts_with("test.ron:2:29: scene.samples_per_pixel: ")
+                && e.contains(
+                    "1000 frames × 4096 motion-blurred samples = 4096000 instants, \
+                     more than the 2000000"
+                ),
+            "{e}"
+        );
+        // Twelve animated values at each of a million frames.
+        let text = "(fps: 24, frames: 1000000, size: (8, 6),\n tracks: {
+            \"camera.position\": (keys: [(time: 0, value: (0, 0, 3)), (time: 1, value: (0, 1, 3))]),
+            \"camera.target\": (keys: [(time: 0, value: (0, 0, 0))]),
+            \"look.ambient\": (keys: [(time: 0, value: (0.1, 0.1, 0.1))]),
+            \"look.light_colour\": (keys: [(time: 0, value: (1, 1, 1))]),
+        })";
+        let e = error_of(text);
+        assert!(
+            e.starts_with("test.ron:2:10: tracks: every instant's scene is checked")
+                && e.contains(
+                    "12 animated values (the tracks' components) × 1000000 frames \
+                     = 12000000 track samples, more than the 10000000"
+                ),
+            "{e}"
+        );
+        let keys: Vec<String> = (0..=MAX_KEYS)
+            .map(|k| format!("(time: {k}, value: 8)"))
+            .collect();
+        let many = with_track(&format!("\"fractal.power\": (keys: [{}])", keys.join(", ")));
+        let e = error_of(&many);
+        assert!(
+            e.contains(
+                "tracks[\"fractal.power\"].keys: the tracks have 100001 keys in all, \
+                 more than the 100000"
+            ),
+            "{e}"
+        );
     }
 
     fn sample(track: &str, time: Real) -> Vec<Real> {

@@ -153,7 +153,10 @@ fn error_points_inside(e: &Error, lines: usize) -> Result<(), String> {
             return Err(format!("column 0 (columns count from 1): {shown}"))
         }
         Error::Syntax { line, .. } => Some(*line),
-        Error::Invalid { line, .. } => *line,
+        Error::Invalid { place: None, .. } => return Err(format!("no line: {shown}")),
+        Error::Invalid {
+            place: Some(at), ..
+        } => Some(at.line),
         _ => return Err(format!("not a timeline error: {shown}")),
     };
     match line {

@@ -72,6 +72,39 @@ impl Dir {
         self.command(args).output().expect("run mandelreel")
     }
 
+    /// Runs `command` (the binary, or a shell around it) as `run` does, but
+    /// fails the test, killing it, if it is still running after `seconds`:
+    /// for input that once made it hang, so a regression fails rather than
+    /// hangs. A guard against hanging, far above the time it takes.
+    pub fn run_guarded(&self, mut command: Command, seconds: u64) -> Output {
+        let (out, err) = (self.path().join(".stdout"), self.path().join(".stderr"));
+        let file = |p: &Path| std::fs::File::create(p).expect("output file");
+        let mut child = command
+            .stdout(file(&out))
+            .stderr(file(&err))
+            .spawn()
+            .expect("run mandelreel");
+        let start = std::time::Instant::now();
+        let status = loop {
+            if let Some(status) = child.try_wait().unwrap() {
+                break status;
+            }
+            if start.elapsed() > std::time::Duration::from_secs(seconds) {
+                let _ = child.kill();
+                let _ = child.wait();
+                let said = std::fs::read_to_string(&err).unwrap_or_default();
+                panic!("{command:?} still ran after {seconds} s: {said}");
+            }
+            std::thread::sleep(std::time::Duration::from_millis(10));
+        };
+        let read = |p: &Path| std::fs::read(p).unwrap_or_default();
+        Output {
+            status,
+            stdout: read(&out),
+            stderr: read(&err),
+        }
+    }
+
     /// Runs the binary and panics with its stderr unless it succeeds.
     pub fn ok(&self, args: &[&str]) -> Output {
         let out = self.run(args);
