@@ -837,6 +837,9 @@ pub fn fit_log_depths(
     (depths, residual)
 }
 
+/// The membership walk step whose depth error `bench` reports.
+const WALK_STEP: Real = 0.25;
+
 /// Depth rows for the first scene at `size`: mandelreel's frame, and
 /// Mandelbulber2's z-buffer where it is installed, against the membership
 /// reference of the accuracy sweep.
@@ -876,6 +879,15 @@ fn depth_rows(
             depth_errors(&fitted, &reference, &footprints),
         ),
     ];
+    // The membership walk, for its error beside the estimate's (its cost
+    // is in `mandelreel accuracy`'s table).
+    let mut walking = frame.clone();
+    walking.quality.membership_step = WALK_STEP;
+    let walked = film_hits(&crate::render::render_frame(&walking, 0, w, h, &|| {}));
+    rows.push(row(
+        &format!("mandelreel (membership_step {WALK_STEP})"),
+        depth_errors(&walked, &reference, &footprints),
+    ));
     let (Some(program), Some(fract)) = (&options.mandelbulber, &scene.fract) else {
         return Ok(rows);
     };

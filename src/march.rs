@@ -16,8 +16,16 @@ use serde::{Deserialize, Serialize};
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct MarchSettings {
-    /// A ray hits when the estimate falls below this fraction of the pixel footprint.
+    /// How near the surface a hit lands, as a fraction of the pixel footprint:
+    /// with `membership_step`, the most a hit may lie short of the crossing;
+    /// without it (0), the estimate under which a ray stops.
     pub hit_threshold: Real,
+    /// Near the surface the estimate can understate the distance many times
+    /// over, so a ray that trusts it stops short. Rays step at least this
+    /// many footprints, test membership at each point and stop only inside
+    /// the set, bisecting the crossing (`Marcher::advance`); 0 trusts the
+    /// estimate and stops where it falls under `hit_threshold`.
+    pub membership_step: Real,
     /// Each step advances by `fudge × estimate` (1 = trust the estimate fully).
     pub fudge: Real,
     /// Steps before a ray is given up as a miss.
@@ -59,6 +67,7 @@ impl Default for MarchSettings {
     fn default() -> Self {
         MarchSettings {
             hit_threshold: 0.5,
+            membership_step: 0.0,
             fudge: 1.0,
             max_steps: 300,
             normal_step: 0.5,
@@ -604,15 +613,25 @@ impl Walk for Marcher {
                 return Some(self.hit(lo, estimate));
             }
         }
-        if estimate.distance < settings.hit_threshold * footprint {
+        // Inside from the start (the camera is in the set), or, trusting
+        // the estimate, near enough.
+        let trusted = settings.membership_step <= 0.0
+            && estimate.distance < settings.hit_threshold * footprint;
+        if !estimate.escaped || trusted {
             return Some(self.hit(t, *estimate));
         }
         self.outside = Some(t);
         let step = settings.step(estimate.distance);
+        let floor = settings.membership_step * footprint;
         // The over-relaxed step is checked at the next point (or, leaving the
         // bounding sphere, by retrying the plain step); a plain step is safe.
-        self.previous_distance = step;
-        self.previous_step = step * self.omega;
+        // A step up to the floor is not: membership at the next point checks it.
+        self.previous_distance = step.max(floor);
+        self.previous_step = if step < floor {
+            floor
+        } else {
+            step * self.omega
+        };
         self.t += self.previous_step;
         if self.t > self.t_exit && self.previous_step > self.previous_distance {
             self.take_back();
@@ -1370,6 +1389,82 @@ mod tests {
     }
 
     #[test]
+    fn membership_walk_lands_on_the_crossing_the_estimate_stops_short_of() {
+        // Near the bulb's surface the estimate understates the distance, so a
+        // ray that trusts it stops where no point of the set is within its
+        // hit threshold further on. Walking by membership, every hit has a
+        // point of the set within hit_threshold footprints further along
+        // the ray: the crossing it was bisected from.
+        let f = Fractal::default();
+        let trusting = MarchSettings::default();
+        let walking = MarchSettings {
+            membership_step: 0.25,
+            ..MarchSettings::default()
+        };
+        let (mut trusted_on, mut walked_on, mut hits) = (0, 0, 0);
+        for i in 0..200u64 {
+            let u = |d: u32| crate::math::sample_1d(7, 0, i, 0, d);
+            let origin = DVec3::new(u(0) - 0.5, u(1) - 0.5, u(2) - 0.5).normalize() * 2.5;
+            let aim = DVec3::new(u(3) - 0.5, u(4) - 0.5, u(5) - 0.5) * 0.8;
+            let r = Ray {
+                origin,
+                dir: (aim - origin).normalize(),
+                pixel_angle: 1e-3,
+                start_footprint: 0.0,
+            };
+            // A point of the set within the threshold further on, sampled
+            // finely: the crossing may be a sheet far thinner than a footprint.
+            let on = |hit: Option<Hit>, settings: &MarchSettings| {
+                hit.is_some_and(|h| {
+                    let reach = settings.hit_threshold * r.footprint(h.t);
+                    (1..=256).any(|k| f.contains(r.at(h.t + reach * k as Real / 256.0)))
+                })
+            };
+            let (a, b) = (march(&r, &f, &trusting).hit, march(&r, &f, &walking).hit);
+            hits += b.is_some() as u32;
+            trusted_on += on(a, &trusting) as u32;
+            walked_on += on(b, &walking) as u32;
+        }
+        assert!(hits > 50, "{hits} hits");
+        assert_eq!(walked_on, hits, "every walked hit is on a crossing");
+        assert!(
+            trusted_on < hits / 2,
+            "{trusted_on} of {hits} trusted hits on one"
+        );
+    }
+
+    #[test]
+    fn membership_walk_never_stops_outside_the_set_it_reached() {
+        // On the unit ball the walk ends within hit_threshold footprints
+        // short of the sphere, from outside, for any walk step; and a ray
+        // passing beside it, however near, misses (no threshold fattens it).
+        for step in [0.05, 0.5, 4.0] {
+            let settings = MarchSettings {
+                membership_step: step,
+                ..MarchSettings::default()
+            };
+            for i in 0..50 {
+                let b = i as Real / 50.0 * 0.999;
+                let r = ray(DVec3::new(b, 0.0, 3.0), -DVec3::Z);
+                let hit = march(&r, &unit_ball(), &settings).hit.expect("hits");
+                let gap = hit.point.length() - 1.0;
+                let limit = settings.hit_threshold * r.footprint(hit.t);
+                assert!(
+                    gap > 0.0 && gap <= limit * 1.0001,
+                    "step {step}, b {b}: gap {gap}"
+                );
+            }
+            let beside = ray(DVec3::new(1.0 + 1e-3, 0.0, 3.0), -DVec3::Z);
+            assert!(march(&beside, &unit_ball(), &settings).hit.is_none());
+        }
+        // Half a footprint off the sphere, the estimate alone calls it a hit.
+        let beside = ray(DVec3::new(1.0 + 1e-3, 0.0, 3.0), -DVec3::Z);
+        assert!(march(&beside, &unit_ball(), &MarchSettings::default())
+            .hit
+            .is_some());
+    }
+
+    #[test]
     fn camera_inside_the_set_hits_at_once_and_never_steps_back() {
         // Naive: inside, ln(r) with r < 1 makes ½·ln r·r/dr negative, a step backwards.
         let r_inside: Real = 0.5;
@@ -1482,10 +1577,19 @@ mod tests {
         // At 1e-12 from the surface, 1920 pixels wide, neighbouring pixels are
         // 3.6e-16 apart at the target: f64 still resolves each of them.
         for distance in [1e-4, 1e-8, 1e-12] {
-            let hits = block_hits(crate::fractal::Precision::F64, distance, 6);
+            let with_depth = block_hits_with_depth(crate::fractal::Precision::F64, distance, 6);
+            let hits: Vec<DVec3> = with_depth.iter().map(|h| h.1).collect();
             assert_eq!(hits.len(), 36, "misses at {distance}");
             assert!(hits.iter().all(|p| p.is_finite()));
             assert_eq!(distinct(&hits), 36, "blocky at {distance}");
+            // And the depths follow the surface: within half a footprint
+            // of a plane (a depth stuck at the camera or in one terrace
+            // over a sloping block would not be).
+            let off = depth_off_plane(&with_depth, 6);
+            assert!(
+                off < 0.5,
+                "depths {off} footprints off a plane at {distance}"
+            );
         }
         // The same test sees blockiness where it exists: f32 at 1e-8.
         let f32_hits = block_hits(crate::fractal::Precision::F32, 1e-8, 6);
@@ -1527,12 +1631,53 @@ mod tests {
         }
     }
 
+    /// Root-mean-square distance of hit depths from the plane that fits
+    /// them best over the pixel grid (`n`×`n`, row by row), in footprints:
+    /// how far a deep zoom's depths depart from the smooth surface they sample.
+    fn depth_off_plane(hits: &[(Real, DVec3, Real)], n: u32) -> Real {
+        // Least squares of t = a + b·x + c·y over a full grid: x and y are
+        // centred, so the three coefficients separate.
+        let m = (n as Real - 1.0) / 2.0;
+        let at = |i: usize| ((i as u32 % n) as Real - m, (i as u32 / n) as Real - m);
+        let count = hits.len() as Real;
+        let a = hits.iter().map(|h| h.0).sum::<Real>() / count;
+        let sxx: Real = (0..hits.len()).map(|i| at(i).0.powi(2)).sum();
+        let b = hits
+            .iter()
+            .enumerate()
+            .map(|(i, h)| at(i).0 * h.0)
+            .sum::<Real>()
+            / sxx;
+        let c = hits
+            .iter()
+            .enumerate()
+            .map(|(i, h)| at(i).1 * h.0)
+            .sum::<Real>()
+            / sxx;
+        let squares: Real = hits
+            .iter()
+            .enumerate()
+            .map(|(i, h)| ((h.0 - a - b * at(i).0 - c * at(i).1) / h.2).powi(2))
+            .sum();
+        (squares / count).sqrt()
+    }
+
+    fn distinct_depths(hits: &[(Real, DVec3, Real)]) -> usize {
+        let mut v: Vec<u64> = hits.iter().map(|h| h.0.to_bits()).collect();
+        v.sort();
+        v.dedup();
+        v.len()
+    }
+
     #[test]
     #[ignore = "measurement for README: cargo test --release -- --ignored zoom_depth_limits --nocapture"]
     fn zoom_depth_limits() {
         use crate::fractal::Precision;
-        for k in 1..=15 {
-            let d = 10f64.powi(-k);
+        let distances = [
+            1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12, 5e-13, 2e-13, 1e-13, 5e-14, 2e-14, 1e-14,
+            5e-15, 2e-15,
+        ];
+        for d in distances {
             let wide = block_hits_with_depth(Precision::F64, d, 8);
             let single = block_hits_with_depth(Precision::F32, d, 8);
             let mut errors: Vec<Real> = wide
@@ -1542,13 +1687,18 @@ mod tests {
                 .collect();
             errors.sort_by(|a, b| a.total_cmp(b));
             let points: Vec<DVec3> = wide.iter().map(|h| h.1).collect();
+            let plane = if wide.len() == 64 {
+                format!("{:.2}", depth_off_plane(&wide, 8))
+            } else {
+                "-".into()
+            };
             eprintln!(
-                "1e-{k}: f64 {} distinct of {}; f32 depth off f64 by median {:.2} / max {:.2} footprints, {} distinct",
-                distinct(&points),
+                "{d:e}: f64 {} hits, {} distinct points, {} distinct depths, {plane} footprints off a plane; f32 depth off f64 by median {:.2} / max {:.2} footprints",
                 wide.len(),
+                distinct(&points),
+                distinct_depths(&wide),
                 errors.get(errors.len() / 2).copied().unwrap_or(Real::NAN),
                 errors.last().copied().unwrap_or(Real::NAN),
-                distinct(&single.iter().map(|h| h.1).collect::<Vec<_>>())
             );
         }
     }

@@ -397,6 +397,9 @@ const MAX_JULIA: Real = 1e15;
 
 /// The largest bounding sphere a scene may have (see `validate`).
 const MAX_BOUNDING_RADIUS: Real = 1e6;
+/// Membership steps longer than this many footprints would step over
+/// whole features: the setting is a fraction of a pixel, or a few.
+const MAX_MEMBERSHIP_STEP: Real = 16.0;
 
 /// Every parameter a track can animate, with its number of components.
 pub const PARAMETERS: &[(&str, usize)] = &[
@@ -413,6 +416,7 @@ pub const PARAMETERS: &[(&str, usize)] = &[
     ("fractal.bailout", 1),
     ("fractal.julia", 3),
     ("quality.hit_threshold", 1),
+    ("quality.membership_step", 1),
     ("quality.fudge", 1),
     ("quality.max_steps", 1),
     ("quality.normal_step", 1),
@@ -472,6 +476,7 @@ fn apply(scene: &mut Scene, name: &str, v: &[Real]) {
         "fractal.bailout" => f.bailout = v[0],
         "fractal.julia" => f.julia = Some(triple()),
         "quality.hit_threshold" => q.hit_threshold = v[0],
+        "quality.membership_step" => q.membership_step = v[0],
         "quality.fudge" => q.fudge = v[0],
         "quality.max_steps" => q.max_steps = count(),
         "quality.normal_step" => q.normal_step = v[0],
@@ -1463,6 +1468,16 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         },
     )?;
     check(
+        q.membership_step.is_finite() && (0.0..=MAX_MEMBERSHIP_STEP).contains(&q.membership_step),
+        "quality.membership_step",
+        || {
+            format!(
+                "must be 0 (trust the estimate) or up to {MAX_MEMBERSHIP_STEP} footprints, got {}",
+                q.membership_step.shown()
+            )
+        },
+    )?;
+    check(
         q.fudge.is_finite() && q.fudge > 0.0 && q.fudge <= 1.0,
         "quality.fudge",
         || format!("must be in (0, 1], got {}", q.fudge.shown()),
@@ -1984,6 +1999,16 @@ mod tests {
                 "quality: (hit_threshold: 0)",
                 "quality.hit_threshold",
                 "must be positive",
+            ),
+            (
+                "quality: (membership_step: -0.5)",
+                "quality.membership_step",
+                "must be 0 (trust the estimate) or up to 16 footprints",
+            ),
+            (
+                "quality: (membership_step: 17)",
+                "quality.membership_step",
+                "must be 0 (trust the estimate) or up to 16 footprints",
             ),
             (
                 "camera: (focus_distance: Some(-2))",

@@ -34,6 +34,7 @@ fn accuracy_writes_csv_table_and_chart() {
         "iterations",
         "bailout",
         "hit_threshold",
+        "membership_step",
         "fudge",
         "max_steps",
         "normal_step",

@@ -254,6 +254,22 @@ fn bench_writes_results_with_counts_that_match_a_render() {
     assert!(num(theirs, "depth_error_mean_px") >= 0.0, "{csv}");
     assert!(md.contains("| mandelbulber2 (fitted) |"), "{md}");
     assert!(md.contains("| mandelreel (fitted) |"), "{md}");
+    // The membership walk's depth error beside the estimate's, as the
+    // accuracy sweep measures it at the same step.
+    let walked = row("tiny depth@24x14", "mandelreel (membership_step 0.25)", "0");
+    let swept = acc
+        .lines()
+        .find(|l| l.starts_with("membership_step,") && l.contains(",0.25,"))
+        .expect("the sweep has the walk at 0.25");
+    let at = acc_header
+        .iter()
+        .position(|h| *h == "depth_error_mean_px")
+        .unwrap();
+    let swept_mean: f64 = swept.split(',').nth(at).unwrap().parse().unwrap();
+    assert!(
+        (num(walked, "depth_error_mean_px") - swept_mean).abs() < 1e-9,
+        "{csv}\n{acc}"
+    );
     assert_eq!(md.matches("Peak memory").count(), 1, "{md}");
 }
 

@@ -12,4 +12,5 @@ mod limits;
 mod locations;
 mod resume;
 mod stability;
+mod surface;
 mod validation;
