@@ -2068,8 +2068,12 @@ fn info(path: &Path) -> anyhow::Result<()> {
         f.iterations,
         f.bailout
     );
+    let walk = match base.quality.membership_step {
+        0.0 => String::new(),
+        step => format!(", membership walk in steps of {step} x footprint"),
+    };
     out!(
-        "quality:  DE {} in {}, hit threshold {} x footprint, fudge {}, {} max steps",
+        "quality:  DE {} in {}, hit threshold {} x footprint{walk}, fudge {}, {} max steps",
         f.de.name(),
         f.precision.name(),
         base.quality.hit_threshold,

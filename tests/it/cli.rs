@@ -620,3 +620,37 @@ fn a_looping_film_has_no_start_a_quarter_period_later_is_the_same_film() {
         );
     }
 }
+
+#[test]
+fn a_membership_walk_renders_deeper_and_the_same_on_any_thread_count() {
+    // The walk goes on past where the estimate stops, so where both hit,
+    // no depth is nearer than the estimate's and some are further; and
+    // its frames, like every frame, do not depend on the threads.
+    let d = Dir::new();
+    d.write("trust.ron", &tiny_timeline(1, 8.0));
+    d.write(
+        "walk.ron",
+        &with_scene(&tiny_timeline(1, 8.0), "quality: (membership_step: 0.25)"),
+    );
+    let info = stdout(&d.ok(&["info", "walk.ron"]));
+    assert!(
+        info.contains("membership walk in steps of 0.25 x footprint"),
+        "{info}"
+    );
+    d.same_on_one_and_two_threads("walk.ron", &["--format", "exr"], &["frame_00000.exr"]);
+    d.ok(&["render", "trust.ron", "--format", "exr", "--out", "trust"]);
+    let (trust, walk) = (d.exr("trust/frame_00000.exr"), d.exr("one/frame_00000.exr"));
+    let (a, b) = (trust.channel("Z"), walk.channel("Z"));
+    let both: Vec<(f32, f32)> = a
+        .iter()
+        .zip(b)
+        .filter(|(a, b)| **a < 1e9 && **b < 1e9)
+        .map(|(a, b)| (*a, *b))
+        .collect();
+    assert!(both.len() > 100, "{} pixels hit in both", both.len());
+    assert!(
+        both.iter().all(|(a, b)| b >= a),
+        "a walked hit nearer than the estimate's"
+    );
+    assert!(both.iter().filter(|(a, b)| b > a).count() > both.len() / 2);
+}
