@@ -1501,7 +1501,23 @@ mod tests {
     /// Hits (t and point) of an n×n block of pixels in the middle of a
     /// 1920×1080 frame, with the camera `distance` from a surface point,
     /// looking straight at it; with each ray's footprint at the hit.
+    /// Where the deep-zoom measurements look at the bulb: the surface
+    /// point on the ray from `origin` along `dir`.
+    const SURFACES: [(DVec3, DVec3); 2] = [
+        (DVec3::new(0.1, 0.35, 2.0), DVec3::new(0.3, -0.2, -1.0)),
+        (DVec3::new(-0.4, 0.2, 2.0), DVec3::new(0.2, -0.1, -1.0)),
+    ];
+
     fn block_hits_with_depth(
+        precision: crate::fractal::Precision,
+        distance: Real,
+        n: u32,
+    ) -> Vec<(Real, DVec3, Real)> {
+        block_hits_at(SURFACES[0], precision, distance, n)
+    }
+
+    fn block_hits_at(
+        (origin, dir): (DVec3, DVec3),
         precision: crate::fractal::Precision,
         distance: Real,
         n: u32,
@@ -1513,8 +1529,7 @@ mod tests {
         };
         // The surface point on a fixed ray: membership steps of 1e-4, then
         // bisection to the last bit of f64.
-        let dir = DVec3::new(0.3, -0.2, -1.0).normalize();
-        let origin = DVec3::new(0.1, 0.35, 2.0);
+        let dir = dir.normalize();
         let exact = Fractal {
             iterations: 30,
             ..Fractal::default()
@@ -1680,6 +1695,20 @@ mod tests {
         for d in distances {
             let wide = block_hits_with_depth(Precision::F64, d, 8);
             let single = block_hits_with_depth(Precision::F32, d, 8);
+            let median_off = |a: &[(Real, DVec3, Real)], b: &[(Real, DVec3, Real)]| {
+                let mut e: Vec<Real> = a
+                    .iter()
+                    .zip(b)
+                    .map(|(a, b)| (a.0 - b.0).abs() / a.2)
+                    .collect();
+                e.sort_by(|a, b| a.total_cmp(b));
+                e.get(e.len() / 2).copied().unwrap_or(Real::NAN)
+            };
+            let other = |p| block_hits_at(SURFACES[1], p, d, 8);
+            eprintln!(
+                "{d:e} second surface: f32 depth off f64 by median {:.2} footprints",
+                median_off(&other(Precision::F64), &other(Precision::F32))
+            );
             let mut errors: Vec<Real> = wide
                 .iter()
                 .zip(&single)
