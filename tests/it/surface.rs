@@ -1,6 +1,6 @@
 //! Where hits land against the membership crossing, and how that crossing
 //! moves with the resolution it is looked for at: the measurement behind
-//! docs/surface.md. Not run by default (a few minutes in release):
+//! docs/surface.md. Not run by default (half a minute in release):
 //! `cargo test --release --test it -- --ignored surface_against_membership --nocapture`.
 
 use mandelreel::march::{march, Ray};
@@ -142,6 +142,9 @@ fn surface_against_membership() {
             "timelines/julia_morph.ron",
             frame,
         );
+    }
+    for example in ["effects", "path_traced", "dof_motion_blur"] {
+        measure(example, &format!("timelines/{example}.ron"), 0);
     }
     measure("S1", "timelines/bench/s1_plain.ron", 0);
 }
