@@ -54,7 +54,7 @@ pub struct Measurement {
     /// Peak signal-to-noise ratio of that difference in dB (infinite when identical).
     pub psnr_db: f64,
     /// On the Pareto front of median time against image error, timing noise
-    /// allowed for (`dominates`).
+    /// allowed for (`pareto_front`).
     pub pareto: bool,
 }
 
@@ -484,42 +484,50 @@ impl FrontPoint {
     }
 }
 
-/// Whether `a` (at index `ia`) pushes `b` (at `ib`) off the front. `a` must
-/// have no more error than `b`. With equal errors, two points whose median
-/// times lie within `TIMING_NOISE` of each other, or whose DE evaluation
-/// counts are equal (the same work: a time difference there is noise), are
-/// one point: the one with fewer evaluations stays, then the scene's own
-/// settings, then the faster, then the earlier row. Otherwise `a` must take
-/// at most `TIMING_NOISE` × `b`'s time and be better in one thing beyond
-/// noise: less error, or under `b`'s time ÷ `TIMING_NOISE`.
-fn dominates(a: &FrontPoint, ia: usize, b: &FrontPoint, ib: usize) -> bool {
-    if a.error > b.error {
-        return false;
-    }
-    let within_noise = a.seconds.max(b.seconds) <= a.seconds.min(b.seconds) * TIMING_NOISE;
-    if a.error == b.error && (within_noise || a.de_evaluations == b.de_evaluations) {
-        let key = |p: &FrontPoint, i: usize| (p.de_evaluations, !p.is_scene, p.seconds, i);
-        return key(a, ia).partial_cmp(&key(b, ib)) == Some(std::cmp::Ordering::Less);
-    }
-    a.seconds <= b.seconds * TIMING_NOISE
-        && (a.error < b.error || a.seconds * TIMING_NOISE < b.seconds)
-}
-
-/// Which points are on the Pareto front of cost against error: none
-/// dominates them (see `dominates`). `None` is no candidate.
+/// Which points are on the Pareto front of cost against error (`None` is
+/// no candidate). Median times within `TIMING_NOISE` of each other are the
+/// same cost, so:
+/// - a point is off the front when another has less error at no more than
+///   `TIMING_NOISE` × its time;
+/// - points with equal error are one point: of those within `TIMING_NOISE`
+///   of the fastest of them, or with its DE evaluation count (the same work,
+///   whose time differences are noise), the one with fewer evaluations
+///   stays, then the scene's own settings, then the faster, then the first.
+///
+/// Deciding equal errors as a group, not pair by pair, keeps the rule free
+/// of cycles (A ties B, B ties C, C beats A), so the front is never empty.
 pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
-    points
+    let candidates: Vec<(usize, FrontPoint)> = points
         .iter()
         .enumerate()
-        .map(|(i, p)| {
-            p.is_some_and(|p| {
-                !points
-                    .iter()
-                    .enumerate()
-                    .any(|(j, q)| j != i && q.is_some_and(|q| dominates(&q, j, &p, i)))
+        .filter_map(|(i, p)| p.map(|p| (i, p)))
+        .collect();
+    let preferred = |a: &&(usize, FrontPoint), b: &&(usize, FrontPoint)| {
+        (a.1.de_evaluations.cmp(&b.1.de_evaluations))
+            .then(b.1.is_scene.cmp(&a.1.is_scene))
+            .then(a.1.seconds.total_cmp(&b.1.seconds))
+            .then(a.0.cmp(&b.0))
+    };
+    let mut front = vec![false; points.len()];
+    for &(i, p) in &candidates {
+        let undercut = candidates
+            .iter()
+            .any(|(_, q)| q.error < p.error && q.seconds <= p.seconds * TIMING_NOISE);
+        let same_error = || candidates.iter().filter(|(_, q)| q.error == p.error);
+        let fastest = same_error()
+            .min_by(|a, b| a.1.seconds.total_cmp(&b.1.seconds))
+            .expect("p has its own error")
+            .1;
+        let kept = same_error()
+            .filter(|(_, q)| {
+                q.seconds <= fastest.seconds * TIMING_NOISE
+                    || q.de_evaluations == fastest.de_evaluations
             })
-        })
-        .collect()
+            .min_by(preferred)
+            .expect("the fastest qualifies");
+        front[i] = !undercut && kept.0 == i;
+    }
+    front
 }
 
 /// The front of median time against `error` over `rows`. The reference is
@@ -544,11 +552,12 @@ pub fn mark_pareto(rows: &mut [Measurement]) {
 pub fn front_rule_text() -> String {
     format!(
         "Times are the median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs of the frame (more for quick frames, within {TIMING_BUDGET_SECONDS} s a variant). \
-★ marks the Pareto front of median time against image RMSE (the chart draws the same front for mean depth error): \
-a variant is off it when another has no more error at no more than {TIMING_NOISE}× its median time and is better beyond noise \
-(less error, or under its time ÷ {TIMING_NOISE}). Two with equal error whose times lie within that {:.0}% noise, \
-or whose DE evaluation counts are equal (the same work), are one point: the star goes to the one with fewer DE evaluations, \
+★ marks the Pareto front of median time against image RMSE (the chart draws the same front for mean depth error too), \
+with times within {:.0}% of each other counted as the same cost: a variant is off the front when another has less error \
+at no more than {TIMING_NOISE}× its median time. Variants with equal error are one point: of those within {:.0}% of the fastest of them, \
+or with its DE evaluation count (the same work), the star goes to the one with fewer DE evaluations, \
 then to the scene's own settings, then to the faster. The reference is the yardstick, not a candidate.",
+        100.0 * (TIMING_NOISE - 1.0),
         100.0 * (TIMING_NOISE - 1.0)
     )
 }
@@ -699,6 +708,24 @@ mod tests {
     }
 
     #[test]
+    fn pareto_front_of_equal_errors_is_one_point_without_cycles() {
+        // A ties B (2.5% apart, B fewer evaluations), B ties C (2.4%, C fewer),
+        // but A is faster than C beyond noise: pair by pair each would push
+        // another off. As a group, B stays: within 3% of the fastest (A), with
+        // fewer evaluations than A; C is beyond noise of A.
+        let point = |seconds, de_evaluations| {
+            Some(FrontPoint {
+                seconds,
+                de_evaluations,
+                error: 0.1,
+                is_scene: false,
+            })
+        };
+        let front = pareto_front(&[point(1.0, 300), point(1.025, 200), point(1.05, 100)]);
+        assert_eq!(front, [false, true, false]);
+    }
+
+    #[test]
     fn median_of_runs_ignores_outliers() {
         assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
         assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
@@ -721,8 +748,11 @@ mod tests {
         assert!(md.contains(&format!(
             "median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs"
         )));
-        assert!(md.contains("1.03× its median time"), "{md}");
-        assert!(md.contains("within that 3% noise"));
+        assert!(
+            md.contains("less error at no more than 1.03× its median time"),
+            "{md}"
+        );
+        assert!(md.contains("within 3% of the fastest of them"));
     }
 
     #[test]
