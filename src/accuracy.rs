@@ -486,7 +486,7 @@ impl FrontPoint {
 
 /// Which points are on the Pareto front of cost against error (`None` is
 /// no candidate). Median times within `TIMING_NOISE` of each other are the
-/// same cost, so:
+/// same cost, and errors equal to three significant digits the same error, so:
 /// - a point is off the front when another has less error at no more than
 ///   `TIMING_NOISE` × its time;
 /// - points with equal error are one point: of those within `TIMING_NOISE`
@@ -508,6 +508,15 @@ pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
             .then(a.1.seconds.total_cmp(&b.1.seconds))
             .then(a.0.cmp(&b.0))
     };
+    // Errors are compared to three significant digits: a variant whose image
+    // differs from another's in the sixth digit is not better.
+    let candidates: Vec<(usize, FrontPoint)> = candidates
+        .into_iter()
+        .map(|(i, p)| {
+            let error = significant(p.error, 3);
+            (i, FrontPoint { error, ..p })
+        })
+        .collect();
     let mut front = vec![false; points.len()];
     for &(i, p) in &candidates {
         let undercut = candidates
@@ -528,6 +537,15 @@ pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
         front[i] = !undercut && kept.0 == i;
     }
     front
+}
+
+/// `v` rounded to `digits` significant digits.
+fn significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
 }
 
 /// The front of median time against `error` over `rows`. The reference is
@@ -553,7 +571,7 @@ pub fn front_rule_text() -> String {
     format!(
         "Times are the median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs of the frame (more for quick frames, within {TIMING_BUDGET_SECONDS} s a variant). \
 ★ marks the Pareto front of median time against image RMSE (the chart draws the same front for mean depth error too), \
-with times within {:.0}% of each other counted as the same cost: a variant is off the front when another has less error \
+with times within {:.0}% of each other counted as the same cost and errors equal to three significant digits as the same error: a variant is off the front when another has less error \
 at no more than {TIMING_NOISE}× its median time. Variants with equal error are one point: of those within {:.0}% of the fastest of them, \
 or with its DE evaluation count (the same work), the star goes to the one with fewer DE evaluations, \
 then to the scene's own settings, then to the faster. The reference is the yardstick, not a candidate.",
@@ -723,6 +741,19 @@ mod tests {
         };
         let front = pareto_front(&[point(1.0, 300), point(1.025, 200), point(1.05, 100)]);
         assert_eq!(front, [false, true, false]);
+    }
+
+    #[test]
+    fn pareto_front_compares_errors_to_three_digits() {
+        // An image differing in the sixth digit, the same work, 0.8× the time
+        // (noise): the scene keeps the star.
+        assert_eq!(front_with_scene(0.8, 1000, 0.1000001), [false, true, false]);
+        assert_eq!(front_with_scene(0.8, 1000, 0.0999999), [false, true, false]);
+        // In the third digit it is less error.
+        assert_eq!(front_with_scene(1.0, 1000, 0.0995), [false, false, true]);
+        assert_eq!(significant(0.012345, 3), 0.0123);
+        assert_eq!(significant(33.094, 3), 33.1);
+        assert_eq!(significant(0.0, 3), 0.0);
     }
 
     #[test]
