@@ -8,7 +8,6 @@
 //! bisection (`march::march_by_membership`), and a shaded image of the same
 //! fractal with every marching knob set high (`reference_scene`).
 
-use crate::error::{Error, Result};
 use crate::fractal::{DeMethod, Precision};
 use crate::march::march_by_membership;
 use crate::math::{linear_to_srgb, Real};
@@ -16,8 +15,10 @@ use crate::render::{render_frame, Film};
 use crate::scene::Scene;
 use rayon::prelude::*;
 use serde::Serialize;
-use std::path::Path;
 use std::time::Instant;
+
+mod chart;
+pub use chart::write_chart;
 
 /// One setting to measure: the scene with one knob changed.
 #[derive(Clone, Debug)]
@@ -52,8 +53,8 @@ pub struct Measurement {
     pub image_rmse: f64,
     /// Peak signal-to-noise ratio of that difference in dB (infinite when identical).
     pub psnr_db: f64,
-    /// On the Pareto front of time against image error: no other variant is
-    /// both faster and closer to the reference.
+    /// On the Pareto front of median time against image error, timing noise
+    /// allowed for (`pareto_front`).
     pub pareto: bool,
 }
 
@@ -350,23 +351,41 @@ fn psnr(rmse: f64) -> f64 {
     }
 }
 
-/// Renders `scene` and returns the film with its wall time. Quick renders
-/// are repeated until a quarter second has passed (at most 20 times) and the
-/// fastest run is kept, so small frames still give stable timings.
+/// Timed runs per variant: at least `MIN_TIMED_RUNS`, more while the
+/// variant has had under `TIMING_BUDGET_SECONDS`, at most `MAX_TIMED_RUNS`.
+pub const MIN_TIMED_RUNS: usize = 5;
+pub const MAX_TIMED_RUNS: usize = 21;
+const TIMING_BUDGET_SECONDS: f64 = 0.3;
+
+/// Renders `scene` and returns the film with the median wall time of
+/// several runs. The median, not the fastest run: a single lucky run of a
+/// 15 ms frame moved variants on and off the Pareto front.
 fn timed_render(scene: &Scene, frame_index: u32, width: u32, height: u32) -> (Film, f64) {
-    let mut best = f64::INFINITY;
+    let mut seconds = Vec::with_capacity(MAX_TIMED_RUNS);
     let mut film = None;
     let started = Instant::now();
-    for _ in 0..20 {
+    while seconds.len() < MIN_TIMED_RUNS
+        || (seconds.len() < MAX_TIMED_RUNS
+            && started.elapsed().as_secs_f64() < TIMING_BUDGET_SECONDS)
+    {
         let t0 = Instant::now();
         let f = render_frame(scene, frame_index, width, height, &|| {});
-        best = best.min(t0.elapsed().as_secs_f64());
+        seconds.push(t0.elapsed().as_secs_f64());
         film = Some(f);
-        if started.elapsed().as_secs_f64() > 0.25 {
-            break;
-        }
     }
-    (film.expect("rendered at least once"), best)
+    (film.expect("rendered at least once"), median(&mut seconds))
+}
+
+/// The median of `values` (the mean of the middle two for an even count;
+/// 0 for none). Reorders `values`.
+fn median(values: &mut [f64]) -> f64 {
+    values.sort_by(|a, b| a.total_cmp(b));
+    let n = values.len();
+    match n {
+        0 => 0.0,
+        _ if n % 2 == 1 => values[n / 2],
+        _ => 0.5 * (values[n / 2 - 1] + values[n / 2]),
+    }
 }
 
 /// Runs the whole sweep on frame `frame_index` of `scene` at `width`×`height`.
@@ -443,23 +462,125 @@ pub fn measure(
     }
 }
 
-/// Marks the variants no other variant beats on both time and image error.
-/// The reference is the yardstick, not a candidate, and is never marked.
-pub fn mark_pareto(rows: &mut [Measurement]) {
-    let candidate = |r: &Measurement| r.knob != "reference";
-    let points: Vec<Option<(f64, f64)>> = rows
-        .iter()
-        .map(|r| candidate(r).then_some((r.seconds, r.image_rmse)))
-        .collect();
-    for (i, row) in rows.iter_mut().enumerate() {
-        let Some((t, e)) = points[i] else {
-            row.pareto = false;
-            continue;
-        };
-        row.pareto = !points.iter().enumerate().any(|(j, p)| {
-            p.is_some_and(|(tj, ej)| j != i && tj <= t && ej <= e && (tj < t || ej < e))
-        });
+/// Median times closer than this factor are within timing noise.
+pub const TIMING_NOISE: f64 = 1.03;
+
+/// One candidate for a Pareto front: its cost and one of its errors.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrontPoint {
+    /// Median wall time.
+    pub seconds: f64,
+    pub de_evaluations: u64,
+    pub error: f64,
+    /// The scene's own settings (wins ties).
+    pub is_scene: bool,
+}
+
+impl FrontPoint {
+    fn of(row: &Measurement, error: f64) -> FrontPoint {
+        FrontPoint {
+            seconds: row.seconds,
+            de_evaluations: row.de_evaluations,
+            error,
+            is_scene: row.knob == "scene",
+        }
     }
+}
+
+/// Which points are on the Pareto front of cost against error (`None` is
+/// no candidate). Median times within `TIMING_NOISE` of each other are the
+/// same cost, and errors equal to three significant digits the same error, so:
+/// - a point is off the front when another has less error at no more than
+///   `TIMING_NOISE` × its time;
+/// - points with equal error are one point: of those within `TIMING_NOISE`
+///   of the fastest of them, or with its DE evaluation count (the same work,
+///   whose time differences are noise), the one with fewer evaluations
+///   stays, then the scene's own settings, then the faster, then the first.
+///
+/// Deciding equal errors as a group, not pair by pair, keeps the rule free
+/// of cycles (A ties B, B ties C, C beats A), so the front is never empty.
+pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
+    let candidates: Vec<(usize, FrontPoint)> = points
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| p.map(|p| (i, p)))
+        .collect();
+    let preferred = |a: &&(usize, FrontPoint), b: &&(usize, FrontPoint)| {
+        (a.1.de_evaluations.cmp(&b.1.de_evaluations))
+            .then(b.1.is_scene.cmp(&a.1.is_scene))
+            .then(a.1.seconds.total_cmp(&b.1.seconds))
+            .then(a.0.cmp(&b.0))
+    };
+    // Errors are compared to three significant digits: a variant whose image
+    // differs from another's in the sixth digit is not better.
+    let candidates: Vec<(usize, FrontPoint)> = candidates
+        .into_iter()
+        .map(|(i, p)| {
+            let error = significant(p.error, 3);
+            (i, FrontPoint { error, ..p })
+        })
+        .collect();
+    let mut front = vec![false; points.len()];
+    for &(i, p) in &candidates {
+        let undercut = candidates
+            .iter()
+            .any(|(_, q)| q.error < p.error && q.seconds <= p.seconds * TIMING_NOISE);
+        let same_error = || candidates.iter().filter(|(_, q)| q.error == p.error);
+        let fastest = same_error()
+            .min_by(|a, b| a.1.seconds.total_cmp(&b.1.seconds))
+            .expect("p has its own error")
+            .1;
+        let kept = same_error()
+            .filter(|(_, q)| {
+                q.seconds <= fastest.seconds * TIMING_NOISE
+                    || q.de_evaluations == fastest.de_evaluations
+            })
+            .min_by(preferred)
+            .expect("the fastest qualifies");
+        front[i] = !undercut && kept.0 == i;
+    }
+    front
+}
+
+/// `v` rounded to `digits` significant digits.
+fn significant(v: f64, digits: i32) -> f64 {
+    if v == 0.0 || !v.is_finite() {
+        return v;
+    }
+    let scale = 10f64.powi(digits - 1 - v.abs().log10().floor() as i32);
+    (v * scale).round() / scale
+}
+
+/// The front of median time against `error` over `rows`. The reference is
+/// the yardstick, not a candidate, and is never on it.
+pub fn front_of(rows: &[Measurement], error: impl Fn(&Measurement) -> f64) -> Vec<bool> {
+    let points: Vec<Option<FrontPoint>> = rows
+        .iter()
+        .map(|r| (r.knob != "reference").then(|| FrontPoint::of(r, error(r))))
+        .collect();
+    pareto_front(&points)
+}
+
+/// Marks (★) the front of median time against image error.
+pub fn mark_pareto(rows: &mut [Measurement]) {
+    let front = front_of(rows, |r| r.image_rmse);
+    for (row, on) in rows.iter_mut().zip(front) {
+        row.pareto = on;
+    }
+}
+
+/// How the times were taken and the front drawn, for the Markdown.
+pub fn front_rule_text() -> String {
+    format!(
+        "Times are the median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs of the frame (more for quick frames, within {TIMING_BUDGET_SECONDS} s a variant). \
+★ marks the Pareto front of median time against image RMSE (the chart draws the same front for mean depth error too), \
+with times within {:.0}% of each other counted as the same cost and errors equal to three significant digits as the same error: a variant is off the front when another has less error \
+at no more than {TIMING_NOISE}× its median time. Variants with equal error are one point: of those within {:.0}% of the fastest of them, \
+or with its DE evaluation count (the same work), the star goes to the one with fewer DE evaluations, \
+then to the scene's own settings, then to the faster. The reference is the yardstick, not a candidate.",
+        100.0 * (TIMING_NOISE - 1.0),
+        100.0 * (TIMING_NOISE - 1.0)
+    )
 }
 
 /// The table as CSV, one row per variant, a column per field.
@@ -510,121 +631,9 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
             if r.pareto { "★" } else { "" }
         );
     }
+    // After the table, so the reference paragraph above stays as it is.
+    out += &format!("\n{}\n", front_rule_text());
     out
-}
-
-static FONT: &[u8] = include_bytes!("../assets/fonts/DejaVuSansMono.ttf");
-
-/// Draws image error against time, one series per knob, Pareto front marked,
-/// and writes it as a PNG.
-pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()> {
-    use plotters::prelude::*;
-    let chart_error = |e: String| Error::Image {
-        path: path.to_path_buf(),
-        message: e,
-    };
-    // Registering twice is harmless; a bad font would be a build error in practice.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| chart_error("the embedded font is unreadable".into()))?;
-    let (w, h) = (1000u32, 640u32);
-    let mut pixels = vec![255u8; (w * h * 3) as usize];
-    // Log axes. The reference (zero error by definition) is not plotted.
-    let measured: Vec<&Measurement> = rows.iter().filter(|r| r.knob != "reference").collect();
-    let positive = |v: f64| v.is_finite() && v > 0.0;
-    let times: Vec<f64> = measured
-        .iter()
-        .map(|r| r.seconds)
-        .filter(|&v| positive(v))
-        .collect();
-    let errors: Vec<f64> = measured
-        .iter()
-        .map(|r| r.image_rmse)
-        .filter(|&v| positive(v))
-        .collect();
-    let range = |v: &[f64], fallback: (f64, f64)| {
-        let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-        let hi = v.iter().copied().fold(0.0, f64::max);
-        if lo.is_finite() && hi > 0.0 {
-            (lo * 0.7, hi * 1.4)
-        } else {
-            fallback
-        }
-    };
-    let (t_min, t_max) = range(&times, (1e-3, 1.0));
-    let (e_min, e_max) = range(&errors, (1e-4, 1.0));
-    let floor = e_min;
-    {
-        let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
-        root.fill(&WHITE).map_err(|e| chart_error(e.to_string()))?;
-        let mut chart = ChartBuilder::on(&root)
-            .caption(title, ("sans-serif", 20))
-            .margin(12)
-            .x_label_area_size(44)
-            .y_label_area_size(64)
-            .build_cartesian_2d((t_min..t_max).log_scale(), (e_min..e_max).log_scale())
-            .map_err(|e| chart_error(e.to_string()))?;
-        chart
-            .configure_mesh()
-            .x_desc("wall time per frame (s)")
-            .x_labels(8)
-            .y_labels(8)
-            .x_label_formatter(&|v| format!("{v:.3}"))
-            .y_label_formatter(&|v| format!("{v:.3}"))
-            .y_desc("image RMSE vs reference (sRGB)")
-            .label_style(("sans-serif", 14))
-            .draw()
-            .map_err(|e| chart_error(e.to_string()))?;
-        let mut knobs: Vec<&'static str> = measured.iter().map(|r| r.knob).collect();
-        knobs.dedup();
-        knobs.sort();
-        knobs.dedup();
-        for (k, knob) in knobs.iter().enumerate() {
-            let colour = Palette99::pick(k).to_rgba();
-            let series: Vec<(f64, f64)> = measured
-                .iter()
-                .filter(|r| r.knob == *knob)
-                .map(|r| (r.seconds.max(t_min), r.image_rmse.max(floor)))
-                .collect();
-            chart
-                .draw_series(series.iter().map(|&p| Circle::new(p, 5, colour.filled())))
-                .map_err(|e| chart_error(e.to_string()))?
-                .label(*knob)
-                .legend(move |(x, y)| Circle::new((x + 10, y), 5, colour.filled()));
-        }
-        let mut front: Vec<(f64, f64)> = measured
-            .iter()
-            .filter(|r| r.pareto)
-            .map(|r| (r.seconds.max(t_min), r.image_rmse.max(floor)))
-            .collect();
-        front.sort_by(|a, b| a.0.total_cmp(&b.0));
-        chart
-            .draw_series(LineSeries::new(front.clone(), BLACK.stroke_width(2)))
-            .map_err(|e| chart_error(e.to_string()))?
-            .label("Pareto front")
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        chart
-            .draw_series(
-                front
-                    .iter()
-                    .map(|&p| Circle::new(p, 7, BLACK.stroke_width(2))),
-            )
-            .map_err(|e| chart_error(e.to_string()))?;
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 14))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(|e| chart_error(e.to_string()))?;
-        root.present().map_err(|e| chart_error(e.to_string()))?;
-    }
-    let image = image::RgbImage::from_raw(w, h, pixels).expect("buffer matches the chart size");
-    crate::output::write_atomic(path, |w, _| {
-        image
-            .write_to(w, image::ImageFormat::Png)
-            .map_err(|e| chart_error(e.to_string()))
-    })
 }
 
 #[cfg(test)]
@@ -651,7 +660,8 @@ mod tests {
             knob,
             setting: String::new(),
             seconds,
-            de_evaluations: 0,
+            // Work in proportion to time, so no two rows here are the same work.
+            de_evaluations: (seconds * 1000.0) as u64,
             depth_error_mean_px: 0.0,
             depth_error_p99_px: 0.0,
             hit_mismatch: 0.0,
@@ -677,6 +687,106 @@ mod tests {
         mark_pareto(&mut rows);
         let front: Vec<_> = rows.iter().filter(|r| r.pareto).map(|r| r.knob).collect();
         assert_eq!(front, ["a", "b", "d"]);
+    }
+
+    /// The front of the scene (1 s, 1000 evaluations, error 0.1) and one
+    /// variant: which of the two are on it.
+    fn front_with_scene(seconds: f64, de_evaluations: u64, error: f64) -> Vec<bool> {
+        let point = |seconds, de_evaluations, error, is_scene| {
+            Some(FrontPoint {
+                seconds,
+                de_evaluations,
+                error,
+                is_scene,
+            })
+        };
+        pareto_front(&[
+            None, // the reference
+            point(1.0, 1000, 0.1, true),
+            point(seconds, de_evaluations, error, false),
+        ])
+    }
+
+    #[test]
+    fn pareto_front_allows_for_timing_noise() {
+        // The same work (same error, same evaluation count) at 0.97× or 0.85×
+        // the time: the difference is noise, one star, the scene's.
+        assert_eq!(front_with_scene(0.97, 1000, 0.1), [false, true, false]);
+        assert_eq!(front_with_scene(0.85, 1000, 0.1), [false, true, false]);
+        assert_eq!(front_with_scene(1.15, 1000, 0.1), [false, true, false]);
+        // Same error within the 3% noise: the evaluation count decides.
+        assert_eq!(front_with_scene(0.98, 990, 0.1), [false, false, true]);
+        assert_eq!(front_with_scene(0.98, 1010, 0.1), [false, true, false]);
+        assert_eq!(front_with_scene(1.02, 990, 0.1), [false, false, true]);
+        // Faster beyond noise, with fewer evaluations to show for it: a real speed-up.
+        assert_eq!(front_with_scene(0.85, 850, 0.1), [false, false, true]);
+        // Less error at a cost within noise pushes the scene off...
+        assert_eq!(front_with_scene(1.02, 1020, 0.099), [false, false, true]);
+        // ...beyond noise, both stay: a trade.
+        assert_eq!(front_with_scene(1.10, 1100, 0.099), [false, true, true]);
+        // Worse and no cheaper: only the scene.
+        assert_eq!(front_with_scene(1.0, 900, 0.2), [false, true, false]);
+    }
+
+    #[test]
+    fn pareto_front_of_equal_errors_is_one_point_without_cycles() {
+        // A ties B (2.5% apart, B fewer evaluations), B ties C (2.4%, C fewer),
+        // but A is faster than C beyond noise: pair by pair each would push
+        // another off. As a group, B stays: within 3% of the fastest (A), with
+        // fewer evaluations than A; C is beyond noise of A.
+        let point = |seconds, de_evaluations| {
+            Some(FrontPoint {
+                seconds,
+                de_evaluations,
+                error: 0.1,
+                is_scene: false,
+            })
+        };
+        let front = pareto_front(&[point(1.0, 300), point(1.025, 200), point(1.05, 100)]);
+        assert_eq!(front, [false, true, false]);
+    }
+
+    #[test]
+    fn pareto_front_compares_errors_to_three_digits() {
+        // An image differing in the sixth digit, the same work, 0.8× the time
+        // (noise): the scene keeps the star.
+        assert_eq!(front_with_scene(0.8, 1000, 0.1000001), [false, true, false]);
+        assert_eq!(front_with_scene(0.8, 1000, 0.0999999), [false, true, false]);
+        // In the third digit it is less error.
+        assert_eq!(front_with_scene(1.0, 1000, 0.0995), [false, false, true]);
+        assert_eq!(significant(0.012345, 3), 0.0123);
+        assert_eq!(significant(33.094, 3), 33.1);
+        assert_eq!(significant(0.0, 3), 0.0);
+    }
+
+    #[test]
+    fn median_of_runs_ignores_outliers() {
+        assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
+        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
+        // One slow run (a page fault, another process) and one lucky one.
+        assert_eq!(median(&mut [1.0, 1.0, 9.0, 1.0, 0.5]), 1.0);
+        assert_eq!(median(&mut []), 0.0);
+    }
+
+    #[test]
+    fn markdown_says_how_the_front_was_computed() {
+        let report = Report {
+            rows: vec![row("reference", 5.0, 0.0), row("scene", 1.0, 0.1)],
+            reference: reference_scene(&Scene::default()),
+            convergence: Convergence {
+                depth_change_mean_px: 0.0,
+                hit_change: 0.0,
+            },
+        };
+        let md = to_markdown(&report, "# t");
+        assert!(md.contains(&format!(
+            "median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs"
+        )));
+        assert!(
+            md.contains("less error at no more than 1.03× its median time"),
+            "{md}"
+        );
+        assert!(md.contains("within 3% of the fastest of them"));
     }
 
     #[test]

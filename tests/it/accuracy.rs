@@ -1,5 +1,5 @@
 //! `mandelreel accuracy` on a tiny frame: the three files, one row per variant,
-//! and zero error for the reference against itself.
+//! zero error for the reference against itself, the front's rule, the chart.
 
 use crate::util::{stdout, tiny_timeline, Dir};
 
@@ -71,6 +71,10 @@ fn accuracy_writes_csv_table_and_chart() {
         rows.len() + 1
     );
     assert!(stdout(&out).contains("| reference |"));
+    // The table says how times were taken and the front computed.
+    assert!(md.contains("median of 5 to 21 runs"), "{md}");
+    assert!(md.contains("less error at no more than 1.03× its median time"));
+    // Two panels side by side over a key: the chart's fixed size.
     let chart = image::open(d.path().join("out/t/accuracy.png")).unwrap();
-    assert!(chart.width() >= 800);
+    assert_eq!((chart.width(), chart.height()), (1600, 1000));
 }
