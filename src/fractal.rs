@@ -2523,4 +2523,60 @@ mod tests {
             }
         }
     }
+
+    #[test]
+    fn no_point_past_the_set_radius_is_in_the_set() {
+        // The bound the far estimate rests on, for powers, bailouts (1e30
+        // lowered to the escape radius), Julia constants and precisions:
+        // every point just past `set_radius` escapes, and its estimate is
+        // finite and positive, never more than its distance to the origin.
+        for power in [2.0, 3.0, 8.0, 12.5] {
+            for bailout in [2.0, 4.0, 100.0, 1e30] {
+                for julia in [
+                    None,
+                    Some(DVec3::new(0.3, -0.5, 0.2)),
+                    Some(DVec3::splat(2.0)),
+                ] {
+                    for precision in [Precision::F64, Precision::F32] {
+                        let f = Fractal {
+                            power,
+                            bailout,
+                            julia,
+                            precision,
+                            ..Fractal::default()
+                        };
+                        let escape = match precision {
+                            Precision::F64 => f.escape_radius::<f64>(),
+                            Precision::F32 => f.escape_radius::<f32>(),
+                        };
+                        assert!(
+                            escape > 1.0
+                                && escape <= bailout
+                                && (escape.powf(power) * 2.0).powi(2).is_finite()
+                        );
+                        let radius = f.set_radius(escape);
+                        assert!(
+                            radius >= 1.0_f64.min(escape) && radius <= escape,
+                            "{f:?}: {radius}"
+                        );
+                        for scale in [1.001, 1.3, 3.0] {
+                            for p in points(300, 0.999..1.0, 17) {
+                                let p = p.normalize() * radius * scale;
+                                assert!(!f.contains(p), "{f:?}: {p} past {radius} is in the set");
+                                let e = f.estimate(p, 1e-3);
+                                assert!(e.escaped, "{f:?} at {p}");
+                                assert!(
+                                    e.distance.is_finite()
+                                        && e.distance > 0.0
+                                        && e.distance <= p.length(),
+                                    "{f:?} at {p}: {}",
+                                    e.distance
+                                );
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
