@@ -560,15 +560,16 @@ impl Fractal {
         stop_at_bailout: bool,
         power: impl Fn(Triplex<T>, T) -> (Triplex<T>, T),
     ) -> Orbit<T> {
+        let escape = self.escape_radius::<T>();
         let mut state = OrbitState::start(self, p);
         while state.i < limit {
-            if stop_at_bailout && state.outside(self.bailout) {
+            if stop_at_bailout && state.outside(escape) {
                 break;
             }
             state.step(&power);
         }
         ITERATIONS.with(|count| count.set(count.get() + state.i as u64));
-        state.finish(self.bailout)
+        state.finish(escape)
     }
 
     /// `N` orbits (Mandelbrot or Julia, stopping at the bailout) iterated
@@ -658,6 +659,195 @@ impl Fractal {
         ITERATIONS.with(|count| count.set(count.get() + iterations));
     }
 
+    /// The radius past which an orbit counts as escaped in `T`: `bailout`,
+    /// or lower where the step that passes it could leave `T`'s range. That
+    /// step lands within Eⁿ + |c| of the origin, and |z|² of it must stay
+    /// finite, with 2¹⁴ to spare for the running derivative (which near the
+    /// surface is about r·ln r/distance): so Eⁿ ≤ 2^(½·range − 14), about
+    /// 1e150 in f64 and 1e15 in f32. Past that, |z|² overflowed and the
+    /// estimate read ∞/∞ (0, a false hit): f64 at bailout 1e30, f32 at any
+    /// bailout above 237 for power 8. Lowering the escape radius above the
+    /// set's own radius (`set_radius`) keeps the set but for orbits that
+    /// would have escaped an iteration or two later. Cheap: a power is taken
+    /// only where the bailout is that large.
+    #[inline]
+    pub fn escape_radius<T: Number>(&self) -> Real {
+        let limit_log2 = 0.5 * T::MAX_LOG2 - 14.0;
+        // The bailout is below 2^e (e from its exponent bits).
+        let e = ((self.bailout.to_bits() >> 52) & 0x7ff) as Real - 1022.0;
+        if self.power * e <= limit_log2 {
+            self.bailout
+        } else {
+            self.bailout.min((limit_log2 / self.power).exp2())
+        }
+    }
+
+    /// A radius the set (at this iteration count and escape radius `escape`)
+    /// lies within. The triplex power takes |z| to |z|ⁿ exactly, so
+    /// |zⁿ + c| ≥ |z|ⁿ − |c| and mₖ₊₁ = mₖⁿ − |c| (|c| = |p| in Mandelbrot
+    /// mode), m₀ = |p|, bounds |zₖ| from below while it stays ≥ 0: a radius
+    /// whose m passes `escape` within the iterations (at most 64 counted)
+    /// holds no point of the set. m grows with the radius (in Mandelbrot mode
+    /// from 2^(1/(n−1)) up, where mₖ ≥ |p| and ∂mₖ/∂|p| ≥ 1), so bisection
+    /// finds the least such radius. For the power-8 bulb it is 1.105 at any
+    /// bailout. Kept per thread for the last fractal asked about.
+    pub fn set_radius(&self, escape: Real) -> Real {
+        thread_local! {
+            static LAST: std::cell::Cell<([u64; 4], Real)> = const { std::cell::Cell::new(([0; 4], Real::NAN)) };
+        }
+        let c_norm = self.julia.map(|c| c.length());
+        let key = [
+            self.power.to_bits(),
+            escape.to_bits(),
+            c_norm.unwrap_or(-1.0).to_bits(),
+            self.iterations as u64,
+        ];
+        let (last_key, last) = LAST.with(|l| l.get());
+        if last_key == key && !last.is_nan() {
+            return last;
+        }
+        let n = self.power;
+        let steps = self.iterations.min(64);
+        let escapes = |rho: Real| {
+            let c = c_norm.unwrap_or(rho);
+            let mut m = rho;
+            for _ in 0..steps {
+                if m > escape {
+                    return true;
+                }
+                m = m.powf(n) - c;
+                if m.is_nan() || m < 0.0 {
+                    return false;
+                }
+            }
+            m > escape
+        };
+        let lowest = if c_norm.is_some() {
+            0.0
+        } else {
+            2f64.powf(1.0 / (n - 1.0))
+        };
+        let radius = if !(lowest < escape && escapes(escape)) {
+            escape
+        } else if escapes(lowest) {
+            lowest
+        } else {
+            // A bracket by doubling first: the escape radius may be 1e18.
+            let (mut lo, mut hi) = (lowest, (2.0 * lowest.max(0.5)).min(escape));
+            while !escapes(hi) {
+                (lo, hi) = (hi, (2.0 * hi).min(escape));
+            }
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if escapes(mid) {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            // Room for the orbit's rounding, f32's included.
+            (hi * (1.0 + 1e-4)).min(escape)
+        };
+        LAST.with(|l| l.set((key, radius)));
+        radius
+    }
+
+    /// `distance`, the estimate of an escaped point `p` after `iterations`,
+    /// or a bound in its place where its formula is known to fail; with the
+    /// orbits the bound took. Both `estimate` and the vector kernel finish
+    /// with this, so they agree to the bit.
+    ///
+    /// - Far from the set (past twice `set_radius`, or past the escape
+    ///   radius): ½·r·ln r/dr holds only near the boundary (seed 001, part V:
+    ///   "for points far away we can restrict the maximum DE step"); after
+    ///   one iteration it is about ½·|p|·ln|p|, beyond the true distance
+    ///   from |p| ≈ 4.5 (power 8), so rays entering a large bounding sphere
+    ///   stepped past the bulb; and past the bailout the old bound |p| − B
+    ///   drew the bailout ball as a surface. With R = `set_radius` and
+    ///   p′ = p·R/|p| its projection onto that sphere, every point q of the
+    ///   set has |p − q|² ≥ |p′ − q|² + (|p| − R)², so the distance is at
+    ///   least √(d(p′)² + (|p| − R)²): a bound that grows as |p| − R and
+    ///   meets the estimate at p′.
+    /// - Near the critical point in Julia mode (`near_critical`): the first
+    ///   step z ↦ zⁿ + c has zero derivative at z = 0, so dr there is 0 and
+    ///   ½·r·ln r/dr infinite (0/0 at the point: a hit at once), and near
+    ///   it far too large. Where the estimate is not below |p| (its ball
+    ///   holds the critical point, so the linearisation it rests on fails),
+    ///   compose instead: the set is its own preimage, and the power
+    ///   stretches distances within radius ρ by n·ρⁿ⁻¹ (the scalar
+    ///   derivative's model, which the analytic estimate trusts everywhere
+    ///   else), so a point of the set within δ of p puts one within
+    ///   n·(|p| + δ)ⁿ⁻¹·δ of z₁ = pⁿ + c: δ is the root of
+    ///   n·(|p| + δ)ⁿ⁻¹·δ = d(z₁). Where δ ≪ |p| that is the estimate
+    ///   itself; at p = 0 it is (d(z₁)/n)^(1/n).
+    pub fn bounded<T: Number>(
+        &self,
+        p: DVec3,
+        scale: Real,
+        distance: Real,
+        iterations: u32,
+        near_critical: bool,
+    ) -> (Real, u32) {
+        let escape = self.escape_radius::<T>();
+        let scaled = p.abs().max_element();
+        let length = if scaled < 1e150 {
+            p.length()
+        } else {
+            scaled * (p / scaled).length()
+        };
+        // The set radius is at least min(1, escape): nothing to bound within 2.
+        if iterations == 0 || length > escape.min(2.0) {
+            let radius = self.set_radius(escape);
+            if iterations == 0 || length > escape.min(2.0 * radius) {
+                let gap = length - radius;
+                if length > 8.0 * radius {
+                    return (gap, 0);
+                }
+                let projected = p * (radius / length);
+                let e = self.estimate_raw::<T>(projected, scale);
+                let near = if e.escaped { e.distance } else { 0.0 };
+                return (near.hypot(gap), e.orbits);
+            }
+        }
+        if near_critical && self.julia.is_some() && !(distance > 0.0 && distance < length) {
+            let n = self.power;
+            // d(z₁) is the estimate times the first step's stretch n·|p|ⁿ⁻¹
+            // (the running derivative is that product); at the critical
+            // point itself, where both are 0, it takes the orbit from z₁.
+            let slope = n * length.powf(n - 1.0);
+            let (target, orbits) =
+                if distance > 0.0 && (distance * slope).is_finite() && slope > 0.0 {
+                    (distance * slope, 0)
+                } else {
+                    let first: Orbit<T> = self.orbit(
+                        [T::from_real(p.x), T::from_real(p.y), T::from_real(p.z)],
+                        1,
+                        false,
+                    );
+                    let z1 = DVec3::new(first.z[0].value(), first.z[1].value(), first.z[2].value());
+                    let e = self.estimate_in::<T>(z1, scale, false);
+                    (if e.escaped { e.distance } else { 0.0 }, 1 + e.orbits)
+                };
+            let stretch = |delta: Real| n * (length + delta).powf(n - 1.0) * delta;
+            // δⁿ ≤ the stretch, and so is δ·n·|p|ⁿ⁻¹: both roots lie above.
+            let mut hi = (target / n).powf(1.0 / n);
+            if slope > 0.0 {
+                hi = hi.min(target / slope);
+            }
+            let mut lo = 0.0;
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if stretch(mid) > target {
+                    hi = mid;
+                } else {
+                    lo = mid;
+                }
+            }
+            return (as_distance(lo), orbits);
+        }
+        (distance, 0)
+    }
+
     /// Whether `p` belongs to the set at this iteration count: its orbit never
     /// passes the bailout. Trusts no distance estimate.
     /// Iterates in the estimator's precision, so a march that finds a point
@@ -677,12 +867,31 @@ impl Fractal {
     /// methods step a fraction of it.
     pub fn estimate(&self, p: DVec3, scale: Real) -> Estimate {
         match self.precision {
-            Precision::F64 => self.estimate_in::<f64>(p, scale),
-            Precision::F32 => self.estimate_in::<f32>(p, scale),
+            Precision::F64 => self.estimate_in::<f64>(p, scale, true),
+            Precision::F32 => self.estimate_in::<f32>(p, scale, true),
         }
     }
 
-    fn estimate_in<T: Number>(&self, p: DVec3, scale: Real) -> Estimate {
+    /// The estimator's value at `p` within the bounds of `bounded` (the
+    /// critical-point bound only where `near_critical`).
+    fn estimate_in<T: Number>(&self, p: DVec3, scale: Real, near_critical: bool) -> Estimate {
+        let mut estimate = self.estimate_raw::<T>(p, scale);
+        if estimate.escaped {
+            let (distance, orbits) = self.bounded::<T>(
+                p,
+                scale,
+                estimate.distance,
+                estimate.iterations,
+                near_critical,
+            );
+            estimate.distance = distance;
+            estimate.orbits += orbits;
+        }
+        estimate
+    }
+
+    /// The estimator's formula at `p`, without `bounded`'s bounds.
+    fn estimate_raw<T: Number>(&self, p: DVec3, scale: Real) -> Estimate {
         let at = |q: DVec3| [T::from_real(q.x), T::from_real(q.y), T::from_real(q.z)];
         // The Jacobian method runs its one orbit in dual numbers: their values
         // are the plain orbit, so no second orbit is needed.
@@ -728,7 +937,7 @@ impl Fractal {
         let distance = if !centre.escaped {
             0.0
         } else if centre.iterations == 0 {
-            distance_to_ball(p, self.bailout)
+            distance_to_ball(p, self.escape_radius::<T>())
         } else {
             let r = centre.r.value();
             let d = match self.de {
@@ -747,7 +956,8 @@ impl Fractal {
                 DeMethod::Potential | DeMethod::SinhPotential | DeMethod::EscapeLength => {
                     // Tetrahedral finite differences; the step is a fraction of the
                     // pixel footprint but never below the precision's noise floor.
-                    let h = (0.25 * scale).max(T::EPSILON.sqrt() * p.length().max(1e-3));
+                    let floor = T::EPSILON.sqrt() * p.length().max(1e-3);
+                    let h = (0.25 * scale).max(floor);
                     let k = centre.iterations;
                     let sample = |q: DVec3| -> Real {
                         match self.de {
@@ -764,14 +974,29 @@ impl Fractal {
                     }
                     orbits += 4;
                     let slope = gradient.length() / (4.0 * h);
-                    match self.de {
-                        DeMethod::EscapeLength => half_r_ln_r_over(r, slope),
-                        DeMethod::Potential => {
-                            0.5 * potential(r, centre.iterations, self.power) / slope
-                        }
-                        _ => {
-                            let g = potential(r, centre.iterations, self.power);
-                            0.5 * g.sinh() / (g.exp() * slope)
+                    // Samples that overflowed make the slope infinite and the
+                    // distance 0: a false hit. And where the precision's
+                    // floor, not the footprint, set the step and the surface
+                    // is nearer than it (by the analytic estimate of the same
+                    // orbit), the stencil straddles the surface: r after k
+                    // iterations leaps by orders across it (in f32, 3.4e-4·|p|
+                    // wide, stopping rays 1e-3 … 1e-7 from the surface at
+                    // once). Both fall back to the analytic estimate.
+                    let straddles = h > 0.25 * scale && h > guarded_distance(centre);
+                    if !(slope.is_finite() && slope > 0.0)
+                        || (self.de == DeMethod::EscapeLength && straddles)
+                    {
+                        Real::NAN
+                    } else {
+                        match self.de {
+                            DeMethod::EscapeLength => half_r_ln_r_over(r, slope),
+                            DeMethod::Potential => {
+                                0.5 * potential(r, centre.iterations, self.power) / slope
+                            }
+                            _ => {
+                                let g = potential(r, centre.iterations, self.power);
+                                0.5 * g.sinh() / (g.exp() * slope)
+                            }
                         }
                     }
                 }
@@ -1078,7 +1303,8 @@ impl<S: pulp::Simd> Register<S> {
     /// The lanes past the bailout (`OrbitState::outside`).
     #[inline(always)]
     fn outside(&self, fractal: &Fractal) -> S::m64s {
-        let bailout2 = self.splat(fractal.bailout * fractal.bailout);
+        let escape = fractal.escape_radius::<f64>();
+        let bailout2 = self.splat(escape * escape);
         self.simd.greater_than_f64s(self.r2.1, bailout2.1)
     }
 
@@ -1147,7 +1373,8 @@ impl<S: pulp::Simd> Register<S> {
                 planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
             };
             let end = [z[0][k], z[1][k], z[2][k]];
-            *out = Orbit::ended(end, r2[k], r[k], dr[k], traps, i[k] as u32, fractal.bailout);
+            let escape = fractal.escape_radius::<f64>();
+            *out = Orbit::ended(end, r2[k], r[k], dr[k], traps, i[k] as u32, escape);
         }
     }
 
@@ -1217,7 +1444,17 @@ impl<S: pulp::Simd> Register<S> {
         if self.any(rare) {
             let rare = store(self.select(rare, one, zero));
             for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
-                out[k].distance = distance_to_ball(points[k], fractal.bailout);
+                out[k].distance = distance_to_ball(points[k], fractal.escape_radius::<f64>());
+            }
+        }
+        // The bounds `Fractal::estimate` puts on its estimator, lane by
+        // lane: each is a cheap test but for the rare lane it applies to.
+        for (out, &p) in out.iter_mut().zip(points) {
+            if out.escaped {
+                let (distance, orbits) =
+                    fractal.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
+                out.distance = distance;
+                out.orbits += orbits;
             }
         }
     }
@@ -2282,6 +2519,62 @@ mod tests {
                 // Outside the bailout ball everything has escaped, with a positive distance.
                 if DVec3::new(x, y, z).length() > f.bailout {
                     prop_assert!(e.escaped && e.distance > 0.0);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn no_point_past_the_set_radius_is_in_the_set() {
+        // The bound the far estimate rests on, for powers, bailouts (1e30
+        // lowered to the escape radius), Julia constants and precisions:
+        // every point just past `set_radius` escapes, and its estimate is
+        // finite and positive, never more than its distance to the origin.
+        for power in [2.0, 3.0, 8.0, 12.5] {
+            for bailout in [2.0, 4.0, 100.0, 1e30] {
+                for julia in [
+                    None,
+                    Some(DVec3::new(0.3, -0.5, 0.2)),
+                    Some(DVec3::splat(2.0)),
+                ] {
+                    for precision in [Precision::F64, Precision::F32] {
+                        let f = Fractal {
+                            power,
+                            bailout,
+                            julia,
+                            precision,
+                            ..Fractal::default()
+                        };
+                        let escape = match precision {
+                            Precision::F64 => f.escape_radius::<f64>(),
+                            Precision::F32 => f.escape_radius::<f32>(),
+                        };
+                        assert!(
+                            escape > 1.0
+                                && escape <= bailout
+                                && (escape.powf(power) * 2.0).powi(2).is_finite()
+                        );
+                        let radius = f.set_radius(escape);
+                        assert!(
+                            radius >= 1.0_f64.min(escape) && radius <= escape,
+                            "{f:?}: {radius}"
+                        );
+                        for scale in [1.001, 1.3, 3.0] {
+                            for p in points(300, 0.999..1.0, 17) {
+                                let p = p.normalize() * radius * scale;
+                                assert!(!f.contains(p), "{f:?}: {p} past {radius} is in the set");
+                                let e = f.estimate(p, 1e-3);
+                                assert!(e.escaped, "{f:?} at {p}");
+                                assert!(
+                                    e.distance.is_finite()
+                                        && e.distance > 0.0
+                                        && e.distance <= p.length(),
+                                    "{f:?} at {p}: {}",
+                                    e.distance
+                                );
+                            }
+                        }
+                    }
                 }
             }
         }

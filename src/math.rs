@@ -23,6 +23,8 @@ pub trait Arith:
 pub trait Number: Arith + Neg<Output = Self> {
     /// Machine epsilon of the underlying float.
     const EPSILON: Real;
+    /// log₂ of the underlying float's largest value (its range).
+    const MAX_LOG2: Real;
     fn from_real(v: Real) -> Self;
     /// The plain value (for comparisons, traps and results).
     fn value(self) -> Real;
@@ -243,6 +245,7 @@ macro_rules! impl_number_for_float {
 
         impl Number for $t {
             const EPSILON: Real = <$t>::EPSILON as Real;
+            const MAX_LOG2: Real = <$t>::MAX_EXP as Real;
             #[inline(always)]
             fn from_real(v: Real) -> Self {
                 v as $t
@@ -383,6 +386,7 @@ impl<T: Number> Arith for Dual<T> {
 
 impl<T: Number> Number for Dual<T> {
     const EPSILON: Real = T::EPSILON;
+    const MAX_LOG2: Real = T::MAX_LOG2;
     fn from_real(v: Real) -> Self {
         Dual::constant(T::from_real(v))
     }

@@ -282,3 +282,259 @@ fn rays_running_out_of_steps_are_counted_and_warned_of() {
     says(&out, "(0 out of steps)");
     assert!(!stderr(&out).contains("warning"), "{}", stderr(&out));
 }
+
+// Hostile but legal scenes, measured against membership: the library's
+// marcher against `march_by_membership` (orbits alone, no estimate), ray by
+// ray over a small camera grid.
+
+use mandelreel::fractal::{DeMethod, Fractal, Precision};
+use mandelreel::march::{march, march_by_membership, MarchSettings, Ray};
+use mandelreel::math::DVec3;
+use mandelreel::scene::Camera;
+
+/// The bulb seen from 13 units, outside every bounding sphere below.
+fn far_camera() -> Camera {
+    Camera {
+        position: DVec3::new(0.0, 3.0, 13.0),
+        fov_degrees: 11.0,
+        ..Camera::default()
+    }
+}
+
+/// How far apart two hits on one ray may be, in footprints: in the halo
+/// where the 12-iteration estimate lingers under the hit threshold, rays
+/// that start elsewhere stop up to 5 footprints apart (0.7 units here).
+const NEAR_FOOTPRINTS: f64 = 6.0;
+
+/// The rays of a 32×18 grid of `camera`'s on which `fractal` marched
+/// inside `radius` disagrees with `trusted` marched inside `reference` (a
+/// hit against a miss, or hits `NEAR_FOOTPRINTS` apart), and those
+/// on which membership alone (`march_by_membership`, no estimate) finds the
+/// set inside `reference`.
+fn disagreements(
+    camera: &Camera,
+    (fractal, radius): (&Fractal, f64),
+    (trusted, reference): (&Fractal, f64),
+) -> (usize, usize) {
+    let frame = camera.frame();
+    let (w, h) = (32, 18);
+    let settings = |bounding_radius| MarchSettings {
+        bounding_radius,
+        ..MarchSettings::default()
+    };
+    let (mut wrong, mut members) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = frame.ray(x as f64 + 0.5, y as f64 + 0.5, w, h);
+            let got = march(&ray, fractal, &settings(radius)).hit;
+            if let Some(hit) = &got {
+                assert!(hit.t.is_finite() && hit.estimate.distance.is_finite());
+            }
+            let want = march(&ray, trusted, &settings(reference)).hit;
+            let (member, _) =
+                march_by_membership(&ray, fractal, &settings(reference), 0.25, 1e-4, 1_000_000);
+            members += usize::from(member.is_some());
+            let agree = match (got.map(|hit| hit.t), want.map(|hit| hit.t)) {
+                (Some(t), Some(u)) => (t - u).abs() <= NEAR_FOOTPRINTS * ray.footprint(u),
+                (None, None) => true,
+                _ => false,
+            };
+            wrong += usize::from(!agree);
+        }
+    }
+    (wrong, members)
+}
+
+/// Asserts that `fractal` marched inside `radius` sees what the everyday
+/// setting (bailout 4 inside a sphere of 1.5, the rest the same) sees on all but 2% of the rays, where membership sees the
+/// set on at least 100 of them.
+fn sees_the_bulb(fractal: &Fractal, radius: f64) {
+    let trusted = Fractal {
+        bailout: 4.0,
+        ..fractal.clone()
+    };
+    let (wrong, members) = disagreements(&far_camera(), (fractal, radius), (&trusted, 1.5));
+    assert!(
+        members > 100,
+        "{fractal:?}: membership sees the set ({members} rays)"
+    );
+    assert!(
+        wrong <= 576 / 50,
+        "{fractal:?} inside {radius}: {wrong} of 576 rays differ ({members} in the set)"
+    );
+}
+
+#[test]
+fn a_bounding_sphere_past_the_bailout_draws_no_bailout_ball() {
+    // Bailout 4 in a sphere of 6: the estimate outside the bailout ball was
+    // |p| − 4, so rays crept onto the ball and hit it (358 of 576 rays
+    // wrong here). Other bailouts, estimators, precisions and a Julia set
+    // alike; the power-8 bulb lies within 1.2.
+    let julia = Some(DVec3::new(0.3, -0.5, 0.2));
+    for (bailout, radius, de, precision, julia) in [
+        (4.0, 6.0, DeMethod::Analytic, Precision::F64, None),
+        (2.0, 3.0, DeMethod::Analytic, Precision::F64, None),
+        (2.0, 3.0, DeMethod::Potential, Precision::F32, None),
+        (4.0, 6.0, DeMethod::SinhPotential, Precision::F64, None),
+        (3.0, 5.0, DeMethod::Analytic, Precision::F32, julia),
+    ] {
+        let f = Fractal {
+            bailout,
+            de,
+            precision,
+            julia,
+            ..Fractal::default()
+        };
+        sees_the_bulb(&f, radius);
+    }
+}
+
+#[test]
+fn large_bailouts_and_spheres_keep_the_bulb() {
+    // Bailout 100 in a sphere of 10: from |p| = 10 the estimate ½·r·ln r/dr
+    // is 11.5 where the bulb is 8.9 away, so rays stepped past it (412 of
+    // 576 rays wrong; the potential estimator hit nothing). Bailout 1e30:
+    // |z|² overflowed past 1e154 and the estimate read ∞/∞.
+    for (bailout, radius, de) in [
+        (100.0, 10.0, DeMethod::Analytic),
+        (100.0, 10.0, DeMethod::Potential),
+        (100.0, 10.0, DeMethod::SinhPotential),
+        (1e30, 10.0, DeMethod::Analytic),
+        (1e30, 1e6, DeMethod::Analytic),
+        (1e30, 1e6, DeMethod::SinhPotential),
+        (1e30, 1e6, DeMethod::Potential),
+    ] {
+        let f = Fractal {
+            bailout,
+            de,
+            ..Fractal::default()
+        };
+        sees_the_bulb(&f, radius);
+    }
+}
+
+#[test]
+fn single_precision_takes_huge_bailouts() {
+    // f32 holds 3.4e38: at bailout 1e30 the last step overflowed and every
+    // ray hit the bounding sphere itself.
+    for (bailout, radius, de) in [
+        (1e30, 1.5, DeMethod::Analytic),
+        (1e30, 10.0, DeMethod::Analytic),
+        (1e6, 1.5, DeMethod::Potential),
+        (1e30, 1.5, DeMethod::SinhPotential),
+    ] {
+        let f = Fractal {
+            bailout,
+            de,
+            precision: Precision::F32,
+            ..Fractal::default()
+        };
+        sees_the_bulb(&f, radius);
+    }
+}
+
+#[test]
+fn a_julia_camera_on_the_critical_point_sees_the_set() {
+    // In Julia mode the derivative of z ↦ zⁿ + c is 0 at z = 0: the
+    // estimate there was 0 (every ray hit at once) and, nearby, far too
+    // large. c = (0.8, 0.3, 0.2) leaves 0 outside the set, which is first
+    // met 0.59 along the view: each ray must find what it finds when
+    // started 0.3 along, past the critical point, where membership finds
+    // nothing before.
+    for de in DeMethod::ALL {
+        for precision in [Precision::F64, Precision::F32] {
+            let f = Fractal {
+                julia: Some(DVec3::new(0.8, 0.3, 0.2)),
+                de,
+                precision,
+                ..Fractal::default()
+            };
+            assert!(!f.contains(DVec3::ZERO));
+            for position in [DVec3::ZERO, DVec3::new(1e-3, 0.0, 0.0), DVec3::splat(-1e-7)] {
+                let camera = Camera {
+                    position,
+                    target: position + DVec3::new(0.2, -0.1, 1.0),
+                    fov_degrees: 30.0,
+                    ..Camera::default()
+                };
+                let frame = camera.frame();
+                let settings = MarchSettings::default();
+                let (mut same, mut hits) = (0, 0);
+                for y in 0..18 {
+                    for x in 0..32 {
+                        let ray = frame.ray(x as f64 + 0.5, y as f64 + 0.5, 32, 18);
+                        let (member, _) =
+                            march_by_membership(&ray, &f, &settings, 0.25, 1e-4, 1_000_000);
+                        assert!(member.is_none_or(|t| t > 0.3));
+                        let later = Ray {
+                            origin: ray.at(0.3),
+                            start_footprint: ray.footprint(0.3),
+                            ..ray
+                        };
+                        let want = march(&later, &f, &settings).hit.map(|hit| 0.3 + hit.t);
+                        let got = march(&ray, &f, &settings).hit.map(|hit| hit.t);
+                        hits += usize::from(got.is_some());
+                        same += usize::from(match (got, want) {
+                            (Some(t), Some(u)) => {
+                                (t - u).abs() <= NEAR_FOOTPRINTS * ray.footprint(u)
+                            }
+                            (None, None) => true,
+                            _ => false,
+                        });
+                    }
+                }
+                assert!(
+                    hits > 200,
+                    "{de:?} {precision:?} from {position}: {hits} hits"
+                );
+                assert!(
+                    same >= 576 - 576 / 10,
+                    "{de:?} {precision:?} from {position}: {same} of 576 rays as from 0.3 along"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn escape_length_in_f32_steps_from_just_outside_the_surface() {
+    // The escape-length stencil is 3.4e-4·|p| wide in f32: from 1e-3 … 1e-7
+    // outside the surface it straddled it, its samples overflowed, and the
+    // ray stopped where it started.
+    for precision in [Precision::F32, Precision::F64] {
+        let f = Fractal {
+            de: DeMethod::EscapeLength,
+            precision,
+            ..Fractal::default()
+        };
+        let reference = MarchSettings::default();
+        for dir in [DVec3::new(0.1, -0.2, -1.0), DVec3::new(-0.3, 0.1, -1.0)] {
+            let fine = Ray {
+                origin: DVec3::new(0.0, 0.3, 3.0),
+                dir: dir.normalize(),
+                pixel_angle: 1e-12,
+                start_footprint: 0.0,
+            };
+            let (crossing, _) = march_by_membership(&fine, &f, &reference, 0.25, 1e-3, 1_000_000);
+            let crossing = crossing.expect("the ray meets the bulb");
+            for offset in [1e-3, 1e-4, 1e-5, 1e-6, 1e-7] {
+                let ray = Ray {
+                    origin: fine.at(crossing - offset),
+                    pixel_angle: 1e-3,
+                    ..fine
+                };
+                let t = march(&ray, &f, &reference).hit.map(|hit| hit.t);
+                let t = t.unwrap_or_else(|| panic!("{precision:?} {offset}: no hit"));
+                if f.contains(ray.origin) {
+                    // A speck of the set the membership steps passed over.
+                    assert_eq!(t, 0.0);
+                    continue;
+                }
+                assert!(
+                    t > 0.25 * offset && t < offset + 1e-4,
+                    "{precision:?} from {offset:e} outside: hit at {t:e}"
+                );
+            }
+        }
+    }
+}
