@@ -351,11 +351,14 @@ fn psnr(rmse: f64) -> f64 {
     }
 }
 
-/// Timed runs per variant: at least `MIN_TIMED_RUNS`, more while the
-/// variant has had under `TIMING_BUDGET_SECONDS`, at most `MAX_TIMED_RUNS`.
+/// Timed runs per variant: more while the variant has had under
+/// `TIMING_BUDGET_SECONDS`, at most `MAX_TIMED_RUNS`; at least
+/// `MIN_TIMED_RUNS` where they fit in `SLOW_BUDGET_SECONDS`, so a slow
+/// frame is not rendered five times over.
 pub const MIN_TIMED_RUNS: usize = 5;
 pub const MAX_TIMED_RUNS: usize = 21;
 const TIMING_BUDGET_SECONDS: f64 = 0.3;
+const SLOW_BUDGET_SECONDS: f64 = 3.0;
 
 /// Renders `scene` and returns the film with the median wall time of
 /// several runs. The median, not the fastest run: a single lucky run of a
@@ -364,10 +367,12 @@ fn timed_render(scene: &Scene, frame_index: u32, width: u32, height: u32) -> (Fi
     let mut seconds = Vec::with_capacity(MAX_TIMED_RUNS);
     let mut film = None;
     let started = Instant::now();
-    while seconds.len() < MIN_TIMED_RUNS
-        || (seconds.len() < MAX_TIMED_RUNS
-            && started.elapsed().as_secs_f64() < TIMING_BUDGET_SECONDS)
-    {
+    let more = |runs: usize, elapsed: f64| {
+        runs == 0
+            || (runs < MAX_TIMED_RUNS && elapsed < TIMING_BUDGET_SECONDS)
+            || (runs < MIN_TIMED_RUNS && elapsed < SLOW_BUDGET_SECONDS)
+    };
+    while more(seconds.len(), started.elapsed().as_secs_f64()) {
         let t0 = Instant::now();
         let f = render_frame(scene, frame_index, width, height, &|| {});
         seconds.push(t0.elapsed().as_secs_f64());
@@ -521,14 +526,25 @@ pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
         })
         .collect();
     let mut front = vec![false; points.len()];
-    for &(i, p) in &candidates {
-        let undercut = candidates
+    let undercut = |p: &FrontPoint| {
+        candidates
             .iter()
-            .any(|(_, q)| q.error < p.error && q.seconds <= p.seconds * TIMING_NOISE);
-        let same_error = || candidates.iter().filter(|(_, q)| q.error == p.error);
+            .any(|(_, q)| q.error < p.error && q.seconds <= p.seconds * TIMING_NOISE)
+    };
+    for &(i, p) in &candidates {
+        // A NaN error is no error level to be on the front at.
+        if p.error.is_nan() || undercut(&p) {
+            continue;
+        }
+        // The level's members another variant beats cannot hold its star.
+        let same_error = || {
+            candidates
+                .iter()
+                .filter(|(_, q)| q.error == p.error && !undercut(q))
+        };
         let fastest = same_error()
             .min_by(|a, b| a.1.seconds.total_cmp(&b.1.seconds))
-            .expect("p has its own error")
+            .expect("p itself qualifies")
             .1;
         let kept = same_error()
             .filter(|(_, q)| {
@@ -537,7 +553,7 @@ pub fn pareto_front(points: &[Option<FrontPoint>]) -> Vec<bool> {
             })
             .min_by(preferred)
             .expect("the fastest qualifies");
-        front[i] = !undercut && kept.0 == i;
+        front[i] = kept.0 == i;
     }
     front
 }
@@ -572,7 +588,7 @@ pub fn mark_pareto(rows: &mut [Measurement]) {
 /// How the times were taken and the front drawn, for the Markdown.
 pub fn front_rule_text() -> String {
     format!(
-        "Times are the median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs of the frame (more for quick frames, within {TIMING_BUDGET_SECONDS} s a variant). \
+        "Times are the median of {MIN_TIMED_RUNS} to {MAX_TIMED_RUNS} runs of the frame (more for quick frames, within {TIMING_BUDGET_SECONDS} s a variant; fewer, down to one, for frames too slow for {MIN_TIMED_RUNS} runs in {SLOW_BUDGET_SECONDS} s). \
 ★ marks the Pareto front of median time against image RMSE (the chart draws the same front for mean depth error too), \
 with times within {:.0}% of each other counted as the same cost and errors equal to three significant digits as the same error: a variant is off the front when another has less error \
 at no more than {TIMING_NOISE}× its median time. Variants with equal error are one point: of those within {:.0}% of the fastest of them, \
@@ -687,6 +703,29 @@ mod tests {
         mark_pareto(&mut rows);
         let front: Vec<_> = rows.iter().filter(|r| r.pareto).map(|r| r.knob).collect();
         assert_eq!(front, ["a", "b", "d"]);
+    }
+
+    #[test]
+    fn a_level_keeps_its_star_when_only_its_slower_member_is_beaten() {
+        // A and B share an error; C, a little better, is within noise of
+        // B's time but not of A's: A holds the level's star (picking B,
+        // which has fewer evaluations, and then finding it beaten left the
+        // level without one). A NaN error is on no front, and panics nothing.
+        let point = |seconds, de_evaluations, error| {
+            Some(FrontPoint {
+                seconds,
+                de_evaluations,
+                error,
+                is_scene: false,
+            })
+        };
+        let front = pareto_front(&[
+            point(1.00, 300, 0.1),
+            point(1.02, 200, 0.1),
+            point(1.04, 300, 0.09),
+            point(0.5, 100, f64::NAN),
+        ]);
+        assert_eq!(front, [true, false, true, false]);
     }
 
     /// The front of the scene (1 s, 1000 evaluations, error 0.1) and one

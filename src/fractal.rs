@@ -610,11 +610,30 @@ impl Fractal {
     ) {
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
             if let Some(n) = whole_power(self.power) {
-                return self.in_vectors(points, n, out);
+                self.in_vectors(points, n, out);
+                return self.bound_lanes(points, out);
             }
         }
         for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
             *out = self.estimate(p, scale);
+        }
+    }
+
+    /// The bounds `estimate` puts on its estimator (`bounded`), on the
+    /// vector kernel's estimates, outside the kernel: a cheap test but for
+    /// the rare lane a bound applies to.
+    fn bound_lanes(&self, points: &[DVec3], out: &mut [Estimate]) {
+        // `bounded`'s own first test, worked out once for all lanes.
+        let near = self.escape_radius::<f64>().min(2.0);
+        let critical = self.julia.is_some();
+        for (out, &p) in out.iter_mut().zip(points) {
+            let bound = out.iterations == 0 || p.length_squared() > near * near || critical;
+            if out.escaped && bound {
+                let (distance, orbits) =
+                    self.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
+                out.distance = distance;
+                out.orbits += orbits;
+            }
         }
     }
 
@@ -789,6 +808,15 @@ impl Fractal {
         near_critical: bool,
     ) -> (Real, u32) {
         let escape = self.escape_radius::<T>();
+        // The common case, a point near the set off Julia's critical point,
+        // in few operations: every estimate of a march comes through here.
+        let near = escape.min(2.0);
+        if iterations > 0
+            && p.length_squared() <= near * near
+            && !(near_critical && self.julia.is_some())
+        {
+            return (distance, 0);
+        }
         let scaled = p.abs().max_element();
         let length = if scaled < 1e150 {
             p.length()
@@ -1194,8 +1222,10 @@ fn orbit_registers<S: pulp::Simd>(
     let lanes = points.len() / 2;
     let mut a = Register::start(simd, fractal, &points[..lanes]);
     let mut b = Register::start(simd, fractal, &points[lanes..]);
+    // Worked out once: the escape test runs every iteration.
+    let escape2 = fractal.escape_radius::<f64>().powi(2);
     for _ in 0..fractal.iterations {
-        let (run_a, run_b) = (a.check(fractal), b.check(fractal));
+        let (run_a, run_b) = (a.check(escape2), b.check(escape2));
         if !(run_a || run_b) {
             break;
         }
@@ -1293,19 +1323,18 @@ impl<S: pulp::Simd> Register<S> {
     /// Stops the lanes past the bailout (`OrbitState::outside`: a NaN
     /// radius keeps iterating alike); whether any lane still runs.
     #[inline(always)]
-    fn check(&mut self, fractal: &Fractal) -> bool {
+    fn check(&mut self, escape2: f64) -> bool {
         let simd = self.simd;
-        let outside = self.outside(fractal);
+        let outside = self.outside(escape2);
         self.running = simd.and_m64s(self.running, simd.not_m64s(outside));
         self.any(self.running)
     }
 
     /// The lanes past the bailout (`OrbitState::outside`).
     #[inline(always)]
-    fn outside(&self, fractal: &Fractal) -> S::m64s {
-        let escape = fractal.escape_radius::<f64>();
-        let bailout2 = self.splat(escape * escape);
-        self.simd.greater_than_f64s(self.r2.1, bailout2.1)
+    fn outside(&self, escape2: f64) -> S::m64s {
+        self.simd
+            .greater_than_f64s(self.r2.1, self.splat(escape2).1)
     }
 
     /// `OrbitState::step` on the running lanes.
@@ -1367,13 +1396,13 @@ impl<S: pulp::Simd> Register<S> {
         let store = Self::store;
         let (z, planes) = (self.z.map(store), self.planes.map(store));
         let [origin, r2, r, dr, i] = [self.origin, self.r2, self.r, self.dr, self.i].map(store);
+        let escape = fractal.escape_radius::<f64>();
         for (k, out) in out.iter_mut().enumerate() {
             let traps = OrbitTraps {
                 origin: origin[k],
                 planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
             };
             let end = [z[0][k], z[1][k], z[2][k]];
-            let escape = fractal.escape_radius::<f64>();
             *out = Orbit::ended(end, r2[k], r[k], dr[k], traps, i[k] as u32, escape);
         }
     }
@@ -1399,7 +1428,7 @@ impl<S: pulp::Simd> Register<S> {
         // else its estimate is not above 0 or not finite, which
         // `as_distance` makes 0 as it does here: so one selection holds
         // `as_distance` and every case but the rare one.
-        let escaped = self.outside(fractal);
+        let escaped = self.outside(fractal.escape_radius::<f64>().powi(2));
         let stepped = simd.greater_than_or_equal_f64s(self.i.1, one.1);
         let in_range = simd.and_m64s(
             simd.greater_than_or_equal_f64s(r.1, self.splat(0.5).1),
@@ -1445,16 +1474,6 @@ impl<S: pulp::Simd> Register<S> {
             let rare = store(self.select(rare, one, zero));
             for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
                 out[k].distance = distance_to_ball(points[k], fractal.escape_radius::<f64>());
-            }
-        }
-        // The bounds `Fractal::estimate` puts on its estimator, lane by
-        // lane: each is a cheap test but for the rare lane it applies to.
-        for (out, &p) in out.iter_mut().zip(points) {
-            if out.escaped {
-                let (distance, orbits) =
-                    fractal.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
-                out.distance = distance;
-                out.orbits += orbits;
             }
         }
     }
@@ -1928,6 +1947,8 @@ mod tests {
                         out: &mut out.1,
                     }
                     .with_simd(simd);
+                    // As `estimate_lanes_into` finishes the kernel's estimates.
+                    f.bound_lanes(&points[..live], &mut out.1[..live]);
                     out
                 }
                 check(

@@ -400,6 +400,9 @@ const MAX_BOUNDING_RADIUS: Real = 1e6;
 /// Membership steps longer than this many footprints would step over
 /// whole features: the setting is a fraction of a pixel, or a few.
 const MAX_MEMBERSHIP_STEP: Real = 16.0;
+/// Shorter steps would spend a ray's `max_steps` creeping along the
+/// surface, and then stop it anywhere.
+const MIN_MEMBERSHIP_STEP: Real = 0.01;
 
 /// Every parameter a track can animate, with its number of components.
 pub const PARAMETERS: &[(&str, usize)] = &[
@@ -1468,11 +1471,12 @@ pub fn validate_scene(s: &Scene) -> Result<(), (String, String)> {
         },
     )?;
     check(
-        q.membership_step.is_finite() && (0.0..=MAX_MEMBERSHIP_STEP).contains(&q.membership_step),
+        q.membership_step == 0.0
+            || (MIN_MEMBERSHIP_STEP..=MAX_MEMBERSHIP_STEP).contains(&q.membership_step),
         "quality.membership_step",
         || {
             format!(
-                "must be 0 (trust the estimate) or up to {MAX_MEMBERSHIP_STEP} footprints, got {}",
+                "must be 0 (trust the estimate) or from {MIN_MEMBERSHIP_STEP} to {MAX_MEMBERSHIP_STEP} footprints, got {}",
                 q.membership_step.shown()
             )
         },
@@ -2003,12 +2007,17 @@ mod tests {
             (
                 "quality: (membership_step: -0.5)",
                 "quality.membership_step",
-                "must be 0 (trust the estimate) or up to 16 footprints",
+                "must be 0 (trust the estimate) or from 0.01 to 16 footprints",
+            ),
+            (
+                "quality: (membership_step: 1e-300)",
+                "quality.membership_step",
+                "must be 0 (trust the estimate) or from 0.01 to 16 footprints",
             ),
             (
                 "quality: (membership_step: 17)",
                 "quality.membership_step",
-                "must be 0 (trust the estimate) or up to 16 footprints",
+                "must be 0 (trust the estimate) or from 0.01 to 16 footprints",
             ),
             (
                 "camera: (focus_distance: Some(-2))",
