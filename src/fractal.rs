@@ -1770,10 +1770,10 @@ mod tests {
             ..Fractal::default()
         });
         // Radii that escape outside the logarithm's range, which lanes
-        // finish one at a time: to +∞ past a huge bailout (the points at
-        // |p| ≈ 4.1 below: 4.1⁸ ≈ 10⁴·⁹, then 10³⁹·², then overflow; some
-        // 400 lanes of this test end so); and a tiny bailout, outside which
-        // most points start.
+        // finish one at a time: a huge bailout (which `escape_radius` now
+        // lowers to about 5.6e18 for power 8, so no lane reaches +∞ any
+        // more; it still checks the lowered radius in both paths), and a
+        // tiny bailout, outside which most points start.
         for bailout in [1e40, 0.3] {
             fractals.push(Fractal {
                 bailout,
@@ -1865,8 +1865,9 @@ mod tests {
                 julia: Some(DVec3::new(0.3, -0.5, 0.2)),
                 ..Fractal::default()
             },
-            // Escaped radii below the logarithm's range and past f64's
-            // (timelines allow neither bailout; the kernel must still agree).
+            // Escaped radii below the logarithm's range, and a bailout past
+            // what f64 can reach in one step, lowered by `escape_radius`
+            // (timelines allow neither; the kernel must still agree).
             Fractal {
                 bailout: 0.45,
                 julia: Some(DVec3::new(0.47, 0.01, 0.0)),
