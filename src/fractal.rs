@@ -627,8 +627,7 @@ impl Fractal {
         let near = self.escape_radius::<f64>().min(2.0);
         let critical = self.julia.is_some();
         for (out, &p) in out.iter_mut().zip(points) {
-            let bound = out.iterations == 0 || p.length_squared() > near * near || critical;
-            if out.escaped && bound {
+            if out.escaped && !no_bound_applies(p, out.iterations, near, critical) {
                 let (distance, orbits) =
                     self.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
                 out.distance = distance;
@@ -810,11 +809,8 @@ impl Fractal {
         let escape = self.escape_radius::<T>();
         // The common case, a point near the set off Julia's critical point,
         // in few operations: every estimate of a march comes through here.
-        let near = escape.min(2.0);
-        if iterations > 0
-            && p.length_squared() <= near * near
-            && !(near_critical && self.julia.is_some())
-        {
+        let critical = near_critical && self.julia.is_some();
+        if no_bound_applies(p, iterations, escape.min(2.0), critical) {
             return (distance, 0);
         }
         let scaled = p.abs().max_element();
@@ -1548,6 +1544,15 @@ fn as_distance(d: Real) -> Real {
     } else {
         0.0
     }
+}
+
+/// Whether none of `Fractal::bounded`'s bounds applies at `p`: its orbit
+/// iterated, it lies within `near` (the escape radius, at most 2), and it
+/// is not near Julia's critical point (`critical`). The test every
+/// estimate of a march takes, so it is kept to a few operations.
+#[inline(always)]
+fn no_bound_applies(p: DVec3, iterations: u32, near: Real, critical: bool) -> bool {
+    iterations > 0 && p.length_squared() <= near * near && !critical
 }
 
 /// The distance from `p` to the bailout ball, for a point outside it before
