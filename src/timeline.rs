@@ -2406,7 +2406,7 @@ mod tests {
     fn the_readme_lists_every_parameter_a_track_can_animate() {
         // The README's table of track parameters, as far as the blank line
         // after its header.
-        let readme = include_str!("../README.md");
+        let readme = include_str!("../docs/timeline.md");
         let start = readme.find("| parameter | value |").expect("the table");
         let table = &readme[start..][..readme[start..].find("\n\n").expect("its end")];
         for (name, _) in PARAMETERS {

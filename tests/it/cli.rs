@@ -535,8 +535,8 @@ fn info_gives_a_looping_zooms_reach_from_its_frames() {
 
 #[test]
 fn the_readmes_reference_timeline_is_valid_and_draws_no_warning() {
-    let readme = include_str!("../../README.md");
-    let section = &readme[readme.find("## Timeline format").unwrap()..];
+    let readme = include_str!("../../docs/timeline.md");
+    let section = &readme[readme.find("# Timeline format").unwrap()..];
     let start = section.find("```ron\n").unwrap() + "```ron\n".len();
     let block = &section[start..start + section[start..].find("```").unwrap()];
     let d = Dir::new();

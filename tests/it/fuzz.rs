@@ -2,11 +2,11 @@
 //! (`Timeline::load`): every input, valid or not, gets its answer, a
 //! timeline or an error pointing into the file, without a panic, within
 //! `DEADLINE` and `guard::MAX_LIVE_BYTES`. The inputs are the example
-//! timelines and README's reference one, and timelines written from a
+//! timelines and docs/timeline.md's reference one, and timelines written from a
 //! grammar of the schema (`grammar`), broken by `mutate`'s edits.
 //!
 //! `cargo test` runs `CASES` cases a property from a fixed seed, so CI is
-//! repeatable; README (Development) says how to run longer.
+//! repeatable; docs/development.md says how to run longer.
 
 mod grammar;
 mod guard;
@@ -262,7 +262,7 @@ fn visible(text: &str) -> String {
         .collect()
 }
 
-/// The example timelines and README's reference timeline, by name.
+/// The example timelines and docs/timeline.md's reference timeline, by name.
 fn seeds() -> Vec<(String, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut seeds = Vec::new();
@@ -278,17 +278,20 @@ fn seeds() -> Vec<(String, String)> {
             seeds.push((file.display().to_string(), text));
         }
     }
-    seeds.push(("README.md's reference timeline".into(), readme_timeline()));
+    seeds.push((
+        "docs/timeline.md's reference timeline".into(),
+        readme_timeline(),
+    ));
     seeds
 }
 
-/// The first RON block of README's "Timeline format" section.
+/// The first RON block of docs/timeline.md's "Timeline format" section.
 fn readme_timeline() -> String {
-    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/README.md"))
-        .expect("read README.md");
+    let readme = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/docs/timeline.md"))
+        .expect("read docs/timeline.md");
     let section = &readme[readme
-        .find("## Timeline format")
-        .expect("README's timeline section")..];
+        .find("# Timeline format")
+        .expect("the timeline reference's section")..];
     let block = &section[section.find("```ron\n").expect("a RON block") + 7..];
     block[..block.find("```").expect("the block's end")].to_string()
 }
