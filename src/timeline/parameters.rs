@@ -1,0 +1,602 @@
+//! Every parameter a track can animate, described once: its name, shape,
+//! the range a scene holds it to and how a track's value sets it. Track
+//! names, `Track`'s setter, `validate_scene`'s range checks of these fields
+//! and the docs' table of parameters all come from `GROUPS`.
+
+use super::messages::Shown;
+use super::validate::{colour, counted, non_negative, positive, rule, Checked};
+use crate::math::{DVec3, Real, Vec3};
+use crate::scene::Scene;
+use Shape::{Number, Triple};
+
+/// A parameter's value: one number, or a triple such as a position or colour.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    Number,
+    Triple,
+}
+
+impl Shape {
+    /// How many numbers a value of this shape holds.
+    pub const fn components(self) -> usize {
+        match self {
+            Number => 1,
+            Triple => 3,
+        }
+    }
+}
+
+/// One animatable parameter.
+#[derive(Clone, Copy, Debug)]
+pub struct Parameter {
+    /// The track's name, the field's path in the scene.
+    pub name: &'static str,
+    pub shape: Shape,
+    /// The docs' value column: the shape, and what is special about it.
+    pub doc: &'static str,
+    /// The scene's value within its range, else what is wrong with it
+    /// (validation adds the field). A disabled effect's fields pass.
+    pub check: fn(&Scene) -> Checked,
+    /// Writes a track's sampled value, `shape.components()` numbers.
+    pub set: fn(&mut Scene, &[Real]),
+}
+
+/// The track that sets the camera–target distance, interpolated in log space.
+pub const ZOOM_TRACK: &str = "camera.distance";
+
+/// The largest camera position or target component a scene may have: the
+/// bulb is a unit across, so from farther it is below a pixel of any field
+/// of view, and the view's length would overflow.
+const MAX_COORDINATE: Real = 1e15;
+
+/// The largest Julia constant component a scene may have. Past a bailout
+/// plus its power every point escapes at the first step and the set is
+/// empty; far past it |z|² overflows (f32 near 1e19, f64 near 1e154), which
+/// would read as a surface.
+const MAX_JULIA: Real = 1e15;
+
+/// The largest bounding sphere a scene may have: the set lies within the
+/// bailout, a few units across; a sphere far larger leaves rays to run out
+/// of steps in empty space.
+const MAX_BOUNDING_RADIUS: Real = 1e6;
+
+/// Membership steps longer than this many footprints would step over
+/// whole features: the setting is a fraction of a pixel, or a few.
+const MAX_MEMBERSHIP_STEP: Real = 16.0;
+/// Shorter steps would spend a ray's `max_steps` creeping along the
+/// surface, and then stop it anywhere.
+const MIN_MEMBERSHIP_STEP: Real = 0.01;
+
+/// The narrowest field of view. A ray's points are its origin plus a
+/// distance along it, so they are placed no finer than 2⁻⁵² of the camera's
+/// distance, while a pixel is as wide as its angle times that distance: a
+/// pixel's angle must stay well above 2⁻⁵² (64 times, 1.4e-14 radians) for
+/// marching to resolve it. 1e-7° over 32 768 rows is 5.3e-14 radians a
+/// pixel. (A camera a billion units away frames the bulb at 1.03e-7°.)
+pub const MIN_FOV_DEGREES: Real = 1e-7;
+
+/// Every animatable parameter, group by group in the order validation
+/// checks them (`validate_scene` runs each group's checks between the
+/// scene's other ones).
+pub const GROUPS: [&[Parameter]; 9] = [
+    CAMERA,
+    FRACTAL,
+    QUALITY,
+    LOOK,
+    SHADOWS,
+    AMBIENT_OCCLUSION,
+    SPECULAR,
+    FOG,
+    GLOW,
+];
+
+/// Every parameter a track can animate, with its number of components.
+pub const PARAMETERS: &[(&str, usize)] = &{
+    let mut all = [("", 0); COUNT];
+    let (mut g, mut i) = (0, 0);
+    while g < GROUPS.len() {
+        let mut k = 0;
+        while k < GROUPS[g].len() {
+            all[i] = (GROUPS[g][k].name, GROUPS[g][k].shape.components());
+            (i, k) = (i + 1, k + 1);
+        }
+        g += 1;
+    }
+    all
+};
+
+/// How many parameters `GROUPS` holds.
+const COUNT: usize = {
+    let (mut n, mut g) = (0, 0);
+    while g < GROUPS.len() {
+        n += GROUPS[g].len();
+        g += 1;
+    }
+    n
+};
+
+/// Every animatable parameter, in the table's order.
+pub fn all() -> impl Iterator<Item = &'static Parameter> {
+    GROUPS.iter().flat_map(|group| group.iter())
+}
+
+/// The parameter a track named `name` animates.
+pub fn find(name: &str) -> Option<&'static Parameter> {
+    all().find(|p| p.name == name)
+}
+
+/// The docs' table of parameters, in Markdown: a row for the parameters
+/// of a group described alike, in the table's order.
+pub fn markdown_table() -> String {
+    let mut rows: Vec<(&str, &str, Vec<String>)> = Vec::new();
+    for p in all() {
+        let group = p.name.split('.').next().unwrap_or(p.name);
+        let name = format!("`{}`", p.name);
+        match rows
+            .iter_mut()
+            .find(|(g, doc, _)| *g == group && *doc == p.doc)
+        {
+            Some((_, _, names)) => names.push(name),
+            None => rows.push((group, p.doc, vec![name])),
+        }
+    }
+    let mut table = String::from("| parameter | value |\n|---|---|\n");
+    for (_, doc, names) in rows {
+        table += &format!("| {} | {doc} |\n", names.join(", "));
+    }
+    table
+}
+
+fn triple(v: &[Real]) -> DVec3 {
+    DVec3::new(v[0], v[1], v[2])
+}
+
+fn colour_of(v: &[Real]) -> Vec3 {
+    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+}
+
+fn count(v: &[Real]) -> u32 {
+    v[0].round().clamp(0.0, u32::MAX as Real) as u32
+}
+
+/// Each component finite and within ±`limit`.
+fn within(v: DVec3, limit: Real) -> Checked {
+    rule(v.is_finite() && v.abs().max_element() <= limit, || {
+        format!(
+            "each component must be finite and within ±{limit:e}, got {}",
+            v.shown()
+        )
+    })
+}
+
+fn finite<T: Shown>(finite: bool, v: T) -> Checked {
+    rule(finite, || format!("must be finite, got {}", v.shown()))
+}
+
+/// A direction: finite and not zero.
+fn direction(v: DVec3) -> Checked {
+    rule(v.is_finite() && v.length() > 0.0, || {
+        format!("must be a finite non-zero vector, got {}", v.shown())
+    })
+}
+
+/// From 0 to 1, a fraction.
+fn fraction(v: f32) -> Checked {
+    rule(v.is_finite() && (0.0..=1.0).contains(&v), || {
+        format!("must be in [0, 1], got {}", v.shown())
+    })
+}
+
+pub(super) const CAMERA: &[Parameter] = &[
+    Parameter {
+        name: "camera.position",
+        shape: Triple,
+        doc: "triple",
+        check: |s| within(s.camera.position, MAX_COORDINATE),
+        set: |s, v| s.camera.position = triple(v),
+    },
+    Parameter {
+        name: "camera.target",
+        shape: Triple,
+        doc: "triple",
+        check: |s| within(s.camera.target, MAX_COORDINATE),
+        set: |s, v| s.camera.target = triple(v),
+    },
+    Parameter {
+        name: "camera.up",
+        shape: Triple,
+        doc: "triple",
+        check: |s| finite(s.camera.up.is_finite(), s.camera.up),
+        set: |s, v| s.camera.up = triple(v),
+    },
+    Parameter {
+        name: "camera.roll_degrees",
+        shape: Number,
+        doc: "number",
+        check: |s| finite(s.camera.roll_degrees.is_finite(), s.camera.roll_degrees),
+        set: |s, v| s.camera.roll_degrees = v[0],
+    },
+    Parameter {
+        name: "camera.fov_degrees",
+        shape: Number,
+        doc: "number",
+        check: |s| fov(s.camera.fov_degrees),
+        set: |s, v| s.camera.fov_degrees = v[0],
+    },
+    Parameter {
+        name: ZOOM_TRACK,
+        shape: Number,
+        doc: "number > 0: the surface zoom (below)",
+        // Not a field of the scene: its keys are checked (`Track::build`),
+        // and the position it places the camera at.
+        check: |_| Ok(()),
+        set: |s, v| {
+            let c = &mut s.camera;
+            let away = crate::math::normalize_or(c.position - c.target, DVec3::Z);
+            c.position = c.target + away * v[0];
+        },
+    },
+    Parameter {
+        name: "camera.aperture_radius",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let r = s.camera.aperture_radius;
+            rule(r.is_finite() && r >= 0.0, || {
+                format!("must be 0 (a pinhole) or positive, got {}", r.shown())
+            })
+        },
+        set: |s, v| s.camera.aperture_radius = v[0],
+    },
+    Parameter {
+        name: "camera.focus_distance",
+        shape: Number,
+        doc: "number",
+        check: |s| s.camera.focus_distance.map_or(Ok(()), positive),
+        set: |s, v| s.camera.focus_distance = Some(v[0]),
+    },
+];
+
+fn fov(fov: Real) -> Checked {
+    rule(
+        fov.is_finite() && (MIN_FOV_DEGREES..179.0).contains(&fov),
+        || {
+            format!(
+                "must be from {MIN_FOV_DEGREES:e} to below 179 degrees, got {}{}",
+                fov.shown(),
+                if fov > 0.0 && fov < MIN_FOV_DEGREES {
+                    " (narrower, a pixel would span less than f64 can tell apart along a \
+                     ray; move the camera closer instead)"
+                } else {
+                    ""
+                }
+            )
+        },
+    )
+}
+
+pub(super) const FRACTAL: &[Parameter] = &[
+    Parameter {
+        name: "fractal.power",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let p = s.fractal.power;
+            rule(p.is_finite() && (1.0..=64.0).contains(&p), || {
+                format!("must be between 1 and 64, got {}", p.shown())
+            })
+        },
+        set: |s, v| s.fractal.power = v[0],
+    },
+    Parameter {
+        name: "fractal.iterations",
+        shape: Number,
+        doc: "number, rounded to a whole count",
+        check: |s| counted(s.fractal.iterations, 10_000),
+        set: |s, v| s.fractal.iterations = count(v),
+    },
+    Parameter {
+        name: "fractal.bailout",
+        shape: Number,
+        doc: "number",
+        check: |s| bailout(s.fractal.bailout, s.fractal.power),
+        set: |s, v| s.fractal.bailout = v[0],
+    },
+    Parameter {
+        name: "fractal.julia",
+        shape: Triple,
+        doc: "triple: the Julia-c morph (switches to Julia mode)",
+        check: |s| s.fractal.julia.map_or(Ok(()), |k| within(k, MAX_JULIA)),
+        set: |s, v| s.fractal.julia = Some(triple(v)),
+    },
+];
+
+/// Above 1, and small enough for the power (checked first) to raise it to.
+fn bailout(bailout: Real, power: Real) -> Checked {
+    rule(bailout.is_finite() && bailout > 1.0, || {
+        format!("must be a finite number above 1, got {}", bailout.shown())
+    })?;
+    // An orbit at the bailout is raised to the power once more: keep that finite.
+    rule(power * bailout.ln() < 600.0, || {
+        format!(
+            "bailout^power must stay below e^600 (f64 overflows near e^709), got {}^{}",
+            bailout.shown(),
+            power.shown()
+        )
+    })
+}
+
+pub(super) const QUALITY: &[Parameter] = &[
+    Parameter {
+        name: "quality.hit_threshold",
+        shape: Number,
+        doc: "number",
+        check: |s| positive(s.quality.hit_threshold),
+        set: |s, v| s.quality.hit_threshold = v[0],
+    },
+    Parameter {
+        name: "quality.membership_step",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let step = s.quality.membership_step;
+            rule(
+                step == 0.0 || (MIN_MEMBERSHIP_STEP..=MAX_MEMBERSHIP_STEP).contains(&step),
+                || {
+                    format!(
+                        "must be 0 (trust the estimate) or from {MIN_MEMBERSHIP_STEP} to \
+                         {MAX_MEMBERSHIP_STEP} footprints, got {}",
+                        step.shown()
+                    )
+                },
+            )
+        },
+        set: |s, v| s.quality.membership_step = v[0],
+    },
+    Parameter {
+        name: "quality.fudge",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let f = s.quality.fudge;
+            rule(f.is_finite() && f > 0.0 && f <= 1.0, || {
+                format!("must be in (0, 1], got {}", f.shown())
+            })
+        },
+        set: |s, v| s.quality.fudge = v[0],
+    },
+    Parameter {
+        name: "quality.max_steps",
+        shape: Number,
+        doc: "number, rounded",
+        check: |s| counted(s.quality.max_steps, 1_000_000),
+        set: |s, v| s.quality.max_steps = count(v),
+    },
+    Parameter {
+        name: "quality.normal_step",
+        shape: Number,
+        doc: "number",
+        check: |s| positive(s.quality.normal_step),
+        set: |s, v| s.quality.normal_step = v[0],
+    },
+    Parameter {
+        name: "quality.bounding_radius",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let r = s.quality.bounding_radius;
+            positive(r)?;
+            rule(r <= MAX_BOUNDING_RADIUS, || {
+                format!("must be at most {MAX_BOUNDING_RADIUS:e}, got {}", r.shown())
+            })
+        },
+        set: |s, v| s.quality.bounding_radius = v[0],
+    },
+    Parameter {
+        name: "quality.over_relaxation",
+        shape: Number,
+        doc: "number",
+        check: |s| {
+            let w = s.quality.over_relaxation;
+            rule(w.is_finite() && (1.0..2.0).contains(&w), || {
+                format!("must be in [1, 2), got {}", w.shown())
+            })
+        },
+        set: |s, v| s.quality.over_relaxation = v[0],
+    },
+];
+
+/// A colour of the look: a triple, each component finite and not negative.
+macro_rules! look_colour {
+    ($name:literal, $field:ident) => {
+        Parameter {
+            name: $name,
+            shape: Triple,
+            doc: "triple",
+            check: |s| colour(s.look.$field),
+            set: |s, v| s.look.$field = colour_of(v),
+        }
+    };
+}
+
+pub(super) const LOOK: &[Parameter] = &[
+    Parameter {
+        name: "look.light_direction",
+        shape: Triple,
+        doc: "triple",
+        check: |s| direction(s.look.light_direction),
+        set: |s, v| s.look.light_direction = triple(v),
+    },
+    look_colour!("look.light_colour", light_colour),
+    look_colour!("look.ambient", ambient),
+    look_colour!("look.base_colour", base_colour),
+    look_colour!("look.trap_x_colour", trap_x_colour),
+    look_colour!("look.trap_y_colour", trap_y_colour),
+    look_colour!("look.trap_z_colour", trap_z_colour),
+    Parameter {
+        name: "look.trap_occlusion",
+        shape: Number,
+        doc: "number",
+        check: |s| fraction(s.look.trap_occlusion),
+        set: |s, v| s.look.trap_occlusion = v[0] as f32,
+    },
+    Parameter {
+        name: "look.exposure",
+        shape: Number,
+        doc: "number",
+        check: |s| non_negative(s.look.exposure),
+        set: |s, v| s.look.exposure = v[0] as f32,
+    },
+    look_colour!("look.background_top", background_top),
+    look_colour!("look.background_bottom", background_bottom),
+];
+
+/// An effect's number: a track may animate it only where the scene enables
+/// the effect (`Timeline::parse` checks), which its setter relies on.
+const EFFECT_NUMBER: &str = "number (the effect must be enabled in `scene.effects`)";
+
+pub(super) const SHADOWS: &[Parameter] = &[Parameter {
+    name: "effects.shadows.softness",
+    shape: Number,
+    doc: EFFECT_NUMBER,
+    check: |s| {
+        s.effects.shadows.as_ref().map_or(Ok(()), |sh| {
+            rule(sh.softness.is_finite() && sh.softness >= 0.0, || {
+                format!("must be 0 (hard) or positive, got {}", sh.softness.shown())
+            })
+        })
+    },
+    set: |s, v| s.effects.shadows.iter_mut().for_each(|x| x.softness = v[0]),
+}];
+
+pub(super) const AMBIENT_OCCLUSION: &[Parameter] = &[
+    Parameter {
+        name: "effects.ambient_occlusion.radius",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            let ao = s.effects.ambient_occlusion.as_ref();
+            ao.map_or(Ok(()), |ao| positive(ao.radius))
+        },
+        set: |s, v| {
+            let ao = s.effects.ambient_occlusion.iter_mut();
+            ao.for_each(|x| x.radius = v[0])
+        },
+    },
+    Parameter {
+        name: "effects.ambient_occlusion.strength",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            let ao = s.effects.ambient_occlusion.as_ref();
+            ao.map_or(Ok(()), |ao| fraction(ao.strength))
+        },
+        set: |s, v| {
+            let ao = s.effects.ambient_occlusion.iter_mut();
+            ao.for_each(|x| x.strength = v[0] as f32)
+        },
+    },
+];
+
+pub(super) const SPECULAR: &[Parameter] = &[
+    Parameter {
+        name: "effects.specular.strength",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            let sp = s.effects.specular.as_ref();
+            sp.map_or(Ok(()), |sp| non_negative(sp.strength))
+        },
+        set: |s, v| {
+            let sp = s.effects.specular.iter_mut();
+            sp.for_each(|x| x.strength = v[0] as f32)
+        },
+    },
+    Parameter {
+        name: "effects.specular.shininess",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            let sp = s.effects.specular.as_ref();
+            sp.map_or(Ok(()), |sp| positive(sp.shininess))
+        },
+        set: |s, v| {
+            let sp = s.effects.specular.iter_mut();
+            sp.for_each(|x| x.shininess = v[0] as f32)
+        },
+    },
+];
+
+pub(super) const FOG: &[Parameter] = &[
+    Parameter {
+        name: "effects.fog.density",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            s.effects
+                .fog
+                .as_ref()
+                .map_or(Ok(()), |f| non_negative(f.density))
+        },
+        set: |s, v| s.effects.fog.iter_mut().for_each(|x| x.density = v[0]),
+    },
+    Parameter {
+        name: "effects.fog.colour",
+        shape: Triple,
+        doc: "triple",
+        check: |s| s.effects.fog.as_ref().map_or(Ok(()), |f| colour(f.colour)),
+        set: |s, v| {
+            s.effects
+                .fog
+                .iter_mut()
+                .for_each(|x| x.colour = colour_of(v))
+        },
+    },
+];
+
+pub(super) const GLOW: &[Parameter] = &[
+    Parameter {
+        name: "effects.glow.strength",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            s.effects
+                .glow
+                .as_ref()
+                .map_or(Ok(()), |g| non_negative(g.strength))
+        },
+        set: |s, v| {
+            s.effects
+                .glow
+                .iter_mut()
+                .for_each(|x| x.strength = v[0] as f32)
+        },
+    },
+    Parameter {
+        name: "effects.glow.width",
+        shape: Number,
+        doc: EFFECT_NUMBER,
+        check: |s| {
+            s.effects
+                .glow
+                .as_ref()
+                .map_or(Ok(()), |g| positive(g.width))
+        },
+        set: |s, v| s.effects.glow.iter_mut().for_each(|x| x.width = v[0]),
+    },
+    Parameter {
+        name: "effects.glow.colour",
+        shape: Triple,
+        doc: "triple",
+        check: |s| s.effects.glow.as_ref().map_or(Ok(()), |g| colour(g.colour)),
+        set: |s, v| {
+            s.effects
+                .glow
+                .iter_mut()
+                .for_each(|x| x.colour = colour_of(v))
+        },
+    },
+];
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,214 @@
+//! Whether a scene can be rendered: every animatable field within the range
+//! its `parameters` entry gives, the fields no track animates within theirs,
+//! and fields that depend on one another consistent (a view direction, path
+//! tracing without the effects it replaces).
+
+use super::messages::Shown;
+use super::parameters::Parameter;
+use super::parameters::{
+    AMBIENT_OCCLUSION, CAMERA, FOG, FRACTAL, GLOW, LOOK, QUALITY, SHADOWS, SPECULAR,
+};
+use crate::error::Result;
+use crate::math::{Real, Vec3};
+use crate::scene::Scene;
+use crate::shade::{Effects, PathTracing, Sky};
+
+/// A value within its range, or what is wrong with it.
+pub type Checked = std::result::Result<(), String>;
+
+/// A field's problem: its path in the scene and the message.
+type Invalid = (String, String);
+
+/// `ok`, else `message`'s problem. The message is built only when the
+/// check fails: every rendered scene is checked, thousands per frame under
+/// motion blur.
+pub(super) fn rule(ok: bool, message: impl FnOnce() -> String) -> Checked {
+    if ok {
+        Ok(())
+    } else {
+        Err(message())
+    }
+}
+
+// The three checks most fields need, each with one wording.
+
+pub(super) fn positive<T: Into<f64> + Copy + Shown>(v: T) -> Checked {
+    let x: f64 = v.into();
+    rule(x.is_finite() && x > 0.0, || {
+        format!("must be positive, got {}", v.shown())
+    })
+}
+
+pub(super) fn non_negative<T: Into<f64> + Copy + Shown>(v: T) -> Checked {
+    let x: f64 = v.into();
+    rule(x.is_finite() && x >= 0.0, || {
+        format!("must be non-negative, got {}", v.shown())
+    })
+}
+
+pub(super) fn colour(c: Vec3) -> Checked {
+    rule(c.is_finite() && c.min_element() >= 0.0, || {
+        format!("colours must be finite and non-negative, got {}", c.shown())
+    })
+}
+
+/// `checked`'s problem, at `field`.
+fn at(field: &str, checked: Checked) -> Result<(), Invalid> {
+    checked.map_err(|message| (field.to_string(), message))
+}
+
+/// The range checks of a group of animatable parameters, in its order.
+fn animatable(s: &Scene, group: &[Parameter]) -> Result<(), Invalid> {
+    group.iter().try_for_each(|p| at(p.name, (p.check)(s)))
+}
+
+/// Checks one frame's scene; on failure returns the field path and the problem.
+pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
+    animatable(s, CAMERA)?;
+    view(s)?;
+    animatable(s, FRACTAL)?;
+    animatable(s, QUALITY)?;
+    at("quality.cone_rays", counted(s.quality.cone_rays, 4096))?;
+    at("samples_per_pixel", counted(s.samples_per_pixel, 4096))?;
+    animatable(s, LOOK)?;
+    extra_lights(s)?;
+    effects(s)
+}
+
+/// A count from 1 to `most`.
+pub(super) fn counted(n: u32, most: u32) -> Checked {
+    rule((1..=most).contains(&n), || {
+        format!("must be 1..={most}, got {n}")
+    })
+}
+
+/// The view direction the camera's position, target and up give.
+fn view(s: &Scene) -> Result<(), Invalid> {
+    let c = &s.camera;
+    let view = c.target - c.position;
+    // Below a few ulps of the coordinates the view direction is noise.
+    let scale = c
+        .position
+        .abs()
+        .max_element()
+        .max(c.target.abs().max_element())
+        .max(1.0);
+    let coincide = rule(view.length() > 8.0 * Real::EPSILON * scale, || {
+        format!(
+            "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale)",
+            8.0 * Real::EPSILON * scale
+        )
+    });
+    at("camera.target", coincide)?;
+    let parallel = rule(view.normalize().cross(c.up).length() > 1e-9, || {
+        format!(
+            "must not be zero or parallel to the view direction, got {}",
+            c.up.shown()
+        )
+    });
+    at("camera.up", parallel)
+}
+
+fn extra_lights(s: &Scene) -> Result<(), Invalid> {
+    let lights = &s.look.extra_lights;
+    let most = crate::shade::MAX_LIGHTS - 1;
+    let count = rule(lights.len() <= most, || {
+        format!("at most {most} extra lights, got {}", lights.len())
+    });
+    at("look.extra_lights", count)?;
+    for (i, light) in lights.iter().enumerate() {
+        let field = |name: &str| format!("look.extra_lights[{i}].{name}");
+        let direction = rule(
+            light.direction.is_finite() && light.direction.length() > 0.0,
+            || {
+                format!(
+                    "must be a finite non-zero vector, got {}",
+                    light.direction.shown()
+                )
+            },
+        );
+        at(&field("direction"), direction)?;
+        at(&field("colour"), colour(light.colour))?;
+        at(&field("intensity"), non_negative(light.intensity))?;
+    }
+    Ok(())
+}
+
+/// Each enabled effect's settings, an effect's animatable ones among them.
+fn effects(s: &Scene) -> Result<(), Invalid> {
+    let e = &s.effects;
+    animatable(s, SHADOWS)?;
+    if let Some(sh) = &e.shadows {
+        at("effects.shadows.max_steps", counted(sh.max_steps, 100_000))?;
+    }
+    if let Some(ao) = &e.ambient_occlusion {
+        at("effects.ambient_occlusion.samples", counted(ao.samples, 64))?;
+    }
+    animatable(s, AMBIENT_OCCLUSION)?;
+    animatable(s, SPECULAR)?;
+    animatable(s, FOG)?;
+    if let Some(pt) = &e.path_tracing {
+        path_tracing(pt, e)?;
+    }
+    if let Some(m) = &e.motion_blur {
+        let shutter = rule(
+            m.shutter.is_finite() && m.shutter > 0.0 && m.shutter <= 1.0,
+            || {
+                format!(
+                    "must be in (0, 1] of the frame interval, got {}",
+                    m.shutter.shown()
+                )
+            },
+        );
+        at("effects.motion_blur.shutter", shutter)?;
+    }
+    animatable(s, GLOW)
+}
+
+fn path_tracing(pt: &PathTracing, e: &Effects) -> Result<(), Invalid> {
+    let alone = rule(
+        e.shadows.is_none() && e.ambient_occlusion.is_none() && e.specular.is_none(),
+        || {
+            "path tracing computes shadows and occlusion itself: remove shadows, ambient_occlusion and specular".into()
+        },
+    );
+    at("effects.path_tracing", alone)?;
+    at(
+        "effects.path_tracing.max_bounces",
+        counted(pt.max_bounces, 1024),
+    )?;
+    let sun = pt.sun_angle_degrees;
+    let sun_angle = rule(sun.is_finite() && (0.0..=30.0).contains(&sun), || {
+        format!("must be 0..=30, got {}", sun.shown())
+    });
+    at("effects.path_tracing.sun_angle_degrees", sun_angle)?;
+    at(
+        "effects.path_tracing.sky_intensity",
+        non_negative(pt.sky_intensity),
+    )?;
+    match pt.sky {
+        Sky::Constant(c) => at("effects.path_tracing.sky", colour(c)),
+        Sky::Preetham { turbidity } => {
+            let ok = turbidity.is_finite() && (1.7..=12.0).contains(&turbidity);
+            let checked = rule(ok, || {
+                format!(
+                    "Preetham turbidity must be 1.7..=12, got {}",
+                    turbidity.shown()
+                )
+            });
+            at("effects.path_tracing.sky.turbidity", checked)
+        }
+        Sky::Environment {
+            rotation_degrees, ..
+        } => {
+            let checked = rule(rotation_degrees.is_finite(), || {
+                format!(
+                    "Environment rotation_degrees must be finite, got {}",
+                    rotation_degrees.shown()
+                )
+            });
+            at("effects.path_tracing.sky.rotation_degrees", checked)
+        }
+        Sky::Gradient => Ok(()),
+    }
+}
