@@ -56,7 +56,6 @@ fn the_default_scene_passes_every_check() {
 }
 
 #[test]
-#[ignore = "needs docs/timeline.md from the docs branch"]
 fn the_docs_table_of_parameters_is_the_generated_one() {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/timeline.md");
     let docs = std::fs::read_to_string(&path).unwrap_or_default();
