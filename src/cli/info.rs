@@ -1,0 +1,219 @@
+//! `info`: validates a timeline and prints its frames, fractal, quality,
+//! tracks, effects, the work each sample does, a measured cost, and warnings.
+
+use crate::job::probe::{cost_probe, worst_orbits_per_sample};
+use crate::job::warnings::{out_of_steps_matters, out_of_steps_warning, warnings};
+use crate::scene::Scene;
+use crate::timeline::{Timeline, ZOOM_TRACK};
+use std::path::Path;
+
+/// Loads the timeline at `path` and prints what it holds.
+pub fn info(path: &Path) -> anyhow::Result<()> {
+    let t = Timeline::load(path)?;
+    let first = t.scene_at(0);
+    let base = &first;
+    out!("timeline: {}", path.display());
+    out!(
+        "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {} sample(s) per pixel",
+        t.frame_count,
+        t.fps,
+        t.duration_seconds(),
+        t.width,
+        t.height,
+        base.samples_per_pixel
+    );
+    if t.looping {
+        out!(
+            "loop:     seamless: every track repeats every {:.3} s, so frame {} would be frame 0 again",
+            t.duration_seconds(),
+            t.frame_count
+        );
+    }
+    let f = &base.fractal;
+    let animated_julia = t.tracks.iter().any(|tr| tr.name == "fractal.julia");
+    let mode = match (f.julia, animated_julia) {
+        (_, true) => "Julia mode (constant animated)".to_string(),
+        (Some(k), false) => format!("Julia mode, c = ({}, {}, {})", k.x, k.y, k.z),
+        (None, false) => "Mandelbrot mode".to_string(),
+    };
+    out!(
+        "fractal:  {mode}, formula {}, power {}, {} iterations, bailout {} (at frame 0)",
+        f.formula.name(),
+        f.power,
+        f.iterations,
+        f.bailout
+    );
+    let walk = match base.quality.membership_step {
+        0.0 => String::new(),
+        step => format!(", membership walk in steps of {step} x footprint"),
+    };
+    out!(
+        "quality:  DE {} in {}, hit threshold {} x footprint{walk}, fudge {}, {} max steps",
+        f.de.name(),
+        f.precision.name(),
+        base.quality.hit_threshold,
+        base.quality.fudge,
+        base.quality.max_steps
+    );
+    print_tracks(&t)?;
+    print_plan(base)?;
+    print_cost(&t, base)
+}
+
+/// Each track: its interpolation, keys and span (a zoom's reach in decades).
+fn print_tracks(t: &Timeline) -> anyhow::Result<()> {
+    if t.tracks.is_empty() {
+        out!("tracks:   none (a still)");
+    } else {
+        out!("tracks:");
+        for tr in &t.tracks {
+            let first = tr.key_times[0];
+            let last = tr.key_times[tr.key_times.len() - 1];
+            let mut line = format!(
+                "  {:<24} {:<10} {} key(s), {first:.3} s .. {last:.3} s",
+                tr.name,
+                format!("{:?}", tr.interpolation),
+                tr.key_times.len()
+            );
+            if tr.name == ZOOM_TRACK {
+                let (mut a, mut b) = (tr.sample(first)[0], tr.sample(last)[0]);
+                if t.looping {
+                    // The last key may be the first again: the zoom's
+                    // reach is between its farthest and nearest frames.
+                    // (Every frame, or 10 000 spread over a longer film.)
+                    let step = (t.frame_count / 10_000).max(1) as usize;
+                    let frames = (0..t.frame_count).step_by(step);
+                    let d: Vec<f64> = frames.map(|f| tr.sample(t.time_of(f))[0]).collect();
+                    a = d.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+                    b = d.iter().copied().fold(f64::INFINITY, f64::min);
+                }
+                line += &format!(
+                    "  (log-space zoom {a:.3e} -> {b:.3e}, {:.1} decades)",
+                    (a / b).log10().abs()
+                );
+            }
+            out!("{line}");
+        }
+    }
+    Ok(())
+}
+
+/// The effects enabled, and which stages run per camera sample with their
+/// cost in distance estimates.
+fn print_plan(base: &Scene) -> anyhow::Result<()> {
+    let effects = &base.effects;
+    let enabled = effects.enabled();
+    out!(
+        "effects:  {}",
+        if enabled.is_empty() {
+            "none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
+                .to_string()
+        } else {
+            enabled.join(", ")
+        }
+    );
+    // The render plan: which stages run per camera sample, and their cost in
+    // distance estimates relative to marching (about 20 per ray at this size).
+    let cones = match (base.cone_rays(), base.march_alone_reason()) {
+        (1, Some(why)) => format!("each camera ray alone, {why}"),
+        (1, None) => "each camera ray alone".to_string(),
+        (n, _) => {
+            let (columns, rows) = crate::march::cone_block(n);
+            format!("blocks of {columns}×{rows} camera rays share a cone first")
+        }
+    };
+    out!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
+    if let Some(sh) = &effects.shadows {
+        out!(
+            "          + shadow march towards the light, up to {} estimates per lit hit ({})",
+            sh.max_steps,
+            if sh.softness > 0.0 {
+                format!("soft, k = {}", sh.softness)
+            } else {
+                "hard".into()
+            }
+        );
+    }
+    if let Some(ao) = &effects.ambient_occlusion {
+        out!(
+            "          + ambient occlusion, {} estimates per hit",
+            ao.samples
+        );
+    }
+    if effects.specular.is_some() {
+        out!("          + specular highlight (no estimates)");
+    }
+    if effects.fog.is_some() {
+        out!("          + fog over hit distance (no estimates)");
+    }
+    if effects.glow.is_some() {
+        out!("          + glow from each ray's nearest approach (no estimates; its rays march without cones)");
+    }
+    if let Some(pt) = &effects.path_tracing {
+        out!(
+            "          + path tracing per hit: up to {} bounces (Russian roulette from the third), each with a march and a normal, plus a ray to the {}° sun",
+            pt.max_bounces, pt.sun_angle_degrees
+        );
+    }
+    if let Some(m) = &effects.motion_blur {
+        out!(
+            "          + motion blur: each of the {} samples sees the timeline at its own time over {} of the frame interval",
+            base.samples_per_pixel, m.shutter
+        );
+    }
+    let lens = base.camera.frame();
+    if lens.has_lens() {
+        out!(
+            "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel of {} or more)",
+            lens.aperture_radius, lens.focus_distance, crate::scene::LENS_SAMPLES
+        );
+    }
+    out!(
+        "          {} sample(s) per pixel: {}x the per-sample work",
+        base.samples_per_pixel,
+        base.samples_per_pixel
+    );
+    Ok(())
+}
+
+/// Frame 0's cost as measured on a thumbnail, where one can be rendered
+/// at once, and the warnings.
+fn print_cost(t: &Timeline, base: &Scene) -> anyhow::Result<()> {
+    // Measured, not guessed: frame 0 as a thumbnail, as declared and with
+    // every effect off, counting the estimates.
+    let probe = cost_probe(t);
+    match &probe {
+        Some(p) => out!(
+            "cost:     frame 0 at {}x{}{}: {} estimates, {:.2}x the same frame without effects ({})",
+            p.width,
+            p.height,
+            if p.samples < base.samples_per_pixel {
+                format!(" with {} of its {} samples per pixel", p.samples, base.samples_per_pixel)
+            } else {
+                String::new()
+            },
+            p.with.de_evaluations,
+            p.with.de_evaluations as f64 / p.without.de_evaluations.max(1) as f64,
+            p.without.de_evaluations
+        ),
+        None => out!(
+            "cost:     not measured: one sample of frame 0 could compute {} orbits of {} \
+             iterations (every march to quality.max_steps); render it with --frames 0 --stats",
+            worst_orbits_per_sample(base),
+            base.fractal.iterations
+        ),
+    }
+    let probe_short = probe.is_some_and(|p| out_of_steps_matters(&p.with));
+    out!("output:   out/{}/ by default", t.name);
+    let all: Vec<u32> = (0..t.frame_count).collect();
+    for warning in warnings(t, &all, true) {
+        out!("warning:  {warning}");
+    }
+    if probe_short {
+        out!(
+            "warning:  {} (of the thumbnail)",
+            out_of_steps_warning(&[0], t)
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,326 @@
+//! The plan of a render: its timeline, size, frames, formats and folder,
+//! checked from a `Sequence` or read back from a folder's job record; each
+//! frame's scenes, hash, files and state; and the ffmpeg command for a video.
+
+use crate::error::Error;
+use crate::job::frames::{frames_text, parse_frames};
+use crate::job::request::{parse_size, Sequence};
+use crate::output::{self, Format};
+use crate::timeline::Timeline;
+use std::path::{Path, PathBuf};
+
+/// A validated render job: what to render, how big, in which formats, where.
+#[derive(Clone)]
+pub struct Plan {
+    pub timeline: Timeline,
+    pub width: u32,
+    pub height: u32,
+    pub range: std::ops::Range<u32>,
+    pub formats: Vec<Format>,
+    pub out_dir: PathBuf,
+    pub preview: bool,
+    pub aovs: Vec<output::Aov>,
+    /// `--samples`, applied to the timeline's scene (and recorded).
+    pub samples: Option<u32>,
+    /// `--verify`: frame files are read to their last byte before they
+    /// count as complete (`output::file_state`).
+    pub verify: bool,
+}
+
+impl Plan {
+    /// Checks every option; touches nothing on disk.
+    pub fn new(timeline_path: &Path, args: &Sequence) -> anyhow::Result<Plan> {
+        let timeline = Timeline::load(timeline_path)?;
+        let mut aovs = args.aovs.clone();
+        aovs.sort();
+        aovs.dedup();
+        let formats = if args.formats.is_empty() {
+            vec![Format::Png]
+        } else {
+            args.formats.clone()
+        };
+        if !aovs.is_empty() && !formats.contains(&Format::Exr) {
+            return Err(
+                Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
+            );
+        }
+        let timeline = timeline.with_samples(args.samples);
+        if args.samples.is_some() && timeline.base.effects.motion_blur.is_some() {
+            // Under motion blur the samples are instants, each checked.
+            timeline
+                .check_scene_count()
+                .map_err(|(_, message)| Error::usage("--samples", message))?;
+            let failing = timeline.first_invalid_frame();
+            let failure = failing.and_then(|f| Some((f, timeline.invalid_instant(f)?)));
+            if let Some((frame, (time, (field, message)))) = failure {
+                let message = format!("frame {frame} (t = {time:.4} s): scene.{field}: {message}");
+                return Err(Error::usage("--samples", message).into());
+            }
+        }
+        let (mut width, mut height) = match &args.size {
+            Some(s) => parse_size("--size", s)?,
+            None => (timeline.width, timeline.height),
+        };
+        let range = match &args.frames {
+            Some(f) => parse_frames(f, timeline.frame_count)?,
+            None => 0..timeline.frame_count,
+        };
+        let mut formats = formats;
+        formats.sort_by_key(|f| f.extension());
+        formats.dedup();
+        let mut out_dir = args
+            .out
+            .clone()
+            .unwrap_or_else(|| Path::new("out").join(&timeline.name));
+        let preview = args.preview;
+        if preview {
+            width = (width / 2).max(1);
+            height = (height / 2).max(1);
+            out_dir = out_dir.join("preview");
+        }
+        Ok(Plan {
+            timeline,
+            width,
+            height,
+            range,
+            formats,
+            out_dir,
+            preview,
+            aovs,
+            samples: args.samples,
+            verify: false,
+        })
+    }
+
+    pub fn layers(&self) -> crate::render::Layers {
+        output::layers_for(&self.aovs)
+    }
+
+    /// The plans an output folder records, one per format with its own
+    /// range, layers and samples (see `output::JobRecord`), and the record.
+    pub fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, output::JobRecord)> {
+        if !dir.join(output::JOB_FILE).exists() {
+            let preview = dir.join("preview");
+            let hint = if preview.join(output::JOB_FILE).exists() {
+                format!("; a preview's is in {}", preview.display())
+            } else {
+                String::new()
+            };
+            let message = format!(
+                "not a mandelreel output folder (no {}){hint}",
+                output::JOB_FILE
+            );
+            return Err(Error::usage(&dir.display().to_string(), message).into());
+        }
+        let job = output::JobRecord::read(dir)?;
+        let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
+        let plan = |o: output::OutputRecord| -> anyhow::Result<Plan> {
+            let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
+                .map_err(|e| anyhow::anyhow!(e))?;
+            let timeline = timeline.clone().with_samples(o.samples);
+            Ok(Plan {
+                width: job.width,
+                height: job.height,
+                range: o.frames.0..o.frames.1.min(timeline.frame_count),
+                formats: vec![format],
+                out_dir: dir.to_path_buf(),
+                preview: job.preview,
+                aovs: o.aovs,
+                samples: o.samples,
+                verify: false,
+                timeline,
+            })
+        };
+        let plans = job
+            .outputs()
+            .into_iter()
+            .map(plan)
+            .collect::<anyhow::Result<_>>()?;
+        Ok((plans, job))
+    }
+
+    /// This plan as one plan per format, so each format's frames can be
+    /// counted on their own.
+    pub fn per_format(&self) -> Vec<Plan> {
+        let one = |&format: &Format| Plan {
+            formats: vec![format],
+            ..self.clone()
+        };
+        self.formats.iter().map(one).collect()
+    }
+
+    pub fn record(&self) -> anyhow::Result<output::JobRecord> {
+        let text = crate::timeline::read_text(&self.timeline.source)?;
+        Ok(output::JobRecord {
+            renderer: format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
+            timeline_path: std::fs::canonicalize(&self.timeline.source)
+                .unwrap_or_else(|_| self.timeline.source.clone()),
+            timeline_text: text,
+            width: self.width,
+            height: self.height,
+            formats: self
+                .formats
+                .iter()
+                .map(|f| f.extension().to_string())
+                .collect(),
+            frames: (self.range.start, self.range.end),
+            preview: self.preview,
+            aovs: self.aovs.clone(),
+            samples: self.samples,
+            outputs: self
+                .formats
+                .iter()
+                .map(|&f| output::OutputRecord {
+                    format: f.extension().to_string(),
+                    frames: (self.range.start, self.range.end),
+                    // Only EXRs hold extra layers.
+                    aovs: if f == Format::Exr {
+                        self.aovs.clone()
+                    } else {
+                        Vec::new()
+                    },
+                    samples: self.samples,
+                })
+                .collect(),
+        })
+    }
+
+    /// The scenes of one frame (one per sample under motion blur) and its content hash.
+    pub fn frame(&self, frame: u32) -> (Vec<crate::scene::Scene>, String) {
+        let scenes = if self.preview {
+            // A quick look: one sample, one instant.
+            let mut scene = self.timeline.scene_at(frame);
+            scene.samples_per_pixel = 1;
+            vec![scene]
+        } else {
+            self.timeline.scenes_for_frame(frame)
+        };
+        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
+        (scenes, hash)
+    }
+
+    pub fn path(&self, frame: u32, format: Format) -> PathBuf {
+        self.out_dir.join(output::frame_file_name(frame, format))
+    }
+
+    /// The format a video is encoded from: the PNGs, where rendered.
+    pub fn video_format(&self) -> Format {
+        if self.formats.contains(&Format::Png) {
+            Format::Png
+        } else {
+            Format::Exr
+        }
+    }
+
+    /// Whether `frame`'s file in `format` is whole and current (no hash
+    /// is computed where there is no file).
+    pub fn is_current_in(&self, frame: u32, format: Format) -> bool {
+        let path = self.path(frame, format);
+        if !path.exists() {
+            return false;
+        }
+        let (_, hash) = self.frame(frame);
+        let key = output::stored_key(format, &hash, &self.aovs);
+        output::file_state(&path, format, &key, self.verify) == output::FileState::Current
+    }
+
+    /// The ffmpeg command encoding `range` from its `format` files: into
+    /// `<name>.mp4` for the whole film, else `<name>_frames_<A>-<B>.mp4`
+    /// (`<name>_frame_<A>.mp4` for one).
+    pub fn video_command(&self, range: &std::ops::Range<u32>, format: Format) -> String {
+        let name = &self.timeline.name;
+        let movie = if *range == (0..self.timeline.frame_count) {
+            name.clone()
+        } else {
+            format!("{name}_{}", frames_text(range).replace(' ', "_"))
+        };
+        let fps = self.timeline.fps;
+        ffmpeg_command(&self.out_dir, &movie, fps, range, format)
+    }
+
+    /// The state of each format's file of `frame` against these inputs
+    /// (read whole with `--verify`).
+    pub fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
+        self.formats
+            .iter()
+            .map(|&f| {
+                let key = output::stored_key(f, hash, &self.aovs);
+                output::file_state(&self.path(frame, f), f, &key, self.verify)
+            })
+            .collect()
+    }
+
+    /// Whether every format of `frame` exists, whole, and was made from
+    /// these inputs.
+    pub fn is_complete(&self, frame: u32, hash: &str) -> bool {
+        let states = self.file_states(frame, hash);
+        states.iter().all(|&s| s == output::FileState::Current)
+    }
+}
+
+/// Quotes a path for a POSIX shell when it needs it.
+pub fn shell_quote(s: &str) -> String {
+    if !s.is_empty()
+        && s.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "/._-+%:=,".contains(c))
+    {
+        s.to_string()
+    } else {
+        format!("'{}'", s.replace('\'', r"'\''"))
+    }
+}
+
+/// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
+pub fn ffmpeg_command(
+    dir: &Path,
+    name: &str,
+    fps: f64,
+    range: &std::ops::Range<u32>,
+    format: Format,
+) -> String {
+    // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
+    // own `%` is written `%%`.
+    let input =
+        Path::new(&dir.to_string_lossy().replace('%', "%%")).join(output::frame_pattern(format));
+    let movie = dir.join(format!("{name}.mp4"));
+    // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
+    let trc = if format == Format::Exr {
+        "-apply_trc iec61966_2_1 "
+    } else {
+        ""
+    };
+    format!(
+        "ffmpeg -y -framerate {fps} -start_number {start} {trc}-i {input} -frames:v {count} \
+         -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
+        start = range.start,
+        count = range.end - range.start,
+        input = shell_quote(&input.to_string_lossy()),
+        movie = shell_quote(&movie.to_string_lossy()),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ffmpeg_command_has_rate_start_and_count() {
+        let c = ffmpeg_command(Path::new("out/zoom"), "zoom", 24.0, &(10..20), Format::Png);
+        assert!(
+            c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"),
+            "{c}"
+        );
+        assert!(c.ends_with("out/zoom/zoom.mp4"));
+        let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
+        assert!(
+            spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),
+            "{spaced}"
+        );
+        let percent = ffmpeg_command(Path::new("take 100%"), "z", 24.0, &(0..5), Format::Png);
+        assert!(
+            percent.contains("-i 'take 100%%/frame_%05d.png'")
+                && percent.ends_with("'take 100%/z.mp4'"),
+            "{percent}"
+        );
+    }
+}
