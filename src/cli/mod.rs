@@ -64,7 +64,7 @@ pub const EXIT_INCOMPLETE: u8 = 4;
     after_help = "Exit status: 0 success, 1 failure (I/O), 2 bad command-line argument, 3 invalid timeline,\n\
                   4 (status only) the sequence is not complete; a render stopped by Ctrl-C or SIGTERM\n\
                   cleans up, says what is done and ends by that signal (130 or 143 in a shell).\n\
-                  Timeline format and examples: README.md and timelines/*.ron."
+                  Timeline format and examples: docs/timeline.md and timelines/*.ron."
 )]
 pub struct Cli {
     #[command(subcommand)]
