@@ -1127,7 +1127,7 @@ fn sampled_passes<R: Default + Clone>(
 
 /// The rows as CSV, one header line first.
 pub fn to_csv(rows: &[Row]) -> String {
-    crate::output::csv_text(rows)
+    crate::output::csv::csv_text(rows)
 }
 
 /// The README's tables, made from the rows.

@@ -430,8 +430,8 @@ pub fn ffmpeg_command(
 ) -> String {
     // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
     // own `%` is written `%%`.
-    let input =
-        Path::new(&dir.to_string_lossy().replace('%', "%%")).join(output::frame_pattern(format));
+    let input = Path::new(&dir.to_string_lossy().replace('%', "%%"))
+        .join(output::frames::frame_pattern(format));
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
     let trc = if format == Format::Exr {
@@ -463,7 +463,7 @@ struct Plan {
     /// `--samples`, applied to the timeline's scene (and recorded).
     samples: Option<u32>,
     /// `--verify`: frame files are read to their last byte before they
-    /// count as complete (`output::file_state`).
+    /// count as complete (`output::frames::file_state`).
     verify: bool,
 }
 
@@ -537,24 +537,24 @@ impl Plan {
     }
 
     /// The plans an output folder records, one per format with its own
-    /// range, layers and samples (see `output::JobRecord`), and the record.
-    fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, output::JobRecord)> {
-        if !dir.join(output::JOB_FILE).exists() {
+    /// range, layers and samples (see `crate::job::record::JobRecord`), and the record.
+    fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, crate::job::record::JobRecord)> {
+        if !dir.join(crate::job::record::JOB_FILE).exists() {
             let preview = dir.join("preview");
-            let hint = if preview.join(output::JOB_FILE).exists() {
+            let hint = if preview.join(crate::job::record::JOB_FILE).exists() {
                 format!("; a preview's is in {}", preview.display())
             } else {
                 String::new()
             };
             let message = format!(
                 "not a mandelreel output folder (no {}){hint}",
-                output::JOB_FILE
+                crate::job::record::JOB_FILE
             );
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
-        let job = output::JobRecord::read(dir)?;
+        let job = crate::job::record::JobRecord::read(dir)?;
         let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
-        let plan = |o: output::OutputRecord| -> anyhow::Result<Plan> {
+        let plan = |o: crate::job::record::OutputRecord| -> anyhow::Result<Plan> {
             let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
                 .map_err(|e| anyhow::anyhow!(e))?;
             let timeline = timeline.clone().with_samples(o.samples);
@@ -619,9 +619,9 @@ impl Plan {
         .into())
     }
 
-    fn record(&self) -> anyhow::Result<output::JobRecord> {
+    fn record(&self) -> anyhow::Result<crate::job::record::JobRecord> {
         let text = crate::timeline::read_text(&self.timeline.source)?;
-        Ok(output::JobRecord {
+        Ok(crate::job::record::JobRecord {
             renderer: format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
             timeline_path: std::fs::canonicalize(&self.timeline.source)
                 .unwrap_or_else(|_| self.timeline.source.clone()),
@@ -640,7 +640,7 @@ impl Plan {
             outputs: self
                 .formats
                 .iter()
-                .map(|&f| output::OutputRecord {
+                .map(|&f| crate::job::record::OutputRecord {
                     format: f.extension().to_string(),
                     frames: (self.range.start, self.range.end),
                     // Only EXRs hold extra layers.
@@ -665,12 +665,13 @@ impl Plan {
         } else {
             self.timeline.scenes_for_frame(frame)
         };
-        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
+        let hash = output::frames::frame_hash(&scenes, frame, self.width, self.height);
         (scenes, hash)
     }
 
     fn path(&self, frame: u32, format: Format) -> PathBuf {
-        self.out_dir.join(output::frame_file_name(frame, format))
+        self.out_dir
+            .join(output::frames::frame_file_name(frame, format))
     }
 
     /// The format a video is encoded from: the PNGs, where rendered.
@@ -690,8 +691,9 @@ impl Plan {
             return false;
         }
         let (_, hash) = self.frame(frame);
-        let key = output::stored_key(format, &hash, &self.aovs);
-        output::file_state(&path, format, &key, self.verify) == output::FileState::Current
+        let key = output::frames::stored_key(format, &hash, &self.aovs);
+        output::frames::file_state(&path, format, &key, self.verify)
+            == output::frames::FileState::Current
     }
 
     /// The ffmpeg command encoding `range` from its `format` files: into
@@ -710,12 +712,12 @@ impl Plan {
 
     /// The state of each format's file of `frame` against these inputs
     /// (read whole with `--verify`).
-    fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
+    fn file_states(&self, frame: u32, hash: &str) -> Vec<output::frames::FileState> {
         self.formats
             .iter()
             .map(|&f| {
-                let key = output::stored_key(f, hash, &self.aovs);
-                output::file_state(&self.path(frame, f), f, &key, self.verify)
+                let key = output::frames::stored_key(f, hash, &self.aovs);
+                output::frames::file_state(&self.path(frame, f), f, &key, self.verify)
             })
             .collect()
     }
@@ -724,7 +726,9 @@ impl Plan {
     /// these inputs.
     fn is_complete(&self, frame: u32, hash: &str) -> bool {
         let states = self.file_states(frame, hash);
-        states.iter().all(|&s| s == output::FileState::Current)
+        states
+            .iter()
+            .all(|&s| s == output::frames::FileState::Current)
     }
 
     /// Renders one frame and writes every format. A frame of one sample per
@@ -763,12 +767,17 @@ impl Plan {
             );
             return self.write_film(frame, film, hash, &scenes[0].look);
         }
-        let checkpoint = output::checkpoint_path(&self.out_dir, frame);
+        let checkpoint = crate::job::checkpoint::checkpoint_path(&self.out_dir, frame);
         // A checkpoint holds linear light: how a PNG shows it is not its key.
-        let light = output::light_hash(hash);
-        let saved_acc =
-            output::read_checkpoint(&checkpoint, light, self.width, self.height, layers)
-                .filter(|a| a.samples_done < n);
+        let light = output::frames::light_hash(hash);
+        let saved_acc = crate::job::checkpoint::read_checkpoint(
+            &checkpoint,
+            light,
+            self.width,
+            self.height,
+            layers,
+        )
+        .filter(|a| a.samples_done < n);
         let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
@@ -785,7 +794,7 @@ impl Plan {
             let until = (acc.samples_done + wave).min(n);
             crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
             if saving && until < n && saved.elapsed() >= checkpoint_every {
-                if let Err(e) = output::write_checkpoint(&checkpoint, &acc, light) {
+                if let Err(e) = crate::job::checkpoint::write_checkpoint(&checkpoint, &acc, light) {
                     say(Said::CheckpointFailed { frame, error: e });
                     saving = false;
                 }
@@ -805,9 +814,12 @@ impl Plan {
         look: &crate::shade::Look,
     ) -> anyhow::Result<FrameStats> {
         for &f in &self.formats {
-            output::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
+            output::frames::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
         }
-        let _ = std::fs::remove_file(output::checkpoint_path(&self.out_dir, frame));
+        let _ = std::fs::remove_file(crate::job::checkpoint::checkpoint_path(
+            &self.out_dir,
+            frame,
+        ));
         Ok(film.stats)
     }
 }
@@ -931,18 +943,18 @@ pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(
 /// under one record.
 fn refuse_other_sequence(
     out_dir: &Path,
-    old: &output::JobRecord,
-    record: &output::JobRecord,
+    old: &crate::job::record::JobRecord,
+    record: &crate::job::record::JobRecord,
     running: usize,
 ) -> crate::error::Result<()> {
     let frames: usize = [Format::Png, Format::Exr]
         .into_iter()
-        .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
+        .map(|f| output::frames::frame_files(out_dir, f).map_or(0, |files| files.len()))
         .sum();
     if frames == 0 && running == 0 {
         return Ok(());
     }
-    let what = |r: &output::JobRecord| {
+    let what = |r: &crate::job::record::JobRecord| {
         let name = r.timeline_path.file_name().unwrap_or_default();
         format!("{} at {}x{}", name.to_string_lossy(), r.width, r.height)
     };
@@ -954,7 +966,7 @@ fn refuse_other_sequence(
              --out, or pass --replace to replace them",
             out_dir.display(),
             what(old),
-            output::JOB_FILE,
+            crate::job::record::JOB_FILE,
             if running > 0 {
                 format!(" and {running} render(s) of it still running")
             } else {
@@ -996,7 +1008,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     let bars_drawn = Arc::new(std::sync::OnceLock::new());
     let _reported = report_interrupt(&tally, &bars_drawn, total, shard);
     // Removed again, when dropped, if the render ends having written nothing.
-    let scaffold = output::Scaffold::make(&out_dir)?;
+    let scaffold = crate::job::record::Scaffold::make(&out_dir)?;
     // Checked under the record's lock, so two renders started at once
     // cannot both pass it.
     let replacing = args.force || args.replace;
@@ -1004,12 +1016,12 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
         if old.same_sequence(&record) || replacing {
             return Ok(());
         }
-        let running = crate::claim::live_runs(&out_dir, args.claim_timeout);
+        let running = crate::job::claim::live_runs(&out_dir, args.claim_timeout);
         refuse_other_sequence(&out_dir, old, &record, running.len())
     })?;
-    let stale = output::remove_stale_partials(&out_dir)?;
+    let stale = output::atomic::remove_stale_partials(&out_dir)?;
     // Until this render ends, `status` lists it as running.
-    let running = crate::claim::announce_run(&out_dir, args.claim_timeout)?;
+    let running = crate::job::claim::announce_run(&out_dir, args.claim_timeout)?;
 
     // Decide which frames need work, so the progress bar and ETA count only
     // those. Their scenes are built again as each renders: kept, a long
@@ -1065,10 +1077,10 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
     // (--claim, --shard): not an error, since the frames come out the same,
     // but each frame neither has finished is rendered twice.
     if !args.claim && shard.is_none() && !todo.is_empty() {
-        let others: Vec<String> = crate::claim::live_runs(&out_dir, args.claim_timeout)
+        let others: Vec<String> = crate::job::claim::live_runs(&out_dir, args.claim_timeout)
             .iter()
             .filter(|run| run.token != running.token())
-            .map(crate::claim::ClaimRecord::who)
+            .map(crate::job::claim::ClaimRecord::who)
             .collect();
         if !others.is_empty() {
             say(format!(
@@ -1114,7 +1126,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                 (
                     plan.path(frame, f),
                     f,
-                    output::stored_key(f, hash, &plan.aovs),
+                    output::frames::stored_key(f, hash, &plan.aovs),
                 )
             })
             .collect();
@@ -1200,8 +1212,8 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                     lock(&tally).complete += 1;
                     continue;
                 }
-                match crate::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
-                    crate::claim::Attempt::Claimed(claim) => {
+                match crate::job::claim::try_claim(&out_dir, *frame, args.claim_timeout)? {
+                    crate::job::claim::Attempt::Claimed(claim) => {
                         // It may have been finished between the check and the claim.
                         if args.force || !plan.is_complete(*frame, hash) {
                             render_one(*frame, hash)?;
@@ -1212,7 +1224,7 @@ fn render(args: RenderArgs) -> anyhow::Result<()> {
                         drop(claim);
                     }
                     // Another live worker has it: look again next round.
-                    crate::claim::Attempt::Held(other) => held.push((k, other)),
+                    crate::job::claim::Attempt::Held(other) => held.push((k, other)),
                 }
             }
             // With --force a worker makes one pass: "complete" cannot tell its
@@ -1398,7 +1410,8 @@ fn report_interrupt(
         let tally = lock(&tally);
         let written = !tally.writing.is_empty()
             && tally.writing.iter().all(|(path, format, key)| {
-                output::file_state(path, *format, key, false) == output::FileState::Current
+                output::frames::file_state(path, *format, key, false)
+                    == output::frames::FileState::Current
             });
         let share = match shard {
             Some((i, n)) if n > 1 => format!(" (shard {i}/{n})"),
@@ -1750,7 +1763,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         (parts, Some(job))
     } else {
         let plan = Plan::new(&args.target, &args.sequence)?;
-        let job = output::JobRecord::read(&plan.out_dir).ok();
+        let job = crate::job::record::JobRecord::read(&plan.out_dir).ok();
         (plan.per_format(), job)
     };
     let parts: Vec<Plan> = parts
@@ -1762,7 +1775,7 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         .collect();
     // What the formats share, over the span of their ranges.
     let Some(first) = parts.first() else {
-        let message = format!("{} records no output format", output::JOB_FILE);
+        let message = format!("{} records no output format", crate::job::record::JOB_FILE);
         return Err(Error::usage(&args.target.display().to_string(), message).into());
     };
     let plan = Plan {
@@ -1771,15 +1784,15 @@ fn status(args: StatusArgs) -> anyhow::Result<()> {
         ..first.clone()
     };
     // Fresh temporary files, by frame: a writer is finishing that frame.
-    let writing = output::frames_being_written(&plan.out_dir);
+    let writing = output::frames::frames_being_written(&plan.out_dir);
     let mut by_state: std::collections::BTreeMap<FrameState, Vec<u32>> = Default::default();
     let mut by_format = vec![std::collections::BTreeMap::new(); parts.len()];
     // Renders running on the folder (`claim::announce_run`), and below, any
     // other worker holding a claim.
     let mut workers: std::collections::BTreeSet<String> =
-        crate::claim::live_runs(&plan.out_dir, args.claim_timeout)
+        crate::job::claim::live_runs(&plan.out_dir, args.claim_timeout)
             .iter()
-            .map(crate::claim::ClaimRecord::who)
+            .map(crate::job::claim::ClaimRecord::who)
             .collect();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
@@ -1965,27 +1978,30 @@ fn frame_state(
     // Each file's header read once, and a file read whole only where
     // its header records these inputs.
     let files = part.file_states(frame, &hash);
-    if files.iter().all(|&s| s == output::FileState::Current) {
+    if files
+        .iter()
+        .all(|&s| s == output::frames::FileState::Current)
+    {
         return (FrameState::Complete, None);
     }
-    let claim = crate::claim::read_claim(&crate::claim::claim_path(&part.out_dir, frame))
-        .filter(|c| crate::claim::is_live(c, claim_timeout));
+    let claim = crate::job::claim::read_claim(&crate::job::claim::claim_path(&part.out_dir, frame))
+        .filter(|c| crate::job::claim::is_live(c, claim_timeout));
     if let Some(claim) = claim {
         return (FrameState::InProgress, Some(claim.who()));
     }
     let state = if writing.contains(&frame) {
         FrameState::InProgress
-    } else if output::checkpoint_is_for(
-        &output::checkpoint_path(&part.out_dir, frame),
-        output::light_hash(&hash),
+    } else if crate::job::checkpoint::checkpoint_is_for(
+        &crate::job::checkpoint::checkpoint_path(&part.out_dir, frame),
+        output::frames::light_hash(&hash),
         part.width,
         part.height,
         part.layers(),
     ) {
         FrameState::Resumable
-    } else if files.contains(&output::FileState::Damaged) {
+    } else if files.contains(&output::frames::FileState::Damaged) {
         FrameState::Damaged
-    } else if files.contains(&output::FileState::Stale) {
+    } else if files.contains(&output::frames::FileState::Stale) {
         FrameState::Stale
     } else {
         FrameState::Missing
@@ -2562,23 +2578,24 @@ fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         let message = format!("the sheet is a PNG: name it .png, not {}", out.display());
         return Err(Error::usage("--out", message).into());
     }
-    let frames = output::frame_files(&args.dir, Format::Png)?;
+    let frames = output::frames::frame_files(&args.dir, Format::Png)?;
     if frames.is_empty() {
         // A --preview render's frames are a folder further down.
         let preview = args.dir.join("preview");
-        let hint = if output::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
-            format!(" (a preview's are in {})", preview.display())
-        } else {
-            String::new()
-        };
+        let hint =
+            if output::frames::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
+                format!(" (a preview's are in {})", preview.display())
+            } else {
+                String::new()
+            };
         return Err(Error::usage(
             &args.dir.display().to_string(),
             format!("no frame_NNNNN.png files in this folder{hint}"),
         )
         .into());
     }
-    let shown = output::evenly_spaced(&frames, args.count);
-    output::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
+    let shown = output::sheet::evenly_spaced(&frames, args.count);
+    output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
     out!(
         "{} frames of {} tiled into {}",
         shown.len(),

@@ -9,13 +9,14 @@
 
 pub mod accuracy;
 pub mod bench;
-pub mod claim;
 pub mod cli;
 pub mod environment;
 pub mod error;
 pub mod fractal;
+pub mod host;
 pub mod input;
 pub mod interrupt;
+pub mod job;
 pub mod march;
 pub mod math;
 pub mod output;
