@@ -601,7 +601,7 @@ then to the scene's own settings, then to the faster. The reference is the yards
 
 /// The table as CSV, one row per variant, a column per field.
 pub fn to_csv(rows: &[Measurement]) -> String {
-    crate::output::csv_text(rows)
+    crate::output::csv::csv_text(rows)
 }
 
 /// The table as Markdown, with times relative to the scene's own settings.

@@ -2,18 +2,18 @@
 //!
 //! Layers, each depending only on those after it:
 //! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`;
-//! `interrupt` (what Ctrl-C cleans up) sits under `output` and `claim`.
+//! `interrupt` (what Ctrl-C cleans up) sits under `output` and `job`.
 //! `input` (reading the files a user names) sits below them all.
 
 #![forbid(unsafe_code)]
 
 pub mod accuracy;
 pub mod bench;
-pub mod claim;
 pub mod cli;
 pub mod environment;
 pub mod error;
 pub mod fractal;
+pub mod host;
 pub mod input;
 pub mod interrupt;
 pub mod job;

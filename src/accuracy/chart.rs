@@ -285,7 +285,7 @@ pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()>
     let (pixels, _) = draw(rows, title).map_err(chart_error)?;
     let (w, h) = CHART_SIZE;
     let image = image::RgbImage::from_raw(w, h, pixels).expect("buffer matches the chart size");
-    crate::output::write_atomic(path, |w, _| {
+    crate::output::atomic::write_atomic(path, |w, _| {
         image
             .write_to(w, image::ImageFormat::Png)
             .map_err(|e| chart_error(e.to_string()))

@@ -17,23 +17,24 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         let message = format!("the sheet is a PNG: name it .png, not {}", out.display());
         return Err(Error::usage("--out", message).into());
     }
-    let frames = output::frame_files(&args.dir, Format::Png)?;
+    let frames = output::frames::frame_files(&args.dir, Format::Png)?;
     if frames.is_empty() {
         // A --preview render's frames are a folder further down.
         let preview = args.dir.join("preview");
-        let hint = if output::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
-            format!(" (a preview's are in {})", preview.display())
-        } else {
-            String::new()
-        };
+        let hint =
+            if output::frames::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
+                format!(" (a preview's are in {})", preview.display())
+            } else {
+                String::new()
+            };
         return Err(Error::usage(
             &args.dir.display().to_string(),
             format!("no frame_NNNNN.png files in this folder{hint}"),
         )
         .into());
     }
-    let shown = output::evenly_spaced(&frames, args.count);
-    output::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
+    let shown = output::sheet::evenly_spaced(&frames, args.count);
+    output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
     out!(
         "{} frames of {} tiled into {}",
         shown.len(),

@@ -23,7 +23,7 @@ pub struct Plan {
     /// `--samples`, applied to the timeline's scene (and recorded).
     pub samples: Option<u32>,
     /// `--verify`: frame files are read to their last byte before they
-    /// count as complete (`output::file_state`).
+    /// count as complete (`output::frames::file_state`).
     pub verify: bool,
 }
 
@@ -97,24 +97,24 @@ impl Plan {
     }
 
     /// The plans an output folder records, one per format with its own
-    /// range, layers and samples (see `output::JobRecord`), and the record.
-    pub fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, output::JobRecord)> {
-        if !dir.join(output::JOB_FILE).exists() {
+    /// range, layers and samples (see `crate::job::record::JobRecord`), and the record.
+    pub fn from_folder(dir: &Path) -> anyhow::Result<(Vec<Plan>, crate::job::record::JobRecord)> {
+        if !dir.join(crate::job::record::JOB_FILE).exists() {
             let preview = dir.join("preview");
-            let hint = if preview.join(output::JOB_FILE).exists() {
+            let hint = if preview.join(crate::job::record::JOB_FILE).exists() {
                 format!("; a preview's is in {}", preview.display())
             } else {
                 String::new()
             };
             let message = format!(
                 "not a mandelreel output folder (no {}){hint}",
-                output::JOB_FILE
+                crate::job::record::JOB_FILE
             );
             return Err(Error::usage(&dir.display().to_string(), message).into());
         }
-        let job = output::JobRecord::read(dir)?;
+        let job = crate::job::record::JobRecord::read(dir)?;
         let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
-        let plan = |o: output::OutputRecord| -> anyhow::Result<Plan> {
+        let plan = |o: crate::job::record::OutputRecord| -> anyhow::Result<Plan> {
             let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
                 .map_err(|e| anyhow::anyhow!(e))?;
             let timeline = timeline.clone().with_samples(o.samples);
@@ -149,9 +149,9 @@ impl Plan {
         self.formats.iter().map(one).collect()
     }
 
-    pub fn record(&self) -> anyhow::Result<output::JobRecord> {
+    pub fn record(&self) -> anyhow::Result<crate::job::record::JobRecord> {
         let text = crate::timeline::read_text(&self.timeline.source)?;
-        Ok(output::JobRecord {
+        Ok(crate::job::record::JobRecord {
             renderer: format!("mandelreel {}", env!("CARGO_PKG_VERSION")),
             timeline_path: std::fs::canonicalize(&self.timeline.source)
                 .unwrap_or_else(|_| self.timeline.source.clone()),
@@ -170,7 +170,7 @@ impl Plan {
             outputs: self
                 .formats
                 .iter()
-                .map(|&f| output::OutputRecord {
+                .map(|&f| crate::job::record::OutputRecord {
                     format: f.extension().to_string(),
                     frames: (self.range.start, self.range.end),
                     // Only EXRs hold extra layers.
@@ -195,12 +195,13 @@ impl Plan {
         } else {
             self.timeline.scenes_for_frame(frame)
         };
-        let hash = output::frame_hash(&scenes, frame, self.width, self.height);
+        let hash = output::frames::frame_hash(&scenes, frame, self.width, self.height);
         (scenes, hash)
     }
 
     pub fn path(&self, frame: u32, format: Format) -> PathBuf {
-        self.out_dir.join(output::frame_file_name(frame, format))
+        self.out_dir
+            .join(output::frames::frame_file_name(frame, format))
     }
 
     /// The format a video is encoded from: the PNGs, where rendered.
@@ -220,8 +221,9 @@ impl Plan {
             return false;
         }
         let (_, hash) = self.frame(frame);
-        let key = output::stored_key(format, &hash, &self.aovs);
-        output::file_state(&path, format, &key, self.verify) == output::FileState::Current
+        let key = output::frames::stored_key(format, &hash, &self.aovs);
+        output::frames::file_state(&path, format, &key, self.verify)
+            == output::frames::FileState::Current
     }
 
     /// The ffmpeg command encoding `range` from its `format` files: into
@@ -240,12 +242,12 @@ impl Plan {
 
     /// The state of each format's file of `frame` against these inputs
     /// (read whole with `--verify`).
-    pub fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
+    pub fn file_states(&self, frame: u32, hash: &str) -> Vec<output::frames::FileState> {
         self.formats
             .iter()
             .map(|&f| {
-                let key = output::stored_key(f, hash, &self.aovs);
-                output::file_state(&self.path(frame, f), f, &key, self.verify)
+                let key = output::frames::stored_key(f, hash, &self.aovs);
+                output::frames::file_state(&self.path(frame, f), f, &key, self.verify)
             })
             .collect()
     }
@@ -254,7 +256,9 @@ impl Plan {
     /// these inputs.
     pub fn is_complete(&self, frame: u32, hash: &str) -> bool {
         let states = self.file_states(frame, hash);
-        states.iter().all(|&s| s == output::FileState::Current)
+        states
+            .iter()
+            .all(|&s| s == output::frames::FileState::Current)
     }
 }
 
@@ -280,8 +284,8 @@ pub fn ffmpeg_command(
 ) -> String {
     // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
     // own `%` is written `%%`.
-    let input =
-        Path::new(&dir.to_string_lossy().replace('%', "%%")).join(output::frame_pattern(format));
+    let input = Path::new(&dir.to_string_lossy().replace('%', "%%"))
+        .join(output::frames::frame_pattern(format));
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
     let trc = if format == Format::Exr {

@@ -16,7 +16,7 @@ use std::sync::Mutex;
 pub struct Job {
     pub request: Request,
     pub plan: Plan,
-    pub record: output::JobRecord,
+    pub record: crate::job::record::JobRecord,
     /// `--shard I/N`, parsed.
     pub shard: Option<(u32, u32)>,
     /// The frames of this worker's share (every frame without a shard).
@@ -28,9 +28,9 @@ pub struct Folder {
     /// The render's announcement (`claim::announce_run`): until it is
     /// dropped, `status` lists the render as running. Dropped before
     /// `scaffold`, so that an empty folder can be removed.
-    pub running: crate::claim::Claim,
+    pub running: crate::job::claim::Claim,
     /// Removed again, when dropped, if the render ends having written nothing.
-    pub scaffold: output::Scaffold,
+    pub scaffold: crate::job::record::Scaffold,
     /// Temporary files an interrupted render left, now removed.
     pub stale: usize,
 }
@@ -77,7 +77,7 @@ impl Job {
     pub fn open(&self) -> anyhow::Result<Folder> {
         let out_dir = &self.plan.out_dir;
         let request = &self.request;
-        let scaffold = output::Scaffold::make(out_dir)?;
+        let scaffold = crate::job::record::Scaffold::make(out_dir)?;
         // Checked under the record's lock, so two renders started at once
         // cannot both pass it.
         let replacing = request.force || request.replace;
@@ -85,11 +85,11 @@ impl Job {
             if old.same_sequence(&self.record) || replacing {
                 return Ok(());
             }
-            let running = crate::claim::live_runs(out_dir, request.claim_timeout);
+            let running = crate::job::claim::live_runs(out_dir, request.claim_timeout);
             refuse_other_sequence(out_dir, old, &self.record, running.len())
         })?;
-        let stale = output::remove_stale_partials(out_dir)?;
-        let running = crate::claim::announce_run(out_dir, request.claim_timeout)?;
+        let stale = output::atomic::remove_stale_partials(out_dir)?;
+        let running = crate::job::claim::announce_run(out_dir, request.claim_timeout)?;
         Ok(Folder {
             running,
             scaffold,
@@ -125,10 +125,10 @@ impl Job {
         if request.claim || self.shard.is_some() || todo.is_empty() {
             return Vec::new();
         }
-        crate::claim::live_runs(&self.plan.out_dir, request.claim_timeout)
+        crate::job::claim::live_runs(&self.plan.out_dir, request.claim_timeout)
             .iter()
             .filter(|run| run.token != folder.running.token())
-            .map(crate::claim::ClaimRecord::who)
+            .map(crate::job::claim::ClaimRecord::who)
             .collect()
     }
 
@@ -154,7 +154,7 @@ impl Job {
                 (
                     plan.path(frame, f),
                     f,
-                    output::stored_key(f, hash, &plan.aovs),
+                    output::frames::stored_key(f, hash, &plan.aovs),
                 )
             })
             .collect();
@@ -203,8 +203,8 @@ impl Job {
                     lock(tally).complete += 1;
                     continue;
                 }
-                match crate::claim::try_claim(&plan.out_dir, *frame, timeout)? {
-                    crate::claim::Attempt::Claimed(claim) => {
+                match crate::job::claim::try_claim(&plan.out_dir, *frame, timeout)? {
+                    crate::job::claim::Attempt::Claimed(claim) => {
                         // It may have been finished between the check and the claim.
                         if force || !plan.is_complete(*frame, hash) {
                             render_one(*frame, hash)?;
@@ -215,7 +215,7 @@ impl Job {
                         drop(claim);
                     }
                     // Another live worker has it: look again next round.
-                    crate::claim::Attempt::Held(other) => held.push((k, other)),
+                    crate::job::claim::Attempt::Held(other) => held.push((k, other)),
                 }
             }
             // With --force a worker makes one pass: "complete" cannot tell its
@@ -264,18 +264,18 @@ impl Job {
 /// under one record.
 fn refuse_other_sequence(
     out_dir: &Path,
-    old: &output::JobRecord,
-    record: &output::JobRecord,
+    old: &crate::job::record::JobRecord,
+    record: &crate::job::record::JobRecord,
     running: usize,
 ) -> crate::error::Result<()> {
     let frames: usize = [Format::Png, Format::Exr]
         .into_iter()
-        .map(|f| output::frame_files(out_dir, f).map_or(0, |files| files.len()))
+        .map(|f| output::frames::frame_files(out_dir, f).map_or(0, |files| files.len()))
         .sum();
     if frames == 0 && running == 0 {
         return Ok(());
     }
-    let what = |r: &output::JobRecord| {
+    let what = |r: &crate::job::record::JobRecord| {
         let name = r.timeline_path.file_name().unwrap_or_default();
         format!("{} at {}x{}", name.to_string_lossy(), r.width, r.height)
     };
@@ -287,7 +287,7 @@ fn refuse_other_sequence(
              --out, or pass --replace to replace them",
             out_dir.display(),
             what(old),
-            output::JOB_FILE,
+            crate::job::record::JOB_FILE,
             if running > 0 {
                 format!(" and {running} render(s) of it still running")
             } else {
@@ -321,7 +321,8 @@ impl Tally {
     pub fn complete_now(&self) -> usize {
         let written = !self.writing.is_empty()
             && self.writing.iter().all(|(path, format, key)| {
-                output::file_state(path, *format, key, false) == output::FileState::Current
+                output::frames::file_state(path, *format, key, false)
+                    == output::frames::FileState::Current
             });
         self.complete + usize::from(written)
     }

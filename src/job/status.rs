@@ -51,7 +51,7 @@ pub fn scan(
         folder_plans(target, sequence)?
     } else {
         let plan = Plan::new(target, sequence)?;
-        let job = output::JobRecord::read(&plan.out_dir).ok();
+        let job = crate::job::record::JobRecord::read(&plan.out_dir).ok();
         (plan.per_format(), job)
     };
     let parts: Vec<Plan> = parts
@@ -59,7 +59,7 @@ pub fn scan(
         .map(|part| Plan { verify, ..part })
         .collect();
     let Some(first) = parts.first() else {
-        let message = format!("{} records no output format", output::JOB_FILE);
+        let message = format!("{} records no output format", crate::job::record::JOB_FILE);
         return Err(Error::usage(&target.display().to_string(), message).into());
     };
     let plan = Plan {
@@ -99,7 +99,7 @@ pub fn scan(
 fn folder_plans(
     target: &Path,
     s: &Sequence,
-) -> anyhow::Result<(Vec<Plan>, Option<output::JobRecord>)> {
+) -> anyhow::Result<(Vec<Plan>, Option<crate::job::record::JobRecord>)> {
     let given = [
         ("--out", s.out.is_some()),
         ("--size", s.size.is_some()),
@@ -137,12 +137,12 @@ fn frame_states(
     claim_timeout: Duration,
 ) -> (ByState, Vec<ByState>, BTreeSet<String>) {
     // Fresh temporary files, by frame: a writer is finishing that frame.
-    let writing = output::frames_being_written(&plan.out_dir);
+    let writing = output::frames::frames_being_written(&plan.out_dir);
     let mut by_state = ByState::new();
     let mut by_format = vec![ByState::new(); parts.len()];
-    let mut workers: BTreeSet<String> = crate::claim::live_runs(&plan.out_dir, claim_timeout)
+    let mut workers: BTreeSet<String> = crate::job::claim::live_runs(&plan.out_dir, claim_timeout)
         .iter()
-        .map(crate::claim::ClaimRecord::who)
+        .map(crate::job::claim::ClaimRecord::who)
         .collect();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
@@ -252,27 +252,30 @@ pub fn frame_state(
     // Each file's header read once, and a file read whole only where
     // its header records these inputs.
     let files = part.file_states(frame, &hash);
-    if files.iter().all(|&s| s == output::FileState::Current) {
+    if files
+        .iter()
+        .all(|&s| s == output::frames::FileState::Current)
+    {
         return (FrameState::Complete, None);
     }
-    let claim = crate::claim::read_claim(&crate::claim::claim_path(&part.out_dir, frame))
-        .filter(|c| crate::claim::is_live(c, claim_timeout));
+    let claim = crate::job::claim::read_claim(&crate::job::claim::claim_path(&part.out_dir, frame))
+        .filter(|c| crate::job::claim::is_live(c, claim_timeout));
     if let Some(claim) = claim {
         return (FrameState::InProgress, Some(claim.who()));
     }
     let state = if writing.contains(&frame) {
         FrameState::InProgress
-    } else if output::checkpoint_is_for(
-        &output::checkpoint_path(&part.out_dir, frame),
-        output::light_hash(&hash),
+    } else if crate::job::checkpoint::checkpoint_is_for(
+        &crate::job::checkpoint::checkpoint_path(&part.out_dir, frame),
+        output::frames::light_hash(&hash),
         part.width,
         part.height,
         part.layers(),
     ) {
         FrameState::Resumable
-    } else if files.contains(&output::FileState::Damaged) {
+    } else if files.contains(&output::frames::FileState::Damaged) {
         FrameState::Damaged
-    } else if files.contains(&output::FileState::Stale) {
+    } else if files.contains(&output::frames::FileState::Stale) {
         FrameState::Stale
     } else {
         FrameState::Missing

@@ -44,12 +44,17 @@ impl Plan {
             );
             return self.write_film(frame, film, hash, &scenes[0].look);
         }
-        let checkpoint = output::checkpoint_path(&self.out_dir, frame);
+        let checkpoint = crate::job::checkpoint::checkpoint_path(&self.out_dir, frame);
         // A checkpoint holds linear light: how a PNG shows it is not its key.
-        let light = output::light_hash(hash);
-        let saved_acc =
-            output::read_checkpoint(&checkpoint, light, self.width, self.height, layers)
-                .filter(|a| a.samples_done < n);
+        let light = output::frames::light_hash(hash);
+        let saved_acc = crate::job::checkpoint::read_checkpoint(
+            &checkpoint,
+            light,
+            self.width,
+            self.height,
+            layers,
+        )
+        .filter(|a| a.samples_done < n);
         let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
@@ -66,7 +71,7 @@ impl Plan {
             let until = (acc.samples_done + wave).min(n);
             crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
             if saving && until < n && saved.elapsed() >= checkpoint_every {
-                if let Err(e) = output::write_checkpoint(&checkpoint, &acc, light) {
+                if let Err(e) = crate::job::checkpoint::write_checkpoint(&checkpoint, &acc, light) {
                     say(Said::CheckpointFailed { frame, error: e });
                     saving = false;
                 }
@@ -86,9 +91,12 @@ impl Plan {
         look: &crate::shade::Look,
     ) -> anyhow::Result<FrameStats> {
         for &f in &self.formats {
-            output::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
+            output::frames::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
         }
-        let _ = std::fs::remove_file(output::checkpoint_path(&self.out_dir, frame));
+        let _ = std::fs::remove_file(crate::job::checkpoint::checkpoint_path(
+            &self.out_dir,
+            frame,
+        ));
         Ok(film.stats)
     }
 }

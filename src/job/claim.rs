@@ -33,7 +33,7 @@ pub struct ClaimRecord {
     pub token: String,
     /// Last sign of life, milliseconds since the Unix epoch.
     pub heartbeat_ms: u64,
-    /// Where `pid` means this process (`output::pid_space`); a claim
+    /// Where `pid` means this process (`host::pid_space`); a claim
     /// without it is only ever taken over after its timeout.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pid_space: Option<String>,
@@ -42,7 +42,7 @@ pub struct ClaimRecord {
 impl ClaimRecord {
     /// A record for this process, with a fresh token and heartbeat.
     fn mine() -> ClaimRecord {
-        let (host, pid) = (crate::output::host_name(), std::process::id());
+        let (host, pid) = (crate::host::host_name(), std::process::id());
         let nanos = SystemTime::now()
             .duration_since(UNIX_EPOCH)
             .map(|d| d.as_nanos())
@@ -52,7 +52,7 @@ impl ClaimRecord {
             host,
             pid,
             heartbeat_ms: now_ms(),
-            pid_space: crate::output::pid_space(),
+            pid_space: crate::host::pid_space(),
         }
     }
 
@@ -120,14 +120,14 @@ fn runs(dir: &Path) -> Vec<(PathBuf, ClaimRecord)> {
 pub fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
     dir.join(format!(
         ".frame_{frame_index:0width$}.claim",
-        width = crate::output::FRAME_DIGITS
+        width = crate::output::frames::FRAME_DIGITS
     ))
 }
 
 fn takeover_path(dir: &Path, frame_index: u32, token: &str, generation: u32) -> PathBuf {
     dir.join(format!(
         ".frame_{frame_index:0width$}.takeover-{token}.{generation}",
-        width = crate::output::FRAME_DIGITS
+        width = crate::output::frames::FRAME_DIGITS
     ))
 }
 
@@ -155,16 +155,16 @@ pub fn read_claim(path: &Path) -> Option<ClaimRecord> {
 pub fn is_live(record: &ClaimRecord, timeout: Duration) -> bool {
     let beating = now_ms().saturating_sub(record.heartbeat_ms) < timeout.as_millis() as u64;
     beating
-        && !(record.host == crate::output::host_name()
+        && !(record.host == crate::host::host_name()
             && record.pid_space.is_some()
-            && record.pid_space == crate::output::pid_space()
-            && crate::output::gone_here(record.pid))
+            && record.pid_space == crate::host::pid_space()
+            && crate::host::gone_here(record.pid))
 }
 
 /// Replaces `path` with `record`, atomically (temporary file, then rename).
 fn write_record(path: &Path, record: &ClaimRecord) -> Result<()> {
     let json = serde_json::to_string(record).expect("a claim record always serialises");
-    crate::output::write_atomic(path, |w, temp| {
+    crate::output::atomic::write_atomic(path, |w, temp| {
         w.write_all(json.as_bytes()).map_err(|e| Error::io(temp, e))
     })
 }
@@ -359,7 +359,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
                     // Someone else is taking it over; their claim will show
                     // up live. Unless the marker is older than the timeout:
                     // its maker died before writing its claim.
-                    if crate::output::file_age(&marker).is_some_and(|age| age > timeout) {
+                    if crate::host::file_age(&marker).is_some_and(|age| age > timeout) {
                         generation += 1;
                         continue;
                     }
@@ -385,221 +385,4 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_run_record_comes_back_after_another_render_removed_it() {
-        // A render stopped past the timeout (SIGSTOP) has its record removed
-        // as dead by the next render; once it beats again, it is back.
-        let dir = tempfile::tempdir().unwrap();
-        let timeout = Duration::from_millis(200);
-        let run = announce_run(dir.path(), timeout).unwrap();
-        let records = || runs(dir.path());
-        assert_eq!(records().len(), 1);
-        std::fs::remove_file(&records()[0].0).unwrap();
-        assert!(records().is_empty());
-        std::thread::sleep(Duration::from_millis(400));
-        assert_eq!(records().len(), 1, "the heartbeat wrote it again");
-        assert_eq!(live_runs(dir.path(), timeout).len(), 1);
-        drop(run);
-        assert!(records().is_empty(), "removed when the render ends");
-    }
-
-    #[test]
-    fn one_claim_at_a_time_released_on_drop() {
-        let dir = tempfile::tempdir().unwrap();
-        let timeout = Duration::from_secs(60);
-        let Attempt::Claimed(claim) = try_claim(dir.path(), 3, timeout).unwrap() else {
-            panic!("a free frame can be claimed");
-        };
-        assert!(claim_path(dir.path(), 3).exists());
-        assert!(matches!(
-            try_claim(dir.path(), 3, timeout).unwrap(),
-            Attempt::Held(_)
-        ));
-        drop(claim);
-        assert!(!claim_path(dir.path(), 3).exists());
-        assert!(matches!(
-            try_claim(dir.path(), 3, timeout).unwrap(),
-            Attempt::Claimed(_)
-        ));
-    }
-
-    /// The claim of a worker that stopped beating two minutes ago, under the
-    /// token "dead-token".
-    fn write_dead_claim(dir: &Path, frame_index: u32) -> ClaimRecord {
-        let dead = ClaimRecord {
-            host: "gone".into(),
-            pid: 1,
-            token: "dead-token".into(),
-            heartbeat_ms: now_ms() - 120_000,
-            pid_space: None,
-        };
-        write_record(&claim_path(dir, frame_index), &dead).unwrap();
-        dead
-    }
-
-    #[test]
-    fn a_takeover_marker_blocks_until_it_is_older_than_the_timeout() {
-        let dir = tempfile::tempdir().unwrap();
-        let dead = write_dead_claim(dir.path(), 5);
-        let timeout = Duration::from_secs(60);
-        // Another worker has just begun taking the dead claim over.
-        let marker = takeover_path(dir.path(), 5, "dead-token", 0);
-        let file = std::fs::File::create(&marker).unwrap();
-        assert!(matches!(
-            try_claim(dir.path(), 5, timeout).unwrap(),
-            Attempt::Held(_)
-        ));
-        assert_eq!(read_claim(&claim_path(dir.path(), 5)).unwrap(), dead);
-        // That worker died before writing its claim: once its marker is older
-        // than the timeout, the frame is taken over instead of blocked forever.
-        file.set_modified(std::time::SystemTime::now() - Duration::from_secs(120))
-            .unwrap();
-        drop(file);
-        let Attempt::Claimed(ours) = try_claim(dir.path(), 5, timeout).unwrap() else {
-            panic!("a stale marker does not block the frame");
-        };
-        assert_eq!(
-            read_claim(&claim_path(dir.path(), 5)).unwrap().pid,
-            std::process::id()
-        );
-        // The stale marker stays (deleting it could let a second taker win
-        // it too): this takeover won the next generation's, which blocks a
-        // worker that still sees the dead claim (put back here for it).
-        let next = takeover_path(dir.path(), 5, "dead-token", 1);
-        assert!(marker.exists() && next.exists());
-        let ours_record = read_claim(&claim_path(dir.path(), 5)).unwrap();
-        let seen = write_dead_claim(dir.path(), 5);
-        assert!(matches!(
-            try_claim(dir.path(), 5, timeout).unwrap(),
-            Attempt::Held(held) if held == seen
-        ));
-        write_record(&claim_path(dir.path(), 5), &ours_record).unwrap();
-        // Done: the claim and both markers go.
-        drop(ours);
-        assert!(!claim_path(dir.path(), 5).exists());
-        assert!(!marker.exists() && !next.exists());
-    }
-
-    #[test]
-    fn a_dead_claim_is_taken_over_exactly_once() {
-        let dir = tempfile::tempdir().unwrap();
-        write_dead_claim(dir.path(), 7);
-        let timeout = Duration::from_secs(60);
-        let first = try_claim(dir.path(), 7, timeout).unwrap();
-        let Attempt::Claimed(ours) = first else {
-            panic!("a claim two minutes old is taken over");
-        };
-        // A second worker that read the dead claim before ours replaced it
-        // (put back here, to be what it sees) loses the takeover: our marker
-        // for that dead claim stands, and it is told the frame is held.
-        let ours_record = read_claim(&claim_path(dir.path(), 7)).unwrap();
-        let dead = write_dead_claim(dir.path(), 7);
-        assert!(takeover_path(dir.path(), 7, &dead.token, 0).exists());
-        assert!(matches!(
-            try_claim(dir.path(), 7, timeout).unwrap(),
-            Attempt::Held(held) if held == dead
-        ));
-        write_record(&claim_path(dir.path(), 7), &ours_record).unwrap();
-        let now = read_claim(&claim_path(dir.path(), 7)).unwrap();
-        assert_eq!(now.pid, std::process::id());
-        drop(ours);
-        assert!(!claim_path(dir.path(), 7).exists());
-    }
-
-    #[test]
-    fn an_empty_claim_left_by_a_crash_is_taken_over_once_it_is_old() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = claim_path(dir.path(), 2);
-        std::fs::write(&path, b"").unwrap();
-        let timeout = Duration::from_secs(60);
-        // Fresh: it may be being written; leave it.
-        assert!(matches!(
-            try_claim(dir.path(), 2, timeout).unwrap(),
-            Attempt::Held(_)
-        ));
-        // Two minutes old: dead; taken over.
-        let old = SystemTime::now() - Duration::from_secs(120);
-        std::fs::File::options()
-            .write(true)
-            .open(&path)
-            .unwrap()
-            .set_modified(old)
-            .unwrap();
-        let Attempt::Claimed(claim) = try_claim(dir.path(), 2, timeout).unwrap() else {
-            panic!("an old empty claim is taken over");
-        };
-        assert_eq!(read_claim(&path).unwrap().pid, std::process::id());
-        drop(claim);
-        assert!(
-            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
-            "nothing left behind"
-        );
-    }
-
-    #[test]
-    fn a_claim_of_an_ended_process_on_this_machine_is_taken_over_at_once() {
-        // A worker stopped by Ctrl-C leaves a claim with a fresh heartbeat:
-        // on this machine its ended process shows, and the frame is free;
-        // while the process lives, and on any other machine, it is held.
-        if crate::output::pid_space().is_none() || !Path::new("/proc/1").exists() {
-            return; // nothing tells an ended process without /proc
-        }
-        let dir = tempfile::tempdir().unwrap();
-        let timeout = Duration::from_secs(300);
-        let mut worker = std::process::Command::new("sleep")
-            .arg("30")
-            .spawn()
-            .unwrap();
-        let pid = worker.id();
-        let fresh = |host: String, pid_space: Option<String>| ClaimRecord {
-            host,
-            pid,
-            token: format!("token-{pid}"),
-            heartbeat_ms: now_ms(),
-            pid_space,
-        };
-        let here = fresh(crate::output::host_name(), crate::output::pid_space());
-        write_record(&claim_path(dir.path(), 4), &here).unwrap();
-        assert!(matches!(
-            try_claim(dir.path(), 4, timeout).unwrap(),
-            Attempt::Held(_)
-        ));
-        worker.kill().unwrap();
-        worker.wait().unwrap();
-        assert!(!is_live(&here, timeout));
-        // Another machine; this host name in another pid namespace (a
-        // container sharing it), or a claim that does not say: alive.
-        let space = crate::output::pid_space();
-        assert!(is_live(&fresh("another-machine".into(), space), timeout));
-        let elsewhere = Some("another-boot/pid:[1]".to_string());
-        assert!(is_live(
-            &fresh(crate::output::host_name(), elsewhere),
-            timeout
-        ));
-        assert!(is_live(&fresh(crate::output::host_name(), None), timeout));
-        let Attempt::Claimed(claim) = try_claim(dir.path(), 4, timeout).unwrap() else {
-            panic!("the ended worker's claim is taken over");
-        };
-        let ours = read_claim(&claim_path(dir.path(), 4)).unwrap();
-        assert_eq!(ours.pid, std::process::id());
-        drop(claim);
-    }
-
-    #[test]
-    fn heartbeat_keeps_a_long_claim_alive() {
-        let dir = tempfile::tempdir().unwrap();
-        let timeout = Duration::from_millis(400);
-        let Attempt::Claimed(_claim) = try_claim(dir.path(), 1, timeout).unwrap() else {
-            panic!("free frame");
-        };
-        let first = read_claim(&claim_path(dir.path(), 1)).unwrap();
-        std::thread::sleep(Duration::from_millis(900));
-        let later = read_claim(&claim_path(dir.path(), 1)).unwrap();
-        assert_eq!(later.token, first.token);
-        assert!(later.heartbeat_ms > first.heartbeat_ms);
-        assert!(is_live(&later, timeout));
-    }
-}
+mod tests;

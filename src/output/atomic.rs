@@ -1,0 +1,99 @@
+//! Atomic writes: a file is replaced whole or not at all, through a hidden
+//! temporary beside it whose name tags its writer, and the temporaries left
+//! by writers that are gone are found and removed.
+
+use crate::error::{Error, Result};
+use crate::host::{file_age, writer_is_dead_here, writer_tag};
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+
+/// Replaces `path` whole or not at all: `write` fills a hidden temporary file
+/// beside it (`.<name>.<host>.<pid>.<random>.partial`, unique per writer, so a
+/// leftover one is never taken for a final file and `remove_stale_partials`
+/// knows whose it is), which is flushed, synced and renamed over `path`. On
+/// any error the temporary file is deleted. Files are readable by all.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut BufWriter<&File>, &Path) -> Result<()>,
+) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut builder = tempfile::Builder::new();
+    let prefix = format!(".{}.{}", name.trim_start_matches('.'), writer_tag());
+    builder.prefix(&prefix).suffix(".partial");
+    #[cfg(unix)]
+    {
+        // Ordinary files, readable by all (tempfile's default is 0600).
+        use std::os::unix::fs::PermissionsExt;
+        builder.permissions(std::fs::Permissions::from_mode(0o644));
+    }
+    // Created and renamed under the interrupt lock, so Ctrl-C removes
+    // every temporary file and none is renamed into place after it.
+    let (temp, _removed_on_interrupt) = {
+        let mut held = crate::interrupt::hold();
+        let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+        let temp_path = temp.path().to_path_buf();
+        let removal = held.on_interrupt(move || {
+            let _ = std::fs::remove_file(temp_path);
+        });
+        (temp, removal)
+    };
+    let temp_path = temp.path().to_path_buf();
+    // Written through the plain file: the temporary file's own writer
+    // would add its path to every error, which `Error::io` names already.
+    let mut writer = BufWriter::new(temp.as_file());
+    write(&mut writer, &temp_path)?;
+    writer
+        .into_inner()
+        .map_err(|e| Error::io(&temp_path, e.into_error()))?
+        .sync_all()
+        .map_err(|e| Error::io(&temp_path, e))?;
+    let held = crate::interrupt::hold();
+    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    drop(held);
+    Ok(())
+}
+
+/// How old a temporary `.partial` file must be to count as left behind by a
+/// killed render. A writer holds one only while encoding a finished frame
+/// (seconds), so anything this old belongs to no live process.
+pub const STALE_PARTIAL_AGE: std::time::Duration = std::time::Duration::from_secs(600);
+
+/// The temporary files in `dir` (any writer's, any version's), each with
+/// whether its writer is gone: a dead process on this machine, or older than
+/// `STALE_PARTIAL_AGE`.
+pub(crate) fn partials(dir: &Path) -> Result<Vec<(PathBuf, String, bool)>> {
+    let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
+    Ok(entries
+        .filter_map(|e| e.ok())
+        .filter_map(|entry| {
+            let name = entry.file_name().to_string_lossy().into_owned();
+            // Every `write_atomic` temporary (frames, job file, checkpoints,
+            // claims, sheets), and earlier versions' names too.
+            if !(name.starts_with('.') && name.ends_with(".partial")) {
+                return None;
+            }
+            let age = file_age(&entry.path());
+            let stale = writer_is_dead_here(name.trim_end_matches(".partial"))
+                || age.is_some_and(|a| a >= STALE_PARTIAL_AGE);
+            Some((entry.path(), name, stale))
+        })
+        .collect())
+}
+
+/// Deletes temporary files in `dir` left by writers that are gone. Returns
+/// how many went. Fresh ones of live writers may belong to a render running
+/// beside this one and are left alone.
+pub fn remove_stale_partials(dir: &Path) -> Result<usize> {
+    Ok(partials(dir)?
+        .into_iter()
+        .filter(|(path, _, stale)| *stale && std::fs::remove_file(path).is_ok())
+        .count())
+}

@@ -1,0 +1,108 @@
+//! Frames on disk: one module per file format (`png`: 8-bit sRGB; `exr`:
+//! linear half-float RGBA, a float Z and the layers `--aov` asks for), frame
+//! files and the content hash each carries in its own metadata so resume can
+//! tell a current frame from a stale one (`frames`), write-to-temporary-
+//! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
+
+pub mod atomic;
+pub mod csv;
+pub mod exr;
+pub mod frames;
+pub mod png;
+pub mod sheet;
+
+#[cfg(test)]
+mod tests;
+
+use crate::render::Film;
+use serde::Serialize;
+
+/// Metadata key under which every frame stores the hash of what made it.
+pub const HASH_KEY: &str = "mandelreel-hash";
+/// Metadata key for the frame's render statistics.
+pub const STATS_KEY: &str = "mandelreel-stats";
+
+/// An output file format.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+pub enum Format {
+    /// 8-bit sRGB PNG.
+    Png,
+    /// OpenEXR: linear half-float R, G, B, A and a float Z (camera distance),
+    /// plus the layers --aov asks for.
+    Exr,
+}
+
+impl Format {
+    pub fn extension(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Exr => "exr",
+        }
+    }
+}
+
+/// Extra EXR layers (arbitrary output variables) a render can write.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    PartialEq,
+    Eq,
+    Hash,
+    PartialOrd,
+    Ord,
+    clap::ValueEnum,
+    Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Aov {
+    /// Surface normal: N.X, N.Y, N.Z.
+    Normal,
+    /// Orbit-trap albedo: albedo.R, albedo.G, albedo.B.
+    Albedo,
+    /// Orbit traps: trap.origin (smallest |z|²), trap.x, trap.y, trap.z.
+    Traps,
+    /// Distance estimates spent per pixel: DE (a cost heat map).
+    Steps,
+}
+
+impl Aov {
+    /// The layer's name, as `--aov` takes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Aov::Normal => "normal",
+            Aov::Albedo => "albedo",
+            Aov::Traps => "traps",
+            Aov::Steps => "steps",
+        }
+    }
+}
+
+/// The render layers `aovs` need.
+pub fn layers_for(aovs: &[Aov]) -> crate::render::Layers {
+    crate::render::Layers {
+        normal: aovs.contains(&Aov::Normal),
+        albedo: aovs.contains(&Aov::Albedo),
+        traps: aovs.contains(&Aov::Traps),
+    }
+}
+
+/// The frame's render statistics, as its file's `STATS_KEY` records them.
+fn stats_text(film: &Film) -> String {
+    format!(
+        "de_evaluations={} primary={} normals={} shadows={} occlusion={} bounces={} sun={} samples={} hits={} max_pixel_evaluations={} repaired_samples={} out_of_steps={}",
+        film.stats.de_evaluations,
+        film.stats.primary_evaluations,
+        film.stats.normal_evaluations,
+        film.stats.shadow_evaluations,
+        film.stats.occlusion_evaluations,
+        film.stats.bounce_evaluations,
+        film.stats.sun_evaluations,
+        film.stats.samples,
+        film.stats.hits,
+        film.stats.max_pixel_evaluations,
+        film.stats.repaired_samples,
+        film.stats.out_of_steps
+    )
+}
