@@ -9,8 +9,10 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod camera;
 pub mod claim;
 pub mod cli;
+pub mod color;
 pub mod environment;
 pub mod error;
 pub mod fractal;

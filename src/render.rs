@@ -547,7 +547,7 @@ struct FrameSetup<'a> {
     /// Samples per pixel, and the ones to take now.
     n: u32,
     samples: std::ops::Range<u32>,
-    cameras: Vec<crate::scene::CameraFrame>,
+    cameras: Vec<crate::camera::CameraFrame>,
     /// Fog is measured in camera–target distances, so zooms keep their haze.
     scales: Vec<Real>,
     /// An environment map is looked up once per frame, not per ray.

@@ -52,13 +52,13 @@ fn block_hits_at(
         }
     }
     let target = origin + dir * lo;
-    let camera = crate::scene::Camera {
+    let camera = crate::camera::Camera {
         position: target - dir * distance,
         target,
         up: DVec3::Y,
         roll_degrees: 0.0,
         fov_degrees: 40.0,
-        ..crate::scene::Camera::default()
+        ..crate::camera::Camera::default()
     }
     .frame();
     let settings = MarchSettings::default();
