@@ -8,9 +8,10 @@
 //! bisection (`march::march_by_membership`), and a shaded image of the same
 //! fractal with every marching knob set high (`reference_scene`).
 
+use crate::color::linear_to_srgb;
 use crate::fractal::{DeMethod, Precision};
 use crate::march::march_by_membership;
-use crate::math::{linear_to_srgb, Real};
+use crate::math::Real;
 use crate::render::{render_frame, Film};
 use crate::scene::Scene;
 use rayon::prelude::*;

@@ -9,7 +9,9 @@
 
 pub mod accuracy;
 pub mod bench;
+pub mod camera;
 pub mod cli;
+pub mod color;
 pub mod environment;
 pub mod error;
 pub mod fractal;

@@ -4,9 +4,9 @@
 //! form is also the timeline's `scene:` block, and its JSON serialisation is
 //! what each frame's content hash is taken over.
 
+use crate::camera::Camera;
 use crate::fractal::Fractal;
-use crate::march::{MarchSettings, Ray};
-use crate::math::{normalize_or, DVec3, Real};
+use crate::march::MarchSettings;
 use serde::{Deserialize, Serialize};
 
 /// The fewest samples a pixel for a smooth depth of field (each sample
@@ -16,121 +16,6 @@ pub const LENS_SAMPLES: u32 = 4;
 /// The fewest samples a pixel for motion blur to blur rather than show its
 /// separate instants; fewer render, with a warning.
 pub const MOTION_BLUR_SAMPLES: u32 = 8;
-
-/// A camera: a pinhole, or a thin lens when its aperture is open.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
-pub struct Camera {
-    pub position: DVec3,
-    pub target: DVec3,
-    /// Approximate up direction; the true up is made perpendicular to the view.
-    pub up: DVec3,
-    /// Rotation about the viewing direction, counter-clockwise as seen by the camera.
-    pub roll_degrees: Real,
-    /// Vertical field of view.
-    pub fov_degrees: Real,
-    /// Radius of the thin lens; 0 (the default) is a pinhole with no depth of field.
-    pub aperture_radius: Real,
-    /// Distance along the view direction that is in focus [default: the target's].
-    pub focus_distance: Option<Real>,
-}
-
-impl Default for Camera {
-    fn default() -> Self {
-        Camera {
-            position: DVec3::new(0.0, 0.6, 2.6),
-            target: DVec3::ZERO,
-            up: DVec3::Y,
-            roll_degrees: 0.0,
-            fov_degrees: 45.0,
-            aperture_radius: 0.0,
-            focus_distance: None,
-        }
-    }
-}
-
-/// Orthonormal camera frame with the image-plane half-height.
-#[derive(Clone, Copy, Debug)]
-pub struct CameraFrame {
-    pub origin: DVec3,
-    pub forward: DVec3,
-    pub right: DVec3,
-    pub up: DVec3,
-    pub tan_half_fov: Real,
-    pub aperture_radius: Real,
-    pub focus_distance: Real,
-}
-
-impl Camera {
-    /// Builds the camera's orthonormal frame. Validation guarantees position ≠
-    /// target and an up vector not parallel to the view; the fallbacks only keep
-    /// the maths finite.
-    pub fn frame(&self) -> CameraFrame {
-        let forward = normalize_or(self.target - self.position, -DVec3::Z);
-        let mut right = normalize_or(forward.cross(self.up), DVec3::X);
-        let mut up = right.cross(forward);
-        if self.roll_degrees != 0.0 {
-            let (s, c) = self.roll_degrees.to_radians().sin_cos();
-            (right, up) = (right * c + up * s, up * c - right * s);
-        }
-        CameraFrame {
-            origin: self.position,
-            forward,
-            right,
-            up,
-            tan_half_fov: (self.fov_degrees.to_radians() * 0.5).tan(),
-            aperture_radius: self.aperture_radius,
-            focus_distance: self
-                .focus_distance
-                .unwrap_or_else(|| (self.target - self.position).length()),
-        }
-    }
-}
-
-impl CameraFrame {
-    /// The ray through image position (`x`, `y`) in pixels from the top-left
-    /// corner (pixel centres at +0.5) of a `width`×`height` image.
-    pub fn ray(&self, x: Real, y: Real, width: u32, height: u32) -> Ray {
-        let (w, h) = (width as Real, height as Real);
-        let sx = (2.0 * x / w - 1.0) * self.tan_half_fov * (w / h);
-        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
-        let dir = (self.forward + self.right * sx + self.up * sy).normalize();
-        Ray {
-            origin: self.origin,
-            dir,
-            pixel_angle: 2.0 * self.tan_half_fov / h,
-            start_footprint: 0.0,
-        }
-    }
-}
-
-impl CameraFrame {
-    /// Whether the camera has a lens (depth of field) rather than a pinhole.
-    pub fn has_lens(&self) -> bool {
-        self.aperture_radius > 0.0
-    }
-
-    /// The ray through image position (`x`, `y`) from lens position (`u`, `v`)
-    /// in [0, 1)²: a thin lens focused at `focus_distance`. Every lens position
-    /// of one image position meets the others on the plane of focus.
-    pub fn lens_ray(&self, x: Real, y: Real, width: u32, height: u32, u: Real, v: Real) -> Ray {
-        let pinhole = self.ray(x, y, width, height);
-        if !self.has_lens() {
-            return pinhole;
-        }
-        let focus =
-            pinhole.origin + pinhole.dir * (self.focus_distance / pinhole.dir.dot(self.forward));
-        // Uniform point on the disc (polar mapping; the sampler is stratified
-        // in u already, so the mapping's distortion matters little).
-        let (radius, angle) = (u.sqrt() * self.aperture_radius, std::f64::consts::TAU * v);
-        let origin = self.origin + (self.right * angle.cos() + self.up * angle.sin()) * radius;
-        Ray {
-            origin,
-            dir: (focus - origin).normalize(),
-            ..pinhole
-        }
-    }
-}
 
 /// Everything needed to render one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -226,75 +111,5 @@ mod tests {
         s.fractal.de = crate::fractal::DeMethod::Analytic;
         s.effects.glow = Some(crate::shade::Glow::default());
         assert_eq!(s.cone_rays(), 1);
-    }
-
-    fn camera() -> Camera {
-        Camera {
-            position: DVec3::new(0.0, 0.0, 5.0),
-            target: DVec3::ZERO,
-            up: DVec3::Y,
-            roll_degrees: 0.0,
-            fov_degrees: 90.0,
-            ..Camera::default()
-        }
-    }
-
-    #[test]
-    fn centre_pixel_looks_at_target() {
-        let f = camera().frame();
-        let r = f.ray(50.0, 25.0, 100, 50);
-        assert!((r.dir - -DVec3::Z).length() < 1e-12);
-        assert!((r.pixel_angle - 2.0 / 50.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn corners_follow_fov_and_aspect() {
-        let f = camera().frame();
-        // fov 90°: the top edge is at 45° up; the right edge at atan(aspect).
-        let top = f.ray(50.0, 0.0, 100, 50);
-        assert!((top.dir.y - (0.5f64).sqrt()).abs() < 1e-12, "{}", top.dir);
-        let right = f.ray(100.0, 25.0, 100, 50);
-        assert!((right.dir.x / -right.dir.z - 2.0).abs() < 1e-12);
-        let left = f.ray(0.0, 25.0, 100, 50);
-        assert!(left.dir.x < 0.0);
-    }
-
-    #[test]
-    fn lens_rays_meet_on_the_plane_of_focus() {
-        let lens = Camera {
-            aperture_radius: 0.2,
-            focus_distance: Some(4.0),
-            ..camera()
-        }
-        .frame();
-        let pinhole = camera().frame();
-        // Without a lens, lens rays are the pinhole's.
-        let a = pinhole.lens_ray(30.0, 10.0, 100, 50, 0.7, 0.2);
-        assert_eq!(a.dir, pinhole.ray(30.0, 10.0, 100, 50).dir);
-        let through = |u: f64, v: f64| {
-            let r = lens.lens_ray(30.0, 10.0, 100, 50, u, v);
-            // Where the ray crosses the plane 4 in front of the camera (z = 1).
-            let t = (r.origin.z - 1.0) / -r.dir.z;
-            (r.origin, r.origin + r.dir * t)
-        };
-        let (o1, p1) = through(0.1, 0.3);
-        let (o2, p2) = through(0.9, 0.8);
-        assert!(o1 != o2, "different lens positions");
-        assert!((o1 - camera().position).length() <= 0.2 + 1e-12);
-        assert!((p1 - p2).length() < 1e-12, "{p1} vs {p2}");
-    }
-
-    #[test]
-    fn roll_rotates_the_up_vector() {
-        let rolled = Camera {
-            roll_degrees: 90.0,
-            ..camera()
-        }
-        .frame();
-        // Rolling 90° counter-clockwise turns the image's up towards the world's −x.
-        assert!((rolled.up - -DVec3::X).length() < 1e-12, "{}", rolled.up);
-        let frame = camera().frame();
-        assert!(frame.right.dot(frame.up).abs() < 1e-15);
-        assert!(frame.forward.dot(frame.up).abs() < 1e-15);
     }
 }

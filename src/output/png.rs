@@ -44,7 +44,7 @@ pub(crate) fn encode(
     // a twentieth of a small frame), a row at a time straight into place on
     // every thread.
     use rayon::prelude::*;
-    let srgb = crate::math::SrgbBytes::get();
+    let srgb = crate::color::SrgbBytes::get();
     let plain = look.is_plain_display();
     let row = (film.width as usize).max(1);
     let mut bytes = vec![0u8; film.colour.len() * 3];

@@ -287,10 +287,10 @@ fn rays_running_out_of_steps_are_counted_and_warned_of() {
 // marcher against `march_by_membership` (orbits alone, no estimate), ray by
 // ray over a small camera grid.
 
+use mandelreel::camera::Camera;
 use mandelreel::fractal::{DeMethod, Fractal, Precision};
 use mandelreel::march::{march, march_by_membership, MarchSettings, Ray};
 use mandelreel::math::DVec3;
-use mandelreel::scene::Camera;
 
 /// The bulb seen from 13 units, outside every bounding sphere below.
 fn far_camera() -> Camera {

@@ -1,0 +1,579 @@
+//! The vector kernel: 16 orbits side by side in SIMD registers (pulp),
+//! each lane bit-identical to the scalar orbit, finished into analytic
+//! estimates in the registers.
+
+use super::estimate::{distance_to_ball, no_bound_applies};
+#[cfg(test)]
+use super::orbit::Orbit;
+use super::orbit::ITERATIONS;
+use super::power::{
+    length_squared, powi, triplex_power_int_unchecked, triplex_power_trig, whole_power,
+};
+use super::{DeMethod, Estimate, Formula, Fractal, OrbitTraps, Precision, Triplex};
+use crate::math::{Arith, DVec3, Real, Vector};
+
+impl Fractal {
+    /// `N` orbits (Mandelbrot or Julia, stopping at the bailout) iterated
+    /// side by side in f64, each lane of a vector register holding one
+    /// orbit. Each lane does exactly the operations of `orbit`, so its
+    /// result is bit-identical. For whole powers; `None` otherwise.
+    /// Rendering takes `estimate_lanes`, which finishes the estimates in the
+    /// registers; this is what the tests hold the vector orbit to.
+    #[cfg(test)]
+    pub(super) fn orbit_lanes<const N: usize>(
+        &self,
+        points: [DVec3; N],
+    ) -> Option<[Orbit<f64>; N]> {
+        let n = whole_power(self.power)?;
+        let mut out = [Orbit::IDLE; N];
+        self.in_vectors(&points, n, &mut out);
+        Some(out)
+    }
+
+    /// Analytic estimates at `N` points at once, finished in the vector
+    /// registers their orbits ran in: bit-identical to `estimate` at each
+    /// point, faster in bulk. Other estimators, precisions and powers fall
+    /// back to one `estimate` per point.
+    pub fn estimate_lanes<const N: usize>(
+        &self,
+        points: [DVec3; N],
+        scales: [Real; N],
+    ) -> [Estimate; N] {
+        let mut out = [Estimate::IDLE; N];
+        self.estimate_lanes_into(&points, &scales, &mut out);
+        out
+    }
+
+    /// `estimate_lanes` into `out`, for callers that keep one array of
+    /// estimates from step to step.
+    pub fn estimate_lanes_into<const N: usize>(
+        &self,
+        points: &[DVec3; N],
+        scales: &[Real; N],
+        out: &mut [Estimate; N],
+    ) {
+        if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
+            if let Some(n) = whole_power(self.power) {
+                self.in_vectors(points, n, out);
+                return self.bound_lanes(points, out);
+            }
+        }
+        for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
+            *out = self.estimate(p, scale);
+        }
+    }
+
+    /// The bounds `estimate` puts on its estimator (`bounded`), on the
+    /// vector kernel's estimates, outside the kernel: a cheap test but for
+    /// the rare lane a bound applies to.
+    pub(super) fn bound_lanes(&self, points: &[DVec3], out: &mut [Estimate]) {
+        // `bounded`'s own first test, worked out once for all lanes.
+        let near = self.escape_radius::<f64>().min(2.0);
+        let critical = self.julia.is_some();
+        for (out, &p) in out.iter_mut().zip(points) {
+            if out.escaped && !no_bound_applies(p, out.iterations, near, critical) {
+                let (distance, orbits) =
+                    self.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
+                out.distance = distance;
+                out.orbits += orbits;
+            }
+        }
+    }
+
+    /// `points` run through the vector kernel for whole power `n`, one
+    /// vector at a time, each writing its results in place into `out`
+    /// (lanes past the points start outside the bailout ball and cost no
+    /// iterations), with the iterations counted for this thread.
+    #[inline(always)]
+    pub(super) fn in_vectors<const N: usize, Out: Finished>(
+        &self,
+        points: &[DVec3; N],
+        n: u32,
+        out: &mut [Out; N],
+    ) {
+        let arch = pulp::Arch::new();
+        for (chunk, out) in points.chunks(VECTOR).zip(out.chunks_mut(VECTOR)) {
+            // Chunks of points and of results have the same lengths.
+            if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
+                let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
+                arch.dispatch(Kernel {
+                    fractal: self,
+                    points: lanes,
+                    live: VECTOR,
+                    n,
+                    out: full,
+                });
+            } else {
+                let lanes: [DVec3; VECTOR] =
+                    std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
+                let mut full = [Out::IDLE; VECTOR];
+                arch.dispatch(Kernel {
+                    fractal: self,
+                    points: &lanes,
+                    live: chunk.len(),
+                    n,
+                    out: &mut full,
+                });
+                out.copy_from_slice(&full[..out.len()]);
+            }
+        }
+        let iterations: u64 = out.iter().map(|o| o.iterations() as u64).sum();
+        ITERATIONS.with(|count| count.set(count.get() + iterations));
+    }
+}
+
+/// A point for a lane with nothing to do: outside the bailout ball, so its
+/// orbit ends before the first iteration.
+pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
+
+/// Orbits the lane kernel takes per call: two AVX-512 registers of eight
+/// f64 in flight at once (with AVX2, two registers of four at a time, twice).
+pub const VECTOR: usize = 16;
+
+/// The most f64 lanes one register has (AVX-512's eight).
+pub(super) const REGISTER: usize = VECTOR / 2;
+
+/// One register's lanes in memory (the first `S::F64_LANES` used), aligned
+/// to a whole cache line so that moving a 512-bit register to or from it
+/// never splits across two lines, wherever the stack happens to be.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+pub(super) struct Stored([f64; REGISTER]);
+
+impl Stored {
+    const ZERO: Stored = Stored([0.0; REGISTER]);
+}
+
+impl std::ops::Deref for Stored {
+    type Target = [f64; REGISTER];
+    fn deref(&self) -> &[f64; REGISTER] {
+        &self.0
+    }
+}
+
+impl std::ops::DerefMut for Stored {
+    fn deref_mut(&mut self) -> &mut [f64; REGISTER] {
+        &mut self.0
+    }
+}
+
+/// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
+/// each instruction set and picked at run time by the processor (pulp's
+/// `Arch`: AVX-512, AVX2 with FMA, or plain scalar code), so one binary runs
+/// everywhere and uses the widest registers it finds. Each operation is
+/// written out as the vector instruction it is, so the speed does not rest
+/// on the compiler vectorising; Rust never fuses a multiply and an add
+/// unasked, so every version rounds exactly as the scalar `orbit` does.
+/// `Kernel<Estimate>` writes the analytic estimates, finished in the
+/// registers; `Kernel<Orbit<f64>>`, for the tests, the orbits. Only the first
+/// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
+/// register of nothing but padding is loaded but neither iterated nor
+/// finished, its results left as they were (`Finished::IDLE` from
+/// `in_vectors`).
+pub(super) struct Kernel<'a, Out> {
+    pub(super) fractal: &'a Fractal,
+    pub(super) points: &'a [DVec3; VECTOR],
+    pub(super) live: usize,
+    /// The whole power.
+    pub(super) n: u32,
+    pub(super) out: &'a mut [Out; VECTOR],
+}
+
+impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
+    type Output = ();
+
+    #[inline(always)]
+    fn with_simd<S: pulp::Simd>(self, simd: S) {
+        let Self {
+            fractal,
+            points,
+            live,
+            n,
+            out,
+        } = self;
+        run_vector(simd, fractal, points, live, n, out)
+    }
+}
+
+/// What a register's finished lanes become. A trait rather than a closure
+/// so it is inlined into the code compiled for the instruction set.
+pub(super) trait Finished: Copy {
+    const IDLE: Self;
+    /// The orbit iterations this result took.
+    fn iterations(&self) -> u32;
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Self],
+    );
+}
+
+#[cfg(test)]
+impl Finished for Orbit<f64> {
+    const IDLE: Self = Orbit::IDLE;
+    fn iterations(&self) -> u32 {
+        self.iterations
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        _: &[DVec3],
+        out: &mut [Self],
+    ) {
+        register.finish(fractal, out)
+    }
+}
+
+impl Finished for Estimate {
+    const IDLE: Self = Estimate::IDLE;
+    fn iterations(&self) -> u32 {
+        self.iterations
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Self],
+    ) {
+        register.estimates(fractal, points, out)
+    }
+}
+
+/// Runs the first `live` of `points` two registers at a time; each
+/// register, with its points, writes its lanes' results (`Finished::write`).
+/// Registers past `live` are skipped.
+#[inline(always)]
+pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
+    simd: S,
+    fractal: &Fractal,
+    points: &[DVec3; VECTOR],
+    live: usize,
+    n: u32,
+    out: &mut [Out; VECTOR],
+) {
+    // Registers are stored in `Stored` arrays of `REGISTER` lanes.
+    const { assert!(S::F64_LANES >= 1 && S::F64_LANES <= REGISTER) };
+    let lanes = S::F64_LANES;
+    // Two registers at a time: their dependency chains are independent,
+    // so the processor overlaps one's square roots and division with
+    // the other's multiplications instead of waiting.
+    let pairs = live.div_ceil(2 * lanes);
+    for (pair, (points, out)) in points
+        .chunks(2 * lanes)
+        .zip(out.chunks_mut(2 * lanes))
+        .take(pairs)
+        .enumerate()
+    {
+        // For power 8, one copy of the loop per convention, so those loops
+        // have no branch on either and unroll; other powers share one copy.
+        let f = fractal;
+        let (a, b) = match (f.formula, n) {
+            (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez),
+            (Formula::Asin, 8) => orbit_registers(simd, f, points, 8, Formula::Asin),
+            (Formula::WhiteNylander, 8) => {
+                orbit_registers(simd, f, points, 8, Formula::WhiteNylander)
+            }
+            (formula, n) => orbit_registers(simd, f, points, n, formula),
+        };
+        let (first, second) = out.split_at_mut(lanes);
+        Out::write(&a, f, &points[..lanes], first);
+        // A second register of padding alone has stayed where it started.
+        if live > (2 * pair + 1) * lanes {
+            Out::write(&b, f, &points[lanes..], second);
+        }
+    }
+}
+
+/// Two registers of orbits iterated in one loop (see `Register`).
+#[inline(always)]
+pub(super) fn orbit_registers<S: pulp::Simd>(
+    simd: S,
+    fractal: &Fractal,
+    points: &[DVec3],
+    n: u32,
+    formula: Formula,
+) -> (Register<S>, Register<S>) {
+    let lanes = points.len() / 2;
+    let mut a = Register::start(simd, fractal, &points[..lanes]);
+    let mut b = Register::start(simd, fractal, &points[lanes..]);
+    // Worked out once: the escape test runs every iteration.
+    let escape2 = fractal.escape_radius::<f64>().powi(2);
+    for _ in 0..fractal.iterations {
+        let (run_a, run_b) = (a.check(escape2), b.check(escape2));
+        if !(run_a || run_b) {
+            break;
+        }
+        if run_a {
+            a.step(formula, n);
+        }
+        if run_b {
+            b.step(formula, n);
+        }
+    }
+    (a, b)
+}
+
+/// One register of orbits: `OrbitState` on `Vector`s, each lane's state
+/// frozen by selection once it has escaped. Lanes near the pole axis take
+/// the trigonometric form one at a time, as `whole_power_step` does.
+#[derive(Clone, Copy)]
+pub(super) struct Register<S: pulp::Simd> {
+    simd: S,
+    z: Triplex<Vector<S>>,
+    c: Triplex<Vector<S>>,
+    plus_one: f64,
+    r2: Vector<S>,
+    r: Vector<S>,
+    dr: Vector<S>,
+    origin: Vector<S>,
+    planes: Triplex<Vector<S>>,
+    i: Vector<S>,
+    running: S::m64s,
+}
+
+impl<S: pulp::Simd> Register<S> {
+    #[inline(always)]
+    pub(super) fn splat(&self, v: f64) -> Vector<S> {
+        Vector::splat(self.simd, v)
+    }
+
+    #[inline(always)]
+    pub(super) fn select(&self, mask: S::m64s, new: Vector<S>, old: Vector<S>) -> Vector<S> {
+        Vector(self.simd, self.simd.select_f64s(mask, new.1, old.1))
+    }
+
+    #[inline(always)]
+    pub(super) fn any(&self, mask: S::m64s) -> bool {
+        self.simd.first_true_m64s(mask) < S::F64_LANES
+    }
+
+    #[inline(always)]
+    pub(super) fn store(v: Vector<S>) -> Stored {
+        let mut a = Stored::ZERO;
+        S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
+        a
+    }
+
+    #[inline(always)]
+    pub(super) fn load(simd: S, a: &Stored) -> Vector<S> {
+        Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
+    }
+
+    /// The orbits of `points` (one register's worth) before iterating.
+    #[inline(always)]
+    pub(super) fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
+        debug_assert_eq!(points.len(), S::F64_LANES);
+        let mut xyz = [Stored::ZERO; 3];
+        for (k, p) in points.iter().enumerate() {
+            (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
+        }
+        let z = [
+            Self::load(simd, &xyz[0]),
+            Self::load(simd, &xyz[1]),
+            Self::load(simd, &xyz[2]),
+        ];
+        let splat = |v: f64| Vector::splat(simd, v);
+        let (c, plus_one) = match fractal.julia {
+            Some(k) => ([splat(k.x), splat(k.y), splat(k.z)], 0.0),
+            None => (z, 1.0),
+        };
+        let r2 = length_squared(z);
+        let infinity = splat(Real::INFINITY);
+        Register {
+            simd,
+            z,
+            c,
+            plus_one,
+            r2,
+            r: r2.sqrt(),
+            dr: splat(1.0),
+            origin: infinity,
+            planes: [infinity; 3],
+            i: splat(0.0),
+            running: simd.equal_f64s(infinity.1, infinity.1),
+        }
+    }
+
+    /// Stops the lanes past the bailout (`OrbitState::outside`: a NaN
+    /// radius keeps iterating alike); whether any lane still runs.
+    #[inline(always)]
+    pub(super) fn check(&mut self, escape2: f64) -> bool {
+        let simd = self.simd;
+        let outside = self.outside(escape2);
+        self.running = simd.and_m64s(self.running, simd.not_m64s(outside));
+        self.any(self.running)
+    }
+
+    /// The lanes past the bailout (`OrbitState::outside`).
+    #[inline(always)]
+    pub(super) fn outside(&self, escape2: f64) -> S::m64s {
+        self.simd
+            .greater_than_f64s(self.r2.1, self.splat(escape2).1)
+    }
+
+    /// `OrbitState::step` on the running lanes.
+    #[inline(always)]
+    pub(super) fn step(&mut self, formula: Formula, n: u32) {
+        let simd = self.simd;
+        let (one, infinity) = (self.splat(1.0), self.splat(Real::INFINITY));
+        let (z, running) = (self.z, self.running);
+        let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n, one);
+        // `triplex_power_int`'s test, lane by lane.
+        let finite = |v: Vector<S>| simd.less_than_f64s(simd.abs_f64s(v.1), infinity.1);
+        let usable = simd.and_m64s(
+            simd.greater_than_f64s(rho2.1, (self.splat(1e-12) * power_r2).1),
+            simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
+        );
+        let near_axis = simd.and_m64s(running, simd.not_m64s(usable));
+        if self.any(near_axis) {
+            let flags = Self::store(self.select(near_axis, one, self.splat(0.0)));
+            let exact =
+                near_axis_powers(formula, z.map(Self::store), Self::store(self.r), n, &flags);
+            for axis in 0..3 {
+                let fixed = Self::load(simd, &exact[axis]);
+                w[axis] = self.select(near_axis, fixed, w[axis]);
+            }
+        }
+        // The traps, as the scalar step: f64::min for the origin trap (a NaN never
+        // replaces a number), glam's `if a < b { a } else { b }` for the
+        // planes (a NaN |z| does).
+        let lesser =
+            |a: Vector<S>, b: Vector<S>| simd.select_f64s(simd.less_than_f64s(a.1, b.1), a.1, b.1);
+        let origin = simd.select_f64s(
+            simd.less_than_f64s(self.r2.1, self.origin.1),
+            self.r2.1,
+            self.origin.1,
+        );
+        self.origin = Vector(simd, simd.select_f64s(running, origin, self.origin.1));
+        for (plane, z) in self.planes.iter_mut().zip(z) {
+            let next = lesser(*plane, Vector(simd, simd.abs_f64s(z.1)));
+            *plane = Vector(simd, simd.select_f64s(running, next, plane.1));
+        }
+        let power = self.splat(n as Real);
+        let dr = power * powi(self.r, n - 1, |a, b| a * b) * self.dr + self.splat(self.plus_one);
+        self.dr = self.select(running, dr, self.dr);
+        let c = self.c;
+        let next_z = [w[0] + c[0], w[1] + c[1], w[2] + c[2]];
+        let next_r2 = length_squared(next_z);
+        self.r2 = self.select(running, next_r2, self.r2);
+        self.r = self.select(running, next_r2.sqrt(), self.r);
+        for axis in 0..3 {
+            self.z[axis] = self.select(running, next_z[axis], z[axis]);
+        }
+        self.i = self.select(running, self.i + one, self.i);
+    }
+
+    /// The finished orbits, into `out` (one per lane).
+    #[cfg(test)]
+    #[inline(always)]
+    pub(super) fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
+        let store = Self::store;
+        let (z, planes) = (self.z.map(store), self.planes.map(store));
+        let [origin, r2, r, dr, i] = [self.origin, self.r2, self.r, self.dr, self.i].map(store);
+        let escape = fractal.escape_radius::<f64>();
+        for (k, out) in out.iter_mut().enumerate() {
+            let traps = OrbitTraps {
+                origin: origin[k],
+                planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+            };
+            let end = [z[0][k], z[1][k], z[2][k]];
+            *out = Orbit::ended(end, r2[k], r[k], dr[k], traps, i[k] as u32, escape);
+        }
+    }
+
+    /// The analytic estimates at `points` (one per lane) from the finished
+    /// orbits, into `out`: `estimate_from_orbit`'s formula, its logarithm
+    /// and division taken in the registers, and so is the choice among its
+    /// cases and the traps' ending (`Orbit::ended`), exact as selections;
+    /// a point outside the bailout from the start, which is rare, goes
+    /// lane by lane.
+    #[inline(always)]
+    pub(super) fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
+        // The analytic estimator in f64 is the only one finished here
+        // (`estimate_lanes_into` sends the others one point at a time).
+        debug_assert!(fractal.de == DeMethod::Analytic && fractal.precision == Precision::F64);
+        let simd = self.simd;
+        let (r, dr) = (self.r, self.dr);
+        let (zero, one, infinity) = (self.splat(0.0), self.splat(1.0), self.splat(Real::INFINITY));
+        // `half_r_ln_r_over`, operation for operation.
+        let raw = self.splat(0.5) * crate::math::ln_in_range(r) * r / dr;
+        // The cases of `estimate_from_orbit`. An escaped orbit that took a
+        // step ends with r in `in_ln_range` (at least ½ and finite), or
+        // else its estimate is not above 0 or not finite, which
+        // `as_distance` makes 0 as it does here: so one selection holds
+        // `as_distance` and every case but the rare one.
+        let escaped = self.outside(fractal.escape_radius::<f64>().powi(2));
+        let stepped = simd.greater_than_or_equal_f64s(self.i.1, one.1);
+        let in_range = simd.and_m64s(
+            simd.greater_than_or_equal_f64s(r.1, self.splat(0.5).1),
+            simd.less_than_f64s(r.1, infinity.1),
+        );
+        let usual = simd.and_m64s(
+            simd.and_m64s(escaped, simd.and_m64s(stepped, in_range)),
+            simd.and_m64s(
+                simd.greater_than_f64s(raw.1, zero.1),
+                simd.less_than_f64s(raw.1, infinity.1),
+            ),
+        );
+        let distance = self.select(usual, raw, zero);
+        let rare = simd.and_m64s(escaped, simd.not_m64s(stepped));
+        // `OrbitTraps::ended`: an orbit whose origin trap is still +∞ met
+        // no trap and takes those of where it ended (its |z|² is `r2`,
+        // computed as `length_squared` computes it).
+        let untrapped = simd.equal_f64s(self.origin.1, infinity.1);
+        let origin = self.select(untrapped, self.r2, self.origin);
+        // No closures: inside pulp's instruction-set functions one may not
+        // be inlined, which would make each vector operation a call.
+        let mut planes = [Stored::ZERO; 3];
+        for ((plane, z), met) in planes.iter_mut().zip(self.z).zip(self.planes) {
+            let end = Vector(simd, simd.abs_f64s(z.1));
+            *plane = Self::store(self.select(untrapped, end, met));
+        }
+        let store = Self::store;
+        let (distance, origin) = (store(distance), store(origin));
+        let (i, escaped) = (store(self.i), store(self.select(escaped, one, zero)));
+        for (k, out) in out.iter_mut().enumerate() {
+            *out = Estimate {
+                distance: distance[k],
+                traps: OrbitTraps {
+                    origin: origin[k],
+                    planes: DVec3::new(planes[0][k], planes[1][k], planes[2][k]),
+                },
+                iterations: i[k] as u32,
+                escaped: escaped[k] != 0.0,
+                orbits: 1,
+            };
+        }
+        if self.any(rare) {
+            let rare = store(self.select(rare, one, zero));
+            for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
+                out[k].distance = distance_to_ball(points[k], fractal.escape_radius::<f64>());
+            }
+        }
+    }
+}
+
+/// The trigonometric power of the lanes flagged (non-zero) in `which`, as
+/// `whole_power_step` takes it near the pole axis; other lanes are left 0.
+/// Rare, and out of line so the vector loop keeps its registers.
+#[cold]
+#[inline(never)]
+pub(super) fn near_axis_powers(
+    formula: Formula,
+    z: [Stored; 3],
+    r: Stored,
+    n: u32,
+    which: &Stored,
+) -> [Stored; 3] {
+    let mut out = [Stored::ZERO; 3];
+    for k in (0..REGISTER).filter(|&k| which[k] != 0.0) {
+        let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
+        for axis in 0..3 {
+            out[axis][k] = exact[axis];
+        }
+    }
+    out
+}

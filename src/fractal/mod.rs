@@ -1,0 +1,194 @@
+//! The Mandelbulb itself: the triplex power for each angle convention (whole
+//! powers by complex squaring, without trigonometry), one iteration driver
+//! (bailout, running derivative, orbit traps, Julia mode) generic over f64, f32
+//! and dual numbers, its vector twin that iterates 16 orbits in SIMD registers
+//! bit-identically (`estimate_lanes`), and five distance
+//! estimators built on them.
+//!
+//! Sources: the spherical power and the scalar running derivative
+//! `dr ← n·r^(n−1)·dr (+1 in Mandelbrot mode)` with `DE = ½·ln(r)·r/dr`: seeds
+//! 002 (course notes) and 001 (Christensen, "distance estimated 3D fractals",
+//! parts V–VI, which also gives the potential-gradient, sinh and escape-length
+//! estimators and their costs); the y-up convention, the power-8 polynomial
+//! (now only a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
+//! "Coloring").
+
+use crate::math::{DVec3, Real};
+use serde::{Deserialize, Serialize};
+
+/// Which spherical-coordinate convention defines the triplex power.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum Formula {
+    /// Quilez's y-up form: θ = acos(y/r), φ = atan2(x, z).
+    Quilez,
+    /// The White–Nylander z-up form: θ = acos(z/r), φ = atan2(y, x).
+    WhiteNylander,
+    /// The asin form Mandelbulber2's "Mandelbulb" formula uses: θ = asin(z/r), φ = atan2(y, x).
+    Asin,
+}
+
+impl Formula {
+    pub fn name(self) -> &'static str {
+        match self {
+            Formula::Quilez => "Quilez",
+            Formula::WhiteNylander => "WhiteNylander",
+            Formula::Asin => "Asin",
+        }
+    }
+}
+
+/// How the distance to the surface is estimated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+pub enum DeMethod {
+    /// ½·ln r·r/dr with the running scalar derivative (one orbit).
+    Analytic,
+    /// Quilez's potential gradient ½·G/|∇G|, G = ln r/n^k, gradient by finite differences (five orbits).
+    Potential,
+    /// Christensen's sinh form ½·sinh G/(e^G·|∇G|) (five orbits).
+    SinhPotential,
+    /// Escape-length gradient ½·r·ln r/|∇r|, every sample at the centre's iteration count (five orbits).
+    EscapeLength,
+    /// Forward-mode derivatives: ½·r·ln r/‖J‖₂ with J the 3×3 Jacobian of z_k and ‖·‖₂ its
+    /// spectral norm (largest stretch), carried through one orbit of dual numbers.
+    Jacobian,
+}
+
+impl DeMethod {
+    pub const ALL: [DeMethod; 5] = [
+        DeMethod::Analytic,
+        DeMethod::Potential,
+        DeMethod::SinhPotential,
+        DeMethod::EscapeLength,
+        DeMethod::Jacobian,
+    ];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            DeMethod::Analytic => "Analytic",
+            DeMethod::Potential => "Potential",
+            DeMethod::SinhPotential => "SinhPotential",
+            DeMethod::EscapeLength => "EscapeLength",
+            DeMethod::Jacobian => "Jacobian",
+        }
+    }
+}
+
+/// Floating-point precision of the distance-estimator kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+pub enum Precision {
+    F64,
+    /// Single precision, as GPU renderers use; marching itself stays f64.
+    F32,
+}
+
+impl Precision {
+    pub fn name(self) -> &'static str {
+        match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        }
+    }
+}
+
+/// Parameters of the fractal for one frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Fractal {
+    pub formula: Formula,
+    /// The exponent n of the triplex power (any real; 8 is the classic bulb).
+    pub power: Real,
+    /// Maximum orbit length.
+    pub iterations: u32,
+    /// Escape radius; must exceed 1 so ln(r) is positive at escape.
+    pub bailout: Real,
+    /// `None` for the Mandelbrot mode (z₀ = c = p), `Some(k)` for the Julia set of constant k.
+    pub julia: Option<DVec3>,
+    /// Distance estimator.
+    pub de: DeMethod,
+    /// Precision of the estimator's arithmetic.
+    pub precision: Precision,
+}
+
+impl Default for Fractal {
+    fn default() -> Self {
+        Fractal {
+            formula: Formula::Quilez,
+            power: 8.0,
+            iterations: 12,
+            bailout: 4.0,
+            julia: None,
+            de: DeMethod::Analytic,
+            precision: Precision::F64,
+        }
+    }
+}
+
+/// Minimum distances of the orbit to the four traps of Quilez's colouring.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OrbitTraps {
+    /// Smallest |z|² over the orbit (the point trap at the origin).
+    pub origin: Real,
+    /// Smallest |z.x|, |z.y|, |z.z| (the planes x=0, y=0, z=0).
+    pub planes: DVec3,
+}
+
+impl OrbitTraps {
+    /// The traps of an orbit that ended at `z`: those it met, or `z`'s own
+    /// for a point outside the bailout from the start, which met none.
+    #[inline(always)]
+    fn ended(self, z: [Real; 3]) -> OrbitTraps {
+        if self.origin == Real::INFINITY {
+            let zv = DVec3::from_array(z);
+            OrbitTraps {
+                origin: zv.length_squared(),
+                planes: zv.abs(),
+            }
+        } else {
+            self
+        }
+    }
+}
+
+/// What one evaluation of the distance estimator returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate {
+    /// Lower bound on the distance to the surface; 0 for points that never escape.
+    pub distance: Real,
+    pub traps: OrbitTraps,
+    /// Iterations done before escape (equal to the limit when the orbit stayed bounded).
+    pub iterations: u32,
+    pub escaped: bool,
+    /// Orbits computed for this estimate (the cost: 1 for analytic, 5 for gradient methods).
+    pub orbits: u32,
+}
+
+impl Estimate {
+    /// A placeholder: where the kernel skips a register of padding, its
+    /// lanes keep this (zero iterations, zero orbits).
+    pub const IDLE: Estimate = Estimate {
+        distance: 0.0,
+        traps: OrbitTraps {
+            origin: 0.0,
+            planes: DVec3::ZERO,
+        },
+        iterations: 0,
+        escaped: false,
+        orbits: 0,
+    };
+}
+
+/// A point of the kernel's number type.
+pub type Triplex<T> = [T; 3];
+
+mod estimate;
+mod kernel;
+mod orbit;
+mod power;
+
+pub use estimate::{spectral_norm, TETRAHEDRON};
+pub use kernel::{IDLE_POINT, VECTOR};
+pub use orbit::{iterations_on_this_thread, Orbit};
+pub use power::{power8_polynomial, powi, triplex_power_int, triplex_power_trig, whole_power};
+
+#[cfg(test)]
+mod tests;

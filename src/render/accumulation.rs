@@ -1,0 +1,139 @@
+//! A frame in progress: per-pixel running sums that waves of samples add
+//! to and a resumed render continues from.
+
+use super::band::{optional_bands, BAND_ROWS, BAND_TASKS};
+use super::film::{finish_pixels, Film, FilmPixels, Layers};
+use super::stats::FrameStats;
+use super::BACKGROUND_DEPTH;
+use crate::math::Vec3;
+use rayon::prelude::*;
+
+/// A frame in progress: per-pixel running sums over the samples done so far,
+/// enough to continue it later. Samples are always added to a pixel in
+/// sample order, so a frame rendered in waves, or resumed from a saved
+/// accumulation, ends bit-identical to one rendered in one go.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Accumulation {
+    pub width: u32,
+    pub height: u32,
+    pub samples_done: u32,
+    pub colour: Vec<[f64; 3]>,
+    pub hits: Vec<u32>,
+    pub depth: Vec<f32>,
+    pub spent: Vec<u64>,
+    /// Layer sums; empty when the layer is not collected.
+    pub normal: Vec<Vec3>,
+    pub albedo: Vec<Vec3>,
+    pub traps: Vec<[f32; 4]>,
+    pub stats: FrameStats,
+}
+
+impl Accumulation {
+    /// Empty sums for `height` rows, every element written rather than left
+    /// to the allocator's zero pages: sums are read before they are
+    /// written, and a zero page first read and then written is copied on
+    /// write, each copy flushing the TLB of every other core running the
+    /// frame.
+    pub fn new(width: u32, height: u32, layers: Layers) -> Accumulation {
+        let mut acc = Accumulation::default();
+        acc.reset(width, height, layers);
+        acc
+    }
+
+    /// Empties the sums for `height` rows of `width`, keeping their memory.
+    pub(super) fn reset(&mut self, width: u32, height: u32, layers: Layers) {
+        fn refill<T: Clone>(v: &mut Vec<T>, n: usize, value: T) {
+            v.clear();
+            v.resize(n, value);
+        }
+        let pixels = width as usize * height as usize;
+        let layer = |on: bool| if on { pixels } else { 0 };
+        (self.width, self.height, self.samples_done) = (width, height, 0);
+        refill(&mut self.colour, pixels, [0.0; 3]);
+        refill(&mut self.hits, pixels, 0);
+        refill(&mut self.depth, pixels, BACKGROUND_DEPTH);
+        refill(&mut self.spent, pixels, 0);
+        refill(&mut self.normal, layer(layers.normal), Vec3::ZERO);
+        refill(&mut self.albedo, layer(layers.albedo), Vec3::ZERO);
+        refill(&mut self.traps, layer(layers.traps), [0.0; 4]);
+        self.stats = FrameStats::default();
+    }
+
+    /// The layers these sums collect.
+    pub(super) fn layers(&self) -> Layers {
+        Layers {
+            normal: !self.normal.is_empty(),
+            albedo: !self.albedo.is_empty(),
+            traps: !self.traps.is_empty(),
+        }
+    }
+
+    /// All the sums as one run of pixels (for a one-band accumulation, its band).
+    pub(super) fn all_mut(&mut self) -> RowSums<'_> {
+        RowSums {
+            colour: &mut self.colour,
+            hits: &mut self.hits,
+            depth: &mut self.depth,
+            spent: &mut self.spent,
+            normal: (!self.normal.is_empty()).then_some(&mut self.normal[..]),
+            albedo: (!self.albedo.is_empty()).then_some(&mut self.albedo[..]),
+            traps: (!self.traps.is_empty()).then_some(&mut self.traps[..]),
+        }
+    }
+
+    /// The sums a band of `BAND_ROWS` rows at a time, for rendering bands
+    /// in parallel, each band a task of its own (`with_max_len(1)`; see
+    /// `BAND_TASKS`).
+    pub(super) fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = RowSums<'_>> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let band = BAND_ROWS * w;
+        self.colour
+            .par_chunks_mut(band)
+            .zip(self.hits.par_chunks_mut(band))
+            .zip(self.depth.par_chunks_mut(band))
+            .zip(self.spent.par_chunks_mut(band))
+            .zip(optional_bands(&mut self.normal, w, h))
+            .zip(optional_bands(&mut self.albedo, w, h))
+            .zip(optional_bands(&mut self.traps, w, h))
+            .map(
+                |((((((colour, hits), depth), spent), normal), albedo), traps)| RowSums {
+                    colour,
+                    hits,
+                    depth,
+                    spent,
+                    normal,
+                    albedo,
+                    traps,
+                },
+            )
+            .with_max_len(BAND_TASKS)
+    }
+
+    /// The finished film, with `n` samples per pixel.
+    pub fn finish(self, n: u32) -> Film {
+        let mut film = Film::blank(self.width, self.height, self.layers());
+        let all = FilmPixels {
+            colour: &mut film.colour,
+            alpha: &mut film.alpha,
+            depth: &mut film.depth,
+            evaluations: &mut film.evaluations,
+            normal: film.normal.as_deref_mut(),
+            albedo: film.albedo.as_deref_mut(),
+            traps: film.traps.as_deref_mut(),
+        };
+        let max_pixel = finish_pixels(&self, n, all);
+        film.stats = self.stats.finished(max_pixel);
+        film
+    }
+}
+
+/// One band of an accumulation's sums.
+pub(super) struct RowSums<'a> {
+    pub(super) colour: &'a mut [[f64; 3]],
+    pub(super) hits: &'a mut [u32],
+    pub(super) depth: &'a mut [f32],
+    pub(super) spent: &'a mut [u64],
+    pub(super) normal: Option<&'a mut [Vec3]>,
+    pub(super) albedo: Option<&'a mut [Vec3]>,
+    pub(super) traps: Option<&'a mut [[f32; 4]]>,
+}

@@ -1,0 +1,437 @@
+//! Bands of rows rendered on rayon's threads: a band's camera rays in
+//! cones, its shadow, occlusion and path rays side by side, and the
+//! radiance of each sample.
+
+use super::accumulation::{Accumulation, RowSums};
+use super::stats::FrameStats;
+use super::subpixel;
+use crate::march::{normals_many, walk_many, MarchResult};
+use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
+use crate::scene::Scene;
+use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
+use rayon::prelude::*;
+
+/// What every band of one frame's rendering shares, worked out once.
+pub(super) struct FrameSetup<'a> {
+    pub(super) scenes: &'a [Scene],
+    pub(super) frame_index: u32,
+    pub(super) width: u32,
+    pub(super) height: u32,
+    /// Samples per pixel, and the ones to take now.
+    pub(super) n: u32,
+    pub(super) samples: std::ops::Range<u32>,
+    pub(super) cameras: Vec<crate::camera::CameraFrame>,
+    /// Fog is measured in camera–target distances, so zooms keep their haze.
+    pub(super) scales: Vec<Real>,
+    /// An environment map is looked up once per frame, not per ray.
+    pub(super) environment: Option<std::sync::Arc<crate::environment::EnvironmentMap>>,
+    pub(super) on_row: &'a (dyn Fn() + Sync),
+}
+
+impl<'a> FrameSetup<'a> {
+    pub(super) fn new(
+        scenes: &'a [Scene],
+        frame_index: u32,
+        width: u32,
+        height: u32,
+        samples: std::ops::Range<u32>,
+        on_row: &'a (dyn Fn() + Sync),
+    ) -> Self {
+        FrameSetup {
+            scenes,
+            frame_index,
+            width,
+            height,
+            n: scenes[0].samples_per_pixel.max(1),
+            samples,
+            cameras: scenes.iter().map(|s| s.camera.frame()).collect(),
+            scales: scenes
+                .iter()
+                .map(|s| (s.camera.position - s.camera.target).length())
+                .collect(),
+            environment: scenes[0]
+                .effects
+                .path_tracing
+                .as_ref()
+                .and_then(|pt| pt.sky.environment()),
+            on_row,
+        }
+    }
+}
+
+/// The image rows rendered together: the rows a block of cone rays can
+/// span (`march::CONE_BLOCK_ROWS`).
+pub(super) const BAND_ROWS: usize = crate::march::CONE_BLOCK_ROWS;
+
+/// Bands in one rayon task at most: one. Left to itself, rayon cuts an
+/// indexed loop into a few runs of bands and a thread works through its run
+/// in order, so a thread that runs out of work can take nothing from a
+/// run another thread has begun, and a frame whose costly bands bunch
+/// together ends on one thread.
+pub(super) const BAND_TASKS: usize = 1;
+
+/// Adds `frame.samples` of every pixel of the band of image rows from `y0`
+/// (as many as `sums` holds) to `sums`.
+pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> FrameStats {
+    let scenes = frame.scenes;
+    let w = frame.width as usize;
+    let rows = sums.colour.len() / w.max(1);
+    let mut stats = FrameStats::default();
+    // A band runs start to end on one thread, so this thread's
+    // count of orbit iterations measures exactly the band's.
+    let iterations_before = crate::fractal::iterations_on_this_thread();
+    // Each sample index at a time over the whole band, so the
+    // band's camera rays march side by side, a block of pixels to a cone
+    // (`march_camera_rays`); each
+    // pixel still takes its samples in order.
+    // This thread's buffers, kept from band to band: allocating
+    // and freeing them per band made the allocator hand pages
+    // back and fault them in again, flushing the other cores' TLBs.
+    let mut scratch = ROW_SCRATCH.take();
+    scratch.marched.resize(rows * w, MarchResult::default());
+    for s in frame.samples.clone() {
+        let k = s as usize % scenes.len();
+        let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
+        scratch.camera_rays(frame, scene, camera, y0, rows, s);
+        let RowScratch {
+            order,
+            runs,
+            rays,
+            marched,
+            surfaces,
+            walks,
+            shadows,
+            occluded,
+            cone_free,
+            paths,
+            ..
+        } = &mut scratch;
+        let (f, q) = (&scene.fractal, &scene.quality);
+        crate::march::march_camera_rays(rays, f, q, runs, marched, cone_free);
+        // Where each ray met the surface, with its normal (the band's hits
+        // four to a kernel call); each pixel's cost goes straight to its sum.
+        surfaces.clear();
+        surfaces.resize(rays.len(), None);
+        let hits = rays
+            .iter()
+            .zip(marched.iter())
+            .enumerate()
+            .filter_map(|(x, (ray, result))| Some((x, ray, result.hit.as_ref()?)));
+        normals_many(
+            hits,
+            &scene.fractal,
+            &scene.quality,
+            |i, ray, hit, (nrm, evals)| {
+                stats.normal_evaluations += evals as u64;
+                sums.spent[order[i]] += evals as u64;
+                surfaces[i] = Some(SurfacePoint::from_hit(ray, hit, nrm));
+            },
+        );
+        band_shadows(scene, surfaces, walks, shadows);
+        let mut outcomes = shadows.iter().copied();
+        band_occlusion(scene, surfaces, occluded);
+        let traced = band_paths(frame, scene, camera, y0, s, order, surfaces, paths);
+        for (i, ((ray, result), at)) in rays
+            .iter()
+            .zip(marched.iter())
+            .zip(surfaces.iter())
+            .enumerate()
+        {
+            // The pixel's offset in the band; its camera ray's cost first.
+            let p = order[i];
+            stats.primary_evaluations += result.evaluations as u64;
+            stats.out_of_steps += result.out_of_steps as u64;
+            sums.spent[p] += result.evaluations as u64;
+            let before = stats.stage_total();
+            let c = trace(
+                scene,
+                ray,
+                result,
+                at.as_ref(),
+                &mut outcomes,
+                occluded.get(i).copied().flatten(),
+                traced.get(i).copied(),
+                camera.up,
+                scale,
+                frame.environment.as_deref(),
+                &mut stats,
+            );
+            if let Some(at) = at.as_ref() {
+                sums.add_hit(p, scene, at);
+                stats.hits += 1;
+            }
+            debug_assert!(
+                c.is_finite(),
+                "non-finite sample at pixel ({}, {})",
+                p % w,
+                y0 + p / w
+            );
+            if !c.is_finite() {
+                stats.repaired_samples += 1;
+            }
+            let c = finite_or_zero(c);
+            sums.colour[p][0] += c.x as f64;
+            sums.colour[p][1] += c.y as f64;
+            sums.colour[p][2] += c.z as f64;
+            stats.samples += 1;
+            sums.spent[p] += stats.stage_total() - before;
+        }
+        debug_assert!(outcomes.next().is_none(), "a shadow outcome per ray walked");
+    }
+    ROW_SCRATCH.set(scratch);
+    stats.de_iterations += crate::fractal::iterations_on_this_thread() - iterations_before;
+    for _ in 0..rows {
+        (frame.on_row)();
+    }
+    stats
+}
+
+impl RowSums<'_> {
+    /// Adds a sample's hit at `at` to pixel `p`'s hit count, depth and the
+    /// layers collected.
+    pub(super) fn add_hit(&mut self, p: usize, scene: &Scene, at: &SurfacePoint) {
+        let &SurfacePoint {
+            t,
+            normal: nrm,
+            traps,
+            ..
+        } = at;
+        self.hits[p] += 1;
+        self.depth[p] = self.depth[p].min(t as f32);
+        if let Some(row) = self.normal.as_deref_mut() {
+            row[p] += nrm.as_vec3();
+        }
+        // Only a requested albedo layer pays for the albedo.
+        if let Some(row) = self.albedo.as_deref_mut() {
+            row[p] += scene.look.albedo(&traps);
+        }
+        if let Some(row) = self.traps.as_deref_mut() {
+            let v = [
+                traps.origin as f32,
+                traps.planes.x as f32,
+                traps.planes.y as f32,
+                traps.planes.z as f32,
+            ];
+            for k in 0..4 {
+                row[p][k] += v[k];
+            }
+        }
+    }
+}
+
+impl RowScratch {
+    /// The band's camera rays for sample `s`, block by block
+    /// (`cone_blocks`): ray i is the pixel `order[i]` of the band. Laid out
+    /// again only when the shape changes (a thread's bands and samples
+    /// mostly share one).
+    pub(super) fn camera_rays(
+        &mut self,
+        frame: &FrameSetup,
+        scene: &Scene,
+        camera: &crate::camera::CameraFrame,
+        y0: usize,
+        rows: usize,
+        s: u32,
+    ) {
+        let (width, height, n) = (frame.width, frame.height, frame.n);
+        let w = width as usize;
+        let layout = (w, rows, crate::march::cone_block(scene.cone_rays()));
+        if self.laid_out != Some(layout) {
+            crate::march::cone_blocks(w, rows, layout.2, &mut self.order, &mut self.runs);
+            self.laid_out = Some(layout);
+        }
+        self.rays.clear();
+        self.rays.extend(self.order.iter().map(|&p| {
+            let (x, y) = (p % w, y0 + p / w);
+            let pixel = (y0 * w + p) as u64;
+            let (ox, oy) = subpixel(scene, frame.frame_index, pixel, s, n);
+            if camera.has_lens() {
+                let u = sample_1d(scene.seed, frame.frame_index, pixel, s, 2);
+                let v = sample_1d(scene.seed, frame.frame_index, pixel, s, 3);
+                camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
+            } else {
+                camera.ray(x as Real + ox, y as Real + oy, width, height)
+            }
+        }));
+    }
+}
+
+/// The band's shadow rays, walked side by side. Shading takes their
+/// outcomes back in the same order, pixel after pixel.
+fn band_shadows(
+    scene: &Scene,
+    surfaces: &[Option<SurfacePoint>],
+    walks: &mut Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
+    shadows: &mut Vec<(f32, u64)>,
+) {
+    shadows.clear();
+    if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
+        walks.clear();
+        for at in surfaces.iter().flatten() {
+            walks.extend(scene.look.shadow_walks(&scene.effects, &scene.quality, at));
+        }
+        shadows.resize(walks.len(), (1.0, 0));
+        walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
+            shadows[i] = out
+        });
+    }
+}
+
+/// The band's path-traced samples, a bounce at a time side by side (none
+/// when the scene is not path traced).
+#[allow(clippy::too_many_arguments)] // the band's whole context, passed plainly
+fn band_paths<'p>(
+    frame: &FrameSetup,
+    scene: &Scene,
+    camera: &crate::camera::CameraFrame,
+    y0: usize,
+    s: u32,
+    order: &[usize],
+    surfaces: &[Option<SurfacePoint>],
+    paths: &'p mut crate::shade::PathScratch,
+) -> &'p [(Vec3, StageCounts)] {
+    let w = frame.width as usize;
+    match &scene.effects.path_tracing {
+        Some(pt) => {
+            let random = |i: usize, d: u32| {
+                sample_1d(
+                    scene.seed,
+                    frame.frame_index,
+                    (y0 * w + order[i]) as u64,
+                    s,
+                    d,
+                )
+            };
+            crate::shade::trace_paths(
+                &scene.look,
+                pt,
+                &scene.fractal,
+                &scene.quality,
+                surfaces,
+                camera.up,
+                frame.environment.as_deref(),
+                &random,
+                paths,
+            );
+            &paths.out[..]
+        }
+        None => &[][..],
+    }
+}
+
+/// The band's ambient occlusion, its samples packed across the hits
+/// (left empty when it is off, or replaced by path tracing).
+fn band_occlusion(
+    scene: &Scene,
+    surfaces: &[Option<SurfacePoint>],
+    occluded: &mut Vec<Option<(f32, u64)>>,
+) {
+    occluded.clear();
+    if let (None, Some(ao)) = (
+        &scene.effects.path_tracing,
+        &scene.effects.ambient_occlusion,
+    ) {
+        occluded.resize(surfaces.len(), None);
+        let hits = surfaces.iter().enumerate().filter_map(|(x, at)| {
+            let at = at.as_ref()?;
+            Some((x, at.point, at.normal, at.t, at.footprint))
+        });
+        crate::shade::occlusions(&scene.fractal, ao, hits, |x, out| occluded[x] = Some(out));
+    }
+}
+
+/// A band's working buffers (see `render_band`).
+#[derive(Default)]
+pub(super) struct RowScratch {
+    /// Each camera ray's pixel in the band, and the blocks' sizes
+    /// (`cone_blocks`), for the width, rows and block shape they were laid
+    /// out for.
+    pub(super) laid_out: Option<(usize, usize, (usize, usize))>,
+    pub(super) order: Vec<usize>,
+    pub(super) runs: Vec<u32>,
+    pub(super) rays: Vec<crate::march::Ray>,
+    pub(super) marched: Vec<MarchResult>,
+    /// Where each camera ray met the surface.
+    pub(super) surfaces: Vec<Option<SurfacePoint>>,
+    pub(super) walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
+    pub(super) shadows: Vec<(f32, u64)>,
+    /// Each pixel's ambient occlusion and its cost, where it hit.
+    pub(super) occluded: Vec<Option<(f32, u64)>>,
+    /// Each camera ray's bounding-sphere interval; where each run of them
+    /// may start, and what its cone cost.
+    pub(super) cone_free: crate::march::ConeScratch,
+    /// The band's path-traced samples, traced together.
+    pub(super) paths: crate::shade::PathScratch,
+}
+
+thread_local! {
+    pub(super) static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
+    /// One band's sums for `render_frame_into`, kept like `ROW_SCRATCH`.
+    pub(super) static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
+}
+
+/// Bands of `BAND_ROWS` rows of an optional layer for the parallel zip:
+/// `Some(band)` per band when the layer is collected, `None` for each band
+/// otherwise.
+pub(super) fn optional_bands<T: Send>(
+    layer: &mut [T],
+    width: usize,
+    height: usize,
+) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
+    let rows: Vec<Option<&mut [T]>> = if layer.is_empty() {
+        (0..height.div_ceil(BAND_ROWS)).map(|_| None).collect()
+    } else {
+        layer.chunks_mut(BAND_ROWS * width).map(Some).collect()
+    };
+    rows.into_par_iter()
+}
+
+/// The radiance of one camera sample, which met the surface at `at` or
+/// nothing. Shadow rays' outcomes come from `shadows` and its ambient
+/// occlusion from `occluded` (see `Look::shade_with`); a path-traced sample's light and counts from
+/// `traced` (see `trace_paths`). Only the stages of the scene's enabled
+/// effects run; `stats` counts each.
+#[allow(clippy::too_many_arguments)]
+fn trace(
+    scene: &Scene,
+    ray: &crate::march::Ray,
+    result: &MarchResult,
+    at: Option<&SurfacePoint>,
+    shadows: &mut dyn Iterator<Item = (f32, u64)>,
+    occluded: Option<(f32, u64)>,
+    traced: Option<(Vec3, StageCounts)>,
+    up: crate::math::DVec3,
+    scale: Real,
+    environment: Option<&crate::environment::EnvironmentMap>,
+    stats: &mut FrameStats,
+) -> Vec3 {
+    let Some(at) = at else {
+        let sky = match &scene.effects.path_tracing {
+            Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
+            None => scene.look.background(ray.dir, up),
+        };
+        let colour = match &scene.effects.glow {
+            Some(g) => sky + glow(g, result.closest),
+            None => sky,
+        };
+        return colour;
+    };
+    let mut stages = StageCounts::default();
+    let lit = match traced {
+        Some((radiance, counts)) => {
+            stages = counts;
+            radiance
+        }
+        None => scene
+            .look
+            .shade_with(&scene.effects, at, &mut stages, shadows, occluded),
+    };
+    stats.shadow_evaluations += stages.shadows;
+    stats.occlusion_evaluations += stages.occlusion;
+    stats.bounce_evaluations += stages.bounces;
+    stats.sun_evaluations += stages.sun_rays;
+    match &scene.effects.fog {
+        Some(fog) => fogged(lit, fog, at.t, scale),
+        None => lit,
+    }
+}

@@ -1,0 +1,215 @@
+//! The film: a rendered frame's pixels and layers, how a frame is
+//! finished from its sums, and what a frame size costs in memory.
+
+use super::accumulation::Accumulation;
+use super::band::{optional_bands, BAND_ROWS, BAND_TASKS};
+use super::sized;
+use super::stats::FrameStats;
+use crate::math::Vec3;
+use rayon::prelude::*;
+
+/// A rendered frame: linear colour, fractal coverage and camera distance per pixel.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Film {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB, row-major from the top-left pixel.
+    pub colour: Vec<Vec3>,
+    /// Share of the pixel's samples that hit the fractal.
+    pub alpha: Vec<f32>,
+    /// Distance from the camera to the nearest hit among the pixel's samples.
+    pub depth: Vec<f32>,
+    /// Orbits computed for the pixel (all samples): where the frame's time went.
+    pub evaluations: Vec<u32>,
+    /// Extra layers, present only when asked for (see `Layers`).
+    pub normal: Option<Vec<Vec3>>,
+    pub albedo: Option<Vec<Vec3>>,
+    /// Orbit traps: origin, then the x, y and z planes.
+    pub traps: Option<Vec<[f32; 4]>>,
+    pub stats: FrameStats,
+}
+
+impl Film {
+    /// A film of `width`×`height` with the layers asked for, for
+    /// `finish_pixels` to fill (see `Film::prepare`).
+    pub(super) fn blank(width: u32, height: u32, layers: Layers) -> Film {
+        let mut film = Film::default();
+        film.prepare(width, height, layers);
+        film
+    }
+
+    /// This film sized to `width`×`height` with the layers asked for, in
+    /// the buffers it already has where they are big enough, for
+    /// `finish_pixels` to fill: it writes every element of every buffer,
+    /// so no pass clears them first (a kept buffer that grows has only its
+    /// new tail zeroed). A sequence's frames thus reuse pages
+    /// already mapped, and a new buffer comes zeroed from the allocator:
+    /// when it maps fresh memory (glibc does for big blocks, until freeing
+    /// one raises its threshold and it clears reused memory instead, on
+    /// the calling thread), as untouched pages that the threads finishing
+    /// the bands fault in. (Filled on one thread first, as a new film once
+    /// was, that took 3.1–3.4 ms of a 640×480 frame; some 1 ms to clear a
+    /// reused one.)
+    pub(super) fn prepare(&mut self, width: u32, height: u32, layers: Layers) {
+        let pixels = width as usize * height as usize;
+        fn layer<T: bytemuck::Zeroable + Clone>(v: &mut Option<Vec<T>>, on: bool, n: usize) {
+            if on {
+                sized(v.get_or_insert_with(Vec::new), n)
+            } else {
+                *v = None
+            }
+        }
+        self.width = width;
+        self.height = height;
+        sized(&mut self.colour, pixels);
+        sized(&mut self.alpha, pixels);
+        sized(&mut self.depth, pixels);
+        sized(&mut self.evaluations, pixels);
+        layer(&mut self.normal, layers.normal, pixels);
+        layer(&mut self.albedo, layers.albedo, pixels);
+        layer(&mut self.traps, layers.traps, pixels);
+        self.stats = FrameStats::default();
+    }
+
+    /// Bytes per pixel of the buffers every film holds (colour, alpha,
+    /// depth, evaluations); the optional layers add to it.
+    pub const BYTES_PER_PIXEL: usize =
+        std::mem::size_of::<Vec3>() + std::mem::size_of::<f32>() * 2 + std::mem::size_of::<u32>();
+}
+
+/// Which extra per-pixel layers to collect. Each is averaged over the
+/// pixel's samples that hit; a layer not asked for costs no memory.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Layers {
+    pub normal: bool,
+    pub albedo: bool,
+    pub traps: bool,
+}
+
+impl Layers {
+    /// Bytes a pixel of these layers takes in a film (the normal and the
+    /// albedo three f32 each, the traps four).
+    pub(super) fn bytes_per_pixel(self) -> u64 {
+        12 * (self.normal as u64 + self.albedo as u64) + 16 * self.traps as u64
+    }
+}
+
+/// About the most memory rendering and writing one frame of `width`×
+/// `height` takes (upwards of it): the film (colour, alpha, depth and
+/// estimates, 24 bytes a pixel, and the layers); for an EXR as much again
+/// for its blocks, for a PNG its 3 bytes of sRGB codes and a byte of
+/// compressed data; and for a frame of several samples per pixel the
+/// running sums (colour in f64, hits, depth and estimates spent, 40 bytes a
+/// pixel, and the layers). What a size can be checked against before it is
+/// rendered.
+pub fn frame_bytes(width: u32, height: u32, layers: Layers, exr: bool, many_samples: bool) -> u64 {
+    let film = 24 + layers.bytes_per_pixel();
+    let encoding = if exr { film } else { 4 };
+    let sums = if many_samples {
+        40 + layers.bytes_per_pixel()
+    } else {
+        0
+    };
+    width as u64 * height as u64 * (film + encoding + sums)
+}
+
+/// Pixels of a film (a band, or all of them).
+pub(super) struct FilmPixels<'a> {
+    pub(super) colour: &'a mut [Vec3],
+    pub(super) alpha: &'a mut [f32],
+    pub(super) depth: &'a mut [f32],
+    pub(super) evaluations: &'a mut [u32],
+    pub(super) normal: Option<&'a mut [Vec3]>,
+    pub(super) albedo: Option<&'a mut [Vec3]>,
+    pub(super) traps: Option<&'a mut [[f32; 4]]>,
+}
+
+impl Film {
+    /// The film a band of `BAND_ROWS` rows at a time, for finishing bands
+    /// in parallel, each band a task of its own (see `BAND_TASKS`).
+    pub(super) fn bands_mut(&mut self) -> impl IndexedParallelIterator<Item = FilmPixels<'_>> {
+        let (w, h) = (self.width as usize, self.height as usize);
+        let band = BAND_ROWS * w;
+        let normal = self.normal.as_deref_mut().unwrap_or_default();
+        let albedo = self.albedo.as_deref_mut().unwrap_or_default();
+        let traps = self.traps.as_deref_mut().unwrap_or_default();
+        self.colour
+            .par_chunks_mut(band)
+            .zip(self.alpha.par_chunks_mut(band))
+            .zip(self.depth.par_chunks_mut(band))
+            .zip(self.evaluations.par_chunks_mut(band))
+            .zip(optional_bands(normal, w, h))
+            .zip(optional_bands(albedo, w, h))
+            .zip(optional_bands(traps, w, h))
+            .map(
+                |((((((colour, alpha), depth), evaluations), normal), albedo), traps)| FilmPixels {
+                    colour,
+                    alpha,
+                    depth,
+                    evaluations,
+                    normal,
+                    albedo,
+                    traps,
+                },
+            )
+            .with_max_len(BAND_TASKS)
+    }
+}
+
+/// Averages the sums of `sums` (all its pixels) over `n` samples into
+/// `out`, pixel for pixel; returns the most estimates one pixel took.
+pub(super) fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64 {
+    // Every element of `out` is written (a film is not cleared before:
+    // `Film::prepare`), which the zips below do only with sums as long.
+    let pixels = sums.colour.len();
+    let layer =
+        |out: Option<usize>, sums: usize| out.is_none_or(|len| len == pixels && sums == len);
+    debug_assert!(
+        [
+            out.colour.len(),
+            out.alpha.len(),
+            out.depth.len(),
+            out.evaluations.len()
+        ]
+        .into_iter()
+        .chain([sums.hits.len(), sums.depth.len(), sums.spent.len()])
+        .all(|len| len == pixels)
+            && layer(out.normal.as_ref().map(|v| v.len()), sums.normal.len())
+            && layer(out.albedo.as_ref().map(|v| v.len()), sums.albedo.len())
+            && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len()),
+        "a band's film and sums differ in size"
+    );
+    let inv = 1.0 / n as f64;
+    for (c, s) in out.colour.iter_mut().zip(&sums.colour) {
+        *c = Vec3::new(
+            (s[0] * inv) as f32,
+            (s[1] * inv) as f32,
+            (s[2] * inv) as f32,
+        );
+    }
+    for (a, &h) in out.alpha.iter_mut().zip(&sums.hits) {
+        *a = h as f32 / n as f32;
+    }
+    out.depth.copy_from_slice(&sums.depth);
+    for (e, &s) in out.evaluations.iter_mut().zip(&sums.spent) {
+        *e = s.min(u32::MAX as u64) as u32;
+    }
+    // A pixel no sample hit has zero layer sums, which stay zero.
+    let per_hit = |i: usize| 1.0 / sums.hits[i].max(1) as f32;
+    if let Some(normal) = out.normal {
+        for (o, v) in normal.iter_mut().zip(&sums.normal) {
+            *o = v.normalize_or_zero();
+        }
+    }
+    if let Some(albedo) = out.albedo {
+        for (i, (o, &v)) in albedo.iter_mut().zip(&sums.albedo).enumerate() {
+            *o = v * per_hit(i);
+        }
+    }
+    if let Some(traps) = out.traps {
+        for (i, (o, v)) in traps.iter_mut().zip(&sums.traps).enumerate() {
+            *o = v.map(|x| x * per_hit(i));
+        }
+    }
+    sums.spent.iter().copied().max().unwrap_or(0)
+}

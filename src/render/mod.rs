@@ -1,0 +1,140 @@
+//! Turning a scene into a film: camera rays, the deterministic sampler, bands
+//! of four rows of pixels spread over rayon's threads (a band's camera rays,
+//! in cones over blocks of pixels, and its shadow rays marched side by side),
+//! and per-frame counters.
+//!
+//! Every pixel depends only on (scene, frame, pixel, sample) and on the
+//! pixels its camera rays share a cone with (fixed by the image size and
+//! `quality.cone_rays`), never on which thread ran it or in which order, so
+//! the image is identical for any thread count.
+
+use crate::math::{sample_1d, Real};
+use crate::scene::Scene;
+use rayon::prelude::*;
+
+mod accumulation;
+mod band;
+mod film;
+mod stats;
+
+pub use accumulation::Accumulation;
+use band::{render_band, FrameSetup, BAND_ROWS, ROW_SUMS};
+use film::finish_pixels;
+pub use film::{frame_bytes, Film, Layers};
+pub use stats::FrameStats;
+
+/// Depth written for pixels that see only background.
+pub const BACKGROUND_DEPTH: f32 = 1.0e10;
+
+/// Sub-pixel offset of sample `s` of `n`: the centre for one sample; a
+/// jittered point in cell `s` of a k×k grid when n = k²; otherwise stratified
+/// in n rows with x uniform, which still covers the whole pixel evenly.
+fn subpixel(scene: &Scene, frame: u32, pixel: u64, s: u32, n: u32) -> (Real, Real) {
+    if n == 1 {
+        return (0.5, 0.5);
+    }
+    let jx = sample_1d(scene.seed, frame, pixel, s, 0);
+    let jy = sample_1d(scene.seed, frame, pixel, s, 1);
+    let k = (n as Real).sqrt().round() as u32;
+    if k * k == n {
+        let (cx, cy) = (s % k, s / k);
+        ((cx as Real + jx) / k as Real, (cy as Real + jy) / k as Real)
+    } else {
+        (jx, (s as Real + jy) / n as Real)
+    }
+}
+
+/// Renders `scene` at `width`×`height` as frame `frame_index`. `on_row` is called
+/// once per finished row (from any thread) for progress display.
+pub fn render_frame(
+    scene: &Scene,
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    on_row: &(dyn Fn() + Sync),
+) -> Film {
+    let mut film = Film::default();
+    render_frame_into(
+        &mut film,
+        std::slice::from_ref(scene),
+        frame_index,
+        width,
+        height,
+        Layers::default(),
+        on_row,
+    );
+    film
+}
+
+/// Renders into `film` a frame whose samples see `scenes` in turn (sample
+/// s the scene s mod len): one scene for a still instant, one per sample
+/// for motion blur. The film's buffers are reused (see `Film::prepare`), so
+/// a sequence's frames can share one; the pixels are those of a new film,
+/// bit for bit.
+pub fn render_frame_into(
+    film: &mut Film,
+    scenes: &[Scene],
+    frame_index: u32,
+    width: u32,
+    height: u32,
+    layers: Layers,
+    on_row: &(dyn Fn() + Sync),
+) {
+    let n = scenes[0].samples_per_pixel.max(1);
+    let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
+    film.prepare(width, height, layers);
+    // Every band of rows renders in parallel into this thread's one-band
+    // sums (the running sums, f64 colour and counters, exist for a band at
+    // a time, not the frame) and is finished straight into its place in the
+    // film: no point where threads wait for each other.
+    film.stats = film
+        .bands_mut()
+        .enumerate()
+        .map(|(band, pixels)| {
+            let mut sums = ROW_SUMS.take();
+            let rows = pixels.colour.len() / width as usize;
+            sums.reset(width, rows as u32, layers);
+            let stats = render_band(&frame, band * BAND_ROWS, sums.all_mut());
+            let max_pixel = finish_pixels(&sums, n, pixels);
+            ROW_SUMS.set(sums);
+            stats.finished(max_pixel)
+        })
+        // `+` keeps the larger per-pixel maximum.
+        .reduce(FrameStats::default, |a, b| a + b);
+}
+
+/// `v` at `n` elements: kept, with whatever values it holds, where its
+/// buffer is big enough; else a new one of zeros from the allocator, whose
+/// untouched pages are faulted in by the first write to each.
+fn sized<T: bytemuck::Zeroable + Clone>(v: &mut Vec<T>, n: usize) {
+    if v.capacity() < n {
+        *v = bytemuck::zeroed_vec(n);
+    } else {
+        v.resize(n, T::zeroed());
+    }
+}
+
+/// Adds samples `acc.samples_done .. until` of every pixel to `acc`.
+pub fn render_samples(
+    scenes: &[Scene],
+    frame_index: u32,
+    acc: &mut Accumulation,
+    until: u32,
+    on_row: &(dyn Fn() + Sync),
+) {
+    let samples = acc.samples_done..until;
+    let frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
+    // One band of rows per task; rayon spreads bands over threads and each
+    // pixel depends only on its own samples and its band, so the result is
+    // independent of the split.
+    let stats = acc
+        .bands_mut()
+        .enumerate()
+        .map(|(band, sums)| render_band(&frame, band * BAND_ROWS, sums))
+        .reduce(FrameStats::default, |a, b| a + b);
+    acc.stats = acc.stats + stats;
+    acc.samples_done = until;
+}
+
+#[cfg(test)]
+mod tests;
