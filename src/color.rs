@@ -47,6 +47,16 @@ pub struct Display {
     pub tone_map: ToneMap,
 }
 
+/// The plain display: linear light as it is, clipped.
+impl Default for Display {
+    fn default() -> Self {
+        Display {
+            exposure: 1.0,
+            tone_map: ToneMap::Clip,
+        }
+    }
+}
+
 impl Display {
     /// Whether display values are the linear light itself (clipped):
     /// PNG coding then takes its plain path.

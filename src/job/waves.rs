@@ -91,7 +91,14 @@ impl Plan {
         look: &crate::shade::Look,
     ) -> anyhow::Result<FrameStats> {
         for &f in &self.formats {
-            output::frames::write_frame(&self.path(frame, f), f, film, hash, &self.aovs, look)?;
+            output::frames::write_frame(
+                &self.path(frame, f),
+                f,
+                film,
+                hash,
+                &self.aovs,
+                look.display_transform(),
+            )?;
         }
         let _ = std::fs::remove_file(crate::job::checkpoint::checkpoint_path(
             &self.out_dir,

@@ -48,7 +48,7 @@ pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -
         .map(|s| {
             let mut s = s.clone();
             s.look.exposure = 1.0;
-            s.look.tone_map = crate::shade::ToneMap::Clip;
+            s.look.tone_map = crate::color::ToneMap::Clip;
             s
         })
         .collect();
@@ -139,15 +139,15 @@ pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
 /// temporary file of a unique name in the same folder (so two renders into one
 /// folder never write into each other's file), are flushed to disk, and only
 /// then renamed over the final name.
-/// `look` decides how a PNG shows the film's linear light (its exposure
-/// and tone map); an EXR holds the linear light as it is.
+/// `display` decides how a PNG shows the film's linear light (exposure and
+/// tone map); an EXR holds the linear light as it is.
 pub fn write_frame(
     path: &Path,
     format: Format,
     film: &Film,
     hash: &str,
     aovs: &[Aov],
-    look: &crate::shade::Look,
+    display: crate::color::Display,
 ) -> Result<()> {
     let image_error = |temp: &Path, message: String| Error::Image {
         path: temp.to_path_buf(),
@@ -156,7 +156,7 @@ pub fn write_frame(
     let key = stored_key(format, hash, aovs);
     write_atomic(path, |writer, temp| match format {
         Format::Png => {
-            super::png::encode(writer, film, &key, look).map_err(|m| image_error(temp, m))
+            super::png::encode(writer, film, &key, display).map_err(|m| image_error(temp, m))
         }
         Format::Exr => {
             super::exr::encode(writer, film, &key, aovs).map_err(|m| image_error(temp, m))

@@ -13,7 +13,7 @@ pub(crate) fn encode(
     out: &mut impl Write,
     film: &Film,
     hash: &str,
-    look: &crate::shade::Look,
+    display: crate::color::Display,
 ) -> std::result::Result<(), String> {
     let mut encoder = png::Encoder::new(out, film.width, film.height);
     encoder.set_color(png::ColorType::Rgb);
@@ -45,7 +45,7 @@ pub(crate) fn encode(
     // every thread.
     use rayon::prelude::*;
     let srgb = crate::color::SrgbBytes::get();
-    let plain = look.is_plain_display();
+    let plain = display.is_plain();
     let row = (film.width as usize).max(1);
     let mut bytes = vec![0u8; film.colour.len() * 3];
     bytes
@@ -55,7 +55,7 @@ pub(crate) fn encode(
             for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
                 for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
                     // At the default display the light is coded as it is.
-                    *byte = srgb.byte(if plain { v } else { look.display(v) });
+                    *byte = srgb.byte(if plain { v } else { display.apply(v) });
                 }
             }
         });

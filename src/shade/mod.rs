@@ -11,7 +11,6 @@
 //! estimate (the smallest k·h/t along the shadow march); distance-field
 //! occlusion compares the estimate with the distance stepped along the normal.
 
-pub use crate::color::ToneMap;
 use crate::fractal::OrbitTraps;
 use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};

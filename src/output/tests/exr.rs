@@ -61,7 +61,7 @@ fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
             film,
             "h",
             aovs,
-            &crate::shade::Look::default(),
+            crate::color::Display::default(),
         )
         .unwrap();
         let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();

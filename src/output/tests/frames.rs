@@ -28,7 +28,7 @@ fn hash_changes_with_any_input() {
     // PNG's key alone: the EXR's and the checkpoint's are the light's.
     let mut g = s.clone();
     g.look.exposure = 2.0;
-    g.look.tone_map = crate::shade::ToneMap::Filmic;
+    g.look.tone_map = crate::color::ToneMap::Filmic;
     let graded = frame_hash(std::slice::from_ref(&g), 0, 4, 3);
     assert_eq!(graded, format!("{h}~exposure=2,Filmic"));
     assert_eq!(light_hash(&graded), h);

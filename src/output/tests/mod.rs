@@ -19,7 +19,7 @@ fn write_plain(path: &Path, format: Format, film: &Film, hash: &str) {
         film,
         hash,
         &[],
-        &crate::shade::Look::default(),
+        crate::color::Display::default(),
     )
     .unwrap();
 }

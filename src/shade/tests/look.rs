@@ -1,6 +1,7 @@
 //! The filmic tone map and the look's serialised form.
 
 use super::*;
+use crate::color::ToneMap;
 
 #[test]
 fn the_filmic_curve_rolls_off_below_white_and_defaults_are_not_serialised() {
