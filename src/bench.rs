@@ -2,7 +2,7 @@
 //! frames, the distance-estimator kernel measured against the machine's
 //! floating-point peak, thread scaling, peak memory and depth error against
 //! the accuracy reference (Mandelbulber2's too, from its z-buffer); written
-//! to `bench/results/<machine>.csv` and a Markdown table for the README.
+//! to `bench/results/<machine>.csv` and the Markdown tables of docs/performance.md.
 //!
 //! Every render runs in its own process, timed from spawn to exit (start-up,
 //! parsing and PNG encoding included: what a user waits for), under a small
@@ -1185,7 +1185,7 @@ pub fn to_csv(rows: &[Row]) -> String {
     crate::output::csv::csv_text(rows)
 }
 
-/// The README's tables, made from the rows.
+/// The Markdown tables of docs/performance.md, made from the rows.
 pub fn to_markdown(rows: &[Row], peak: &Peak) -> String {
     let mut md = String::new();
     let machine = rows.first().map_or("", |r| r.machine.as_str());

@@ -1,9 +1,9 @@
 //! mandelreel: keyframed Mandelbulb films from RON timelines.
 //!
-//! Layers, each depending only on those after it:
-//! `cli → bench, accuracy → render, output → shade → march → fractal → math`, and `timeline → scene`;
-//! `interrupt` (what Ctrl-C cleans up) sits under `output` and `job`.
-//! `input` (reading the files a user names) sits below them all.
+//! Modules stand in layers, from the command line (`cli`) down through the
+//! job, the output files, the timeline and the renderer to the fractal and the
+//! arithmetic; each uses only the layers below it. docs/architecture.md lists
+//! them and tests/it/layers.rs holds the code to that list.
 
 #![forbid(unsafe_code)]
 
@@ -22,7 +22,6 @@ pub mod job;
 pub mod march;
 pub mod math;
 pub mod output;
-pub mod pick;
 pub mod render;
 pub mod scene;
 pub mod shade;

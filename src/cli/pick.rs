@@ -1,5 +1,5 @@
 //! `pick`: reads the frame and pixel asked for, and prints the point the
-//! ray through that pixel hits (`crate::pick`), as text or JSON.
+//! ray through that pixel hits (`crate::render::pick`), as text or JSON.
 
 use super::PickArgs;
 use crate::error::Error;
@@ -28,7 +28,8 @@ pub fn pick(args: PickArgs) -> anyhow::Result<()> {
     if x >= width || y >= height {
         return Err(bad().into());
     }
-    let report = crate::pick::pick(&t, args.frame, [x, y], [width, height]);
+    let report =
+        crate::render::pick::pick(&t.scene_at(args.frame), args.frame, [x, y], [width, height]);
     if args.json {
         out!("{}", serde_json::to_string(&report)?);
         return Ok(());

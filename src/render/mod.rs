@@ -15,6 +15,7 @@ use rayon::prelude::*;
 mod accumulation;
 mod band;
 mod film;
+pub mod pick;
 mod stats;
 
 pub use accumulation::Accumulation;

@@ -8,6 +8,7 @@ mod cli;
 mod farm;
 mod formats;
 mod fuzz;
+mod layers;
 mod limits;
 mod locations;
 mod resume;

@@ -1,4 +1,4 @@
-//! The stability catalogue (README "Stability"): each case fails on the
+//! The stability catalogue (docs/stability.md): each case fails on the
 //! naive formula, shown first, and passes on ours.
 
 use super::*;

@@ -29,4 +29,3 @@ mod cone;
 mod march;
 mod membership;
 mod normal;
-mod zoom;

@@ -2,7 +2,7 @@
 //! ray marched against one frame's fractal, for choosing a zoom target.
 
 use crate::march::{march, normal};
-use crate::timeline::Timeline;
+use crate::scene::Scene;
 use serde::Serialize;
 
 /// What the ray through one pixel meets, as `pick --json` prints it.
@@ -34,10 +34,9 @@ pub struct PickFractal {
 }
 
 /// Marches the ray through the centre of pixel (`x`, `y`) of a
-/// `width`×`height` image of `frame` of `timeline`. The frame and pixel
-/// must be inside the film and the image.
-pub fn pick(timeline: &Timeline, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
-    let scene = timeline.scene_at(frame);
+/// `width`×`height` image of `scene`, frame `frame` of its film. The pixel
+/// must be inside the image.
+pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
     let camera = scene.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
     let result = march(&ray, &scene.fractal, &scene.quality);

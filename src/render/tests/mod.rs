@@ -310,3 +310,5 @@ fn a_frame_rendered_in_waves_equals_one_rendered_at_once() {
     assert_eq!(waves.evaluations, at_once.evaluations);
     assert_eq!(at_once.colour.len(), (w * h) as usize);
 }
+
+mod zoom;

@@ -1,6 +1,8 @@
 //! Deep zooms: how far each precision keeps the surface sharp.
 
-use super::*;
+use crate::fractal::Fractal;
+use crate::march::*;
+use crate::math::{DVec3, Real};
 
 /// Hits (t and point) of an n×n block of pixels in the middle of a
 /// 1920×1080 frame, with the camera `distance` from a surface point,
@@ -189,7 +191,7 @@ fn distinct_depths(hits: &[(Real, DVec3, Real)]) -> usize {
 }
 
 #[test]
-#[ignore = "measurement for README: cargo test --release -- --ignored zoom_depth_limits --nocapture"]
+#[ignore = "measurement for docs/stability.md: cargo test --release -- --ignored zoom_depth_limits --nocapture"]
 fn zoom_depth_limits() {
     use crate::fractal::Precision;
     let distances = [
