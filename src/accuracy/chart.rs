@@ -310,6 +310,60 @@ fn text<E: std::fmt::Display>(e: E) -> String {
 }
 
 /// Renders the chart into an RGB buffer of `CHART_SIZE`.
+type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
+
+/// What every part of the chart draws a variant with: the variants plotted
+/// (every row but the reference, with its row index), their colours and labels.
+struct Variants<'r> {
+    rows: &'r [Measurement],
+    plotted: Vec<(usize, &'r Measurement)>,
+    colours: Vec<RGBColor>,
+    labels: Vec<String>,
+}
+
+impl<'r> Variants<'r> {
+    fn of(rows: &'r [Measurement]) -> Variants<'r> {
+        let plotted: Vec<(usize, &Measurement)> = rows
+            .iter()
+            .enumerate()
+            .filter(|(_, r)| r.knob != "reference")
+            .collect();
+        let mut knobs: Vec<&str> = Vec::new();
+        for (_, r) in &plotted {
+            if r.knob != "scene" && !knobs.contains(&r.knob) {
+                knobs.push(r.knob);
+            }
+        }
+        let colours = plotted
+            .iter()
+            .map(|(_, r)| {
+                knobs
+                    .iter()
+                    .position(|k| *k == r.knob)
+                    .map_or(BLACK, |i| KNOB_COLOURS[i % KNOB_COLOURS.len()])
+            })
+            .collect();
+        // Numbered from 1 in table order (the scene is first).
+        let labels = plotted
+            .iter()
+            .enumerate()
+            .map(|(n, (_, r))| {
+                if r.knob == "scene" {
+                    format!("{} scene", n + 1)
+                } else {
+                    (n + 1).to_string()
+                }
+            })
+            .collect();
+        Variants {
+            rows,
+            plotted,
+            colours,
+            labels,
+        }
+    }
+}
+
 fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geometry), String> {
     // Registering twice is harmless; a bad font would be a build error in practice.
     plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
@@ -317,235 +371,246 @@ fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geom
     let (w, h) = CHART_SIZE;
     let mut pixels = vec![255u8; (w * h * 3) as usize];
     let mut geometry = Geometry::default();
-    let candidates: Vec<(usize, &Measurement)> = rows
-        .iter()
-        .enumerate()
-        .filter(|(_, r)| r.knob != "reference")
-        .collect();
-    let mut knobs: Vec<&str> = Vec::new();
-    for (_, r) in &candidates {
-        if r.knob != "scene" && !knobs.contains(&r.knob) {
-            knobs.push(r.knob);
-        }
-    }
-    let colour = |r: &Measurement| {
-        knobs
-            .iter()
-            .position(|k| *k == r.knob)
-            .map_or(BLACK, |i| KNOB_COLOURS[i % KNOB_COLOURS.len()])
-    };
-    // Numbered from 1 in table order (the scene is first).
-    let label_of = |n: usize, r: &Measurement| {
-        if r.knob == "scene" {
-            format!("{n} scene")
-        } else {
-            n.to_string()
-        }
-    };
-    let label_font = ("sans-serif", 12).into_font().color(&BLACK);
-    let key_font = ("sans-serif", 13).into_font().color(&BLACK);
+    let variants = Variants::of(rows);
     {
         let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(text)?;
         let (top, _) = root.split_vertically(PANELS_HEIGHT);
         let top = top.titled(title, ("sans-serif", 22)).map_err(text)?;
-        let halves = top.split_evenly((1, 2));
-        let xs: Vec<f64> = candidates.iter().map(|(_, r)| r.seconds).collect();
-        for (area, panel) in halves.iter().zip(&PANELS) {
-            let ys: Vec<f64> = candidates
-                .iter()
-                .map(|(_, r)| (panel.error)(r).max(panel.floor))
-                .collect();
-            let (x0, x1) = log_range(&xs);
-            let (y0, y1) = log_range(&ys);
-            let light = |lo, hi| decade_values(lo, hi, MANTISSAS[3]);
-            let mut chart = ChartBuilder::on(area)
-                .caption(panel.title, ("sans-serif", 17))
-                .margin(10)
-                .margin_right(28)
-                .x_label_area_size(48)
-                .y_label_area_size(80)
-                .build_cartesian_2d(
-                    (x0..x1)
-                        .log_scale()
-                        .with_key_points(log_ticks(x0, x1, 9))
-                        .with_light_points(light(x0, x1)),
-                    (y0..y1)
-                        .log_scale()
-                        .with_key_points(log_ticks(y0, y1, 9))
-                        .with_light_points(light(y0, y1)),
-                )
-                .map_err(text)?;
-            chart
-                .configure_mesh()
-                .x_desc("median wall time per frame (s)")
-                .y_desc(panel.axis)
-                .x_label_formatter(&|v| tick_label(*v))
-                .y_label_formatter(&|v| tick_label(*v))
-                .label_style(("sans-serif", 13))
-                .axis_desc_style(("sans-serif", 14))
-                .bold_line_style(BLACK.mix(0.2))
-                .light_line_style(BLACK.mix(0.07))
-                .draw()
-                .map_err(text)?;
-            let (xr, yr) = chart.plotting_area().get_pixel_range();
-            let plot = Rect {
-                x0: xr.start,
-                y0: yr.start,
-                x1: xr.end,
-                y1: yr.end,
-            };
-            let points: Vec<(i32, i32)> = xs
-                .iter()
-                .zip(&ys)
-                .map(|(&x, &y)| chart.backend_coord(&(x, y)))
-                .collect();
-
-            // The front under the points.
-            let on_front = front_of(rows, panel.error);
-            let front: Vec<(f64, f64)> = candidates
-                .iter()
-                .zip(xs.iter().zip(&ys))
-                .filter(|((i, _), _)| on_front[*i])
-                .map(|(_, (&x, &y))| (x, y))
-                .collect();
-            let path: Vec<(i32, i32)> = step_path(&front)
-                .iter()
-                .map(|p| chart.backend_coord(p))
-                .collect();
-            root.draw(&PathElement::new(path, BLACK.stroke_width(2)))
-                .map_err(text)?;
-
-            for ((_, r), &p) in candidates.iter().zip(&points) {
-                for c in marker(p, colour(r), flagged(r), r.knob == "scene") {
-                    root.draw(&c).map_err(text)?;
-                }
-            }
-            let labels: Vec<String> = candidates
-                .iter()
-                .enumerate()
-                .map(|(n, (_, r))| label_of(n + 1, r))
-                .collect();
-            let sizes = labels
-                .iter()
-                .map(|l| {
-                    let (w, h) = root.estimate_text_size(l, &label_font).map_err(text)?;
-                    Ok((w as i32 + 1, h as i32))
-                })
-                .collect::<std::result::Result<Vec<_>, String>>()?;
-            let spots = place_labels(&points, &sizes, plot);
-            for ((label, spot), &p) in labels.iter().zip(&spots).zip(&points) {
-                if !Rect::around(p, POINT_RADIUS + 3).overlaps(spot) {
-                    let leader = vec![p, spot.nearest(p)];
-                    root.draw(&PathElement::new(leader, BLACK.mix(0.35)))
-                        .map_err(text)?;
-                }
-                root.draw(&Text::new(
-                    label.clone(),
-                    (spot.x0, spot.y0),
-                    label_font.clone(),
-                ))
-                .map_err(text)?;
-            }
+        for (area, panel) in top.split_evenly((1, 2)).iter().zip(&PANELS) {
+            let (plot, points, spots) = draw_panel(&root, area, panel, &variants)?;
             geometry.plots.push(plot);
             geometry.points.push(points);
             geometry.labels.push(spots);
         }
-
-        // The key, below both panels.
         geometry.key = Rect::sized(
             0,
             PANELS_HEIGHT as i32,
             w as i32,
             (h - PANELS_HEIGHT) as i32,
         );
-        let mut y = geometry.key.y0 + 8;
-        let mut x = 20;
-        let legend = [
-            (
-                "colour: knob; number: the list below",
-                KNOB_COLOURS[0],
-                false,
-                false,
-            ),
-            ("big ring: the scene's own settings", BLACK, false, true),
-            (
-                "red outline: overshoot > 0 or hit/miss differs on >= 0.1% of pixels",
-                KNOB_COLOURS[0],
-                true,
-                false,
-            ),
-        ];
-        for (words, fill, flag, scene) in legend {
-            for c in marker((x + 12, y + 8), fill, flag, scene) {
-                root.draw(&c).map_err(text)?;
-            }
-            root.draw(&Text::new(words, (x + 30, y), key_font.clone()))
-                .map_err(text)?;
-            x += 50 + root.estimate_text_size(words, &key_font).map_err(text)?.0 as i32;
-        }
-        y += 22;
-        root.draw(&PathElement::new(
-            vec![(20, y + 8), (44, y + 8), (44, y + 2)],
-            BLACK.stroke_width(2),
-        ))
-        .map_err(text)?;
-        let note = format!(
-            "step line: Pareto front of median time against that panel's error (times within {:.0}% are one cost); \
-             0 errors drawn at the floor; the reference is not plotted",
-            100.0 * (TIMING_NOISE - 1.0)
-        );
-        root.draw(&Text::new(note, (50, y), key_font.clone()))
-            .map_err(text)?;
-        y += 30;
-
-        let rows_per_column = ((geometry.key.y1 - 6 - y) / KEY_LINE).max(1) as usize;
-        let columns = candidates.len().div_ceil(rows_per_column).max(4);
-        let column_width = (w as i32 - 20) / columns as i32;
-        let char_width = root
-            .estimate_text_size("0000000000", &key_font)
-            .map_err(text)?
-            .0 as i32
-            / 10;
-        let fits = ((column_width - 28) / char_width.max(1)).max(4) as usize;
-        for (n, (_, r)) in candidates.iter().enumerate() {
-            let (cx, cy) = (
-                10 + (n / rows_per_column) as i32 * column_width,
-                y + (n % rows_per_column) as i32 * KEY_LINE,
-            );
-            let dot = (cx + 10, cy + 8);
-            for c in marker(dot, colour(r), flagged(r), false) {
-                root.draw(&c).map_err(text)?;
-            }
-            let mut words = format!("{:>2} {} {}", n + 1, r.knob, r.setting);
-            if flagged(r) {
-                words += &format!(
-                    " (over {:.2}%, hit/miss {:.2}%)",
-                    100.0 * r.overshoot,
-                    100.0 * r.hit_mismatch
-                );
-            }
-            if words.chars().count() > fits {
-                words = words.chars().take(fits - 1).collect::<String>() + "~";
-            }
-            let style = if flagged(r) {
-                key_font.clone().color(&FLAG)
-            } else {
-                key_font.clone()
-            };
-            let size = root.estimate_text_size(&words, &style).map_err(text)?;
-            root.draw(&Text::new(words, (cx + 22, cy), style))
-                .map_err(text)?;
-            geometry.key_entries.push(Rect::sized(
-                cx,
-                cy,
-                22 + size.0 as i32,
-                KEY_LINE.max(size.1 as i32),
-            ));
-        }
+        geometry.key_entries = draw_key(&root, geometry.key, &variants)?;
         root.present().map_err(text)?;
     }
     Ok((pixels, geometry))
+}
+
+/// One panel: its axes, the Pareto front as a step line, the points and
+/// their labels; returns the plotting area, the points and the labels' spots.
+#[allow(clippy::type_complexity)]
+fn draw_panel(
+    root: &Area,
+    area: &Area,
+    panel: &Panel,
+    variants: &Variants,
+) -> std::result::Result<(Rect, Vec<(i32, i32)>, Vec<Rect>), String> {
+    let plotted = &variants.plotted;
+    let xs: Vec<f64> = plotted.iter().map(|(_, r)| r.seconds).collect();
+    let ys: Vec<f64> = plotted
+        .iter()
+        .map(|(_, r)| (panel.error)(r).max(panel.floor))
+        .collect();
+    let (x0, x1) = log_range(&xs);
+    let (y0, y1) = log_range(&ys);
+    let light = |lo, hi| decade_values(lo, hi, MANTISSAS[3]);
+    let mut chart = ChartBuilder::on(area)
+        .caption(panel.title, ("sans-serif", 17))
+        .margin(10)
+        .margin_right(28)
+        .x_label_area_size(48)
+        .y_label_area_size(80)
+        .build_cartesian_2d(
+            (x0..x1)
+                .log_scale()
+                .with_key_points(log_ticks(x0, x1, 9))
+                .with_light_points(light(x0, x1)),
+            (y0..y1)
+                .log_scale()
+                .with_key_points(log_ticks(y0, y1, 9))
+                .with_light_points(light(y0, y1)),
+        )
+        .map_err(text)?;
+    chart
+        .configure_mesh()
+        .x_desc("median wall time per frame (s)")
+        .y_desc(panel.axis)
+        .x_label_formatter(&|v| tick_label(*v))
+        .y_label_formatter(&|v| tick_label(*v))
+        .label_style(("sans-serif", 13))
+        .axis_desc_style(("sans-serif", 14))
+        .bold_line_style(BLACK.mix(0.2))
+        .light_line_style(BLACK.mix(0.07))
+        .draw()
+        .map_err(text)?;
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let plot = Rect {
+        x0: xr.start,
+        y0: yr.start,
+        x1: xr.end,
+        y1: yr.end,
+    };
+    let points: Vec<(i32, i32)> = xs
+        .iter()
+        .zip(&ys)
+        .map(|(&x, &y)| chart.backend_coord(&(x, y)))
+        .collect();
+
+    // The front under the points.
+    let on_front = front_of(variants.rows, panel.error);
+    let front: Vec<(f64, f64)> = plotted
+        .iter()
+        .zip(xs.iter().zip(&ys))
+        .filter(|((i, _), _)| on_front[*i])
+        .map(|(_, (&x, &y))| (x, y))
+        .collect();
+    let path: Vec<(i32, i32)> = step_path(&front)
+        .iter()
+        .map(|p| chart.backend_coord(p))
+        .collect();
+    root.draw(&PathElement::new(path, BLACK.stroke_width(2)))
+        .map_err(text)?;
+    for (((_, r), &p), &fill) in plotted.iter().zip(&points).zip(&variants.colours) {
+        for c in marker(p, fill, flagged(r), r.knob == "scene") {
+            root.draw(&c).map_err(text)?;
+        }
+    }
+    let spots = draw_labels(root, &points, &variants.labels, plot)?;
+    Ok((plot, points, spots))
+}
+
+/// Each point's label beside it, where it overlaps nothing, with a leader
+/// line where it had to move away; returns where the labels went.
+fn draw_labels(
+    root: &Area,
+    points: &[(i32, i32)],
+    labels: &[String],
+    plot: Rect,
+) -> std::result::Result<Vec<Rect>, String> {
+    let label_font = ("sans-serif", 12).into_font().color(&BLACK);
+    let sizes = labels
+        .iter()
+        .map(|l| {
+            let (w, h) = root.estimate_text_size(l, &label_font).map_err(text)?;
+            Ok((w as i32 + 1, h as i32))
+        })
+        .collect::<std::result::Result<Vec<_>, String>>()?;
+    let spots = place_labels(points, &sizes, plot);
+    for ((label, spot), &p) in labels.iter().zip(&spots).zip(points) {
+        if !Rect::around(p, POINT_RADIUS + 3).overlaps(spot) {
+            let leader = vec![p, spot.nearest(p)];
+            root.draw(&PathElement::new(leader, BLACK.mix(0.35)))
+                .map_err(text)?;
+        }
+        root.draw(&Text::new(
+            label.clone(),
+            (spot.x0, spot.y0),
+            label_font.clone(),
+        ))
+        .map_err(text)?;
+    }
+    Ok(spots)
+}
+
+/// The key below both panels: what the marks mean, then every variant by
+/// number; returns where each variant's entry went.
+fn draw_key(root: &Area, key: Rect, variants: &Variants) -> std::result::Result<Vec<Rect>, String> {
+    let key_font = ("sans-serif", 13).into_font().color(&BLACK);
+    let mut y = key.y0 + 8;
+    let mut x = 20;
+    let legend = [
+        (
+            "colour: knob; number: the list below",
+            KNOB_COLOURS[0],
+            false,
+            false,
+        ),
+        ("big ring: the scene's own settings", BLACK, false, true),
+        (
+            "red outline: overshoot > 0 or hit/miss differs on >= 0.1% of pixels",
+            KNOB_COLOURS[0],
+            true,
+            false,
+        ),
+    ];
+    for (words, fill, flag, scene) in legend {
+        for c in marker((x + 12, y + 8), fill, flag, scene) {
+            root.draw(&c).map_err(text)?;
+        }
+        root.draw(&Text::new(words, (x + 30, y), key_font.clone()))
+            .map_err(text)?;
+        x += 50 + root.estimate_text_size(words, &key_font).map_err(text)?.0 as i32;
+    }
+    y += 22;
+    root.draw(&PathElement::new(
+        vec![(20, y + 8), (44, y + 8), (44, y + 2)],
+        BLACK.stroke_width(2),
+    ))
+    .map_err(text)?;
+    let note = format!(
+        "step line: Pareto front of median time against that panel's error (times within {:.0}% are one cost); \
+         0 errors drawn at the floor; the reference is not plotted",
+        100.0 * (TIMING_NOISE - 1.0)
+    );
+    root.draw(&Text::new(note, (50, y), key_font.clone()))
+        .map_err(text)?;
+    y += 30;
+    draw_key_entries(root, key, y, variants, &key_font)
+}
+
+/// The numbered list of variants, in columns from `top` to the key's foot.
+fn draw_key_entries(
+    root: &Area,
+    key: Rect,
+    top: i32,
+    variants: &Variants,
+    key_font: &TextStyle,
+) -> std::result::Result<Vec<Rect>, String> {
+    let plotted = &variants.plotted;
+    let rows_per_column = ((key.y1 - 6 - top) / KEY_LINE).max(1) as usize;
+    let columns = plotted.len().div_ceil(rows_per_column).max(4);
+    let column_width = (key.x1 - key.x0 - 20) / columns as i32;
+    let char_width = root
+        .estimate_text_size("0000000000", key_font)
+        .map_err(text)?
+        .0 as i32
+        / 10;
+    let fits = ((column_width - 28) / char_width.max(1)).max(4) as usize;
+    let mut entries = Vec::new();
+    for (n, ((_, r), &fill)) in plotted.iter().zip(&variants.colours).enumerate() {
+        let (cx, cy) = (
+            10 + (n / rows_per_column) as i32 * column_width,
+            top + (n % rows_per_column) as i32 * KEY_LINE,
+        );
+        for c in marker((cx + 10, cy + 8), fill, flagged(r), false) {
+            root.draw(&c).map_err(text)?;
+        }
+        let mut words = format!("{:>2} {} {}", n + 1, r.knob, r.setting);
+        if flagged(r) {
+            words += &format!(
+                " (over {:.2}%, hit/miss {:.2}%)",
+                100.0 * r.overshoot,
+                100.0 * r.hit_mismatch
+            );
+        }
+        if words.chars().count() > fits {
+            words = words.chars().take(fits - 1).collect::<String>() + "~";
+        }
+        let style = if flagged(r) {
+            key_font.clone().color(&FLAG)
+        } else {
+            key_font.clone()
+        };
+        let size = root.estimate_text_size(&words, &style).map_err(text)?;
+        root.draw(&Text::new(words, (cx + 22, cy), style))
+            .map_err(text)?;
+        entries.push(Rect::sized(
+            cx,
+            cy,
+            22 + size.0 as i32,
+            KEY_LINE.max(size.1 as i32),
+        ));
+    }
+    Ok(entries)
 }
 
 #[cfg(test)]
