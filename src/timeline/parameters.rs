@@ -77,7 +77,7 @@ pub const MIN_FOV_DEGREES: Real = 1e-7;
 
 /// Every animatable parameter, group by group in the order validation
 /// checks them (`validate_scene` runs each group's checks between the
-/// scene's other ones).
+/// scene's other ones; quality's and look's in `validate::*_CHECKS` order).
 pub const GROUPS: [&[Parameter]; 9] = [
     CAMERA,
     FRACTAL,

@@ -72,3 +72,28 @@ fn the_docs_table_of_parameters_is_the_generated_one() {
         path.display()
     );
 }
+
+#[test]
+fn validation_orders_name_each_quality_and_look_parameter_once() {
+    use crate::timeline::validate::{LOOK_CHECKS, QUALITY_CHECKS};
+    for (group, order) in [(QUALITY, &QUALITY_CHECKS[..]), (LOOK, &LOOK_CHECKS[..])] {
+        let mut names: Vec<&str> = group.iter().map(|p| p.name).collect();
+        let mut ordered = order.to_vec();
+        names.sort_unstable();
+        ordered.sort_unstable();
+        assert_eq!(names, ordered);
+    }
+}
+
+#[test]
+fn of_two_wrong_fields_validation_names_the_one_it_always_checked_first() {
+    use crate::timeline::validate_scene;
+    let mut s = Scene::default();
+    s.quality.normal_step = 0.0;
+    s.quality.fudge = 2.0;
+    assert_eq!(validate_scene(&s).unwrap_err().0, "quality.normal_step");
+    let mut s = Scene::default();
+    s.look.exposure = -1.0;
+    s.look.background_top = crate::math::Vec3::splat(-1.0);
+    assert_eq!(validate_scene(&s).unwrap_err().0, "look.background_top");
+}
