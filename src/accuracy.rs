@@ -233,10 +233,11 @@ pub fn reference_depths(
 /// The sRGB image of a film as its PNG shows it (`look`'s exposure and
 /// tone map), as 0..1 floats.
 fn srgb(film: &Film, look: &crate::shade::Look) -> Vec<f32> {
+    let display = look.display_transform();
     film.colour
         .iter()
         .flat_map(|c| [c.x, c.y, c.z])
-        .map(|x| linear_to_srgb(look.display(x)))
+        .map(|x| linear_to_srgb(display.apply(x)))
         .collect()
 }
 

@@ -39,7 +39,7 @@ pub fn frame_pattern(format: Format) -> String {
 /// grade re-renders no EXR-only sequence and keeps checkpoints.
 pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
     let look = &scenes[0].look;
-    let plain = scenes.iter().all(|s| s.look.is_plain_display());
+    let plain = scenes.iter().all(|s| s.look.display_transform().is_plain());
     if plain {
         return light_digest(scenes, frame_index, width, height);
     }

@@ -52,18 +52,6 @@ impl Look {
             tone_map: self.tone_map,
         }
     }
-
-    /// Whether display values are the linear light itself (clipped): PNG
-    /// coding then takes its plain path.
-    pub fn is_plain_display(&self) -> bool {
-        self.display_transform().is_plain()
-    }
-
-    /// The display value of linear `x` (`exposure`, then `tone_map`).
-    #[inline]
-    pub fn display(&self, x: f32) -> f32 {
-        self.display_transform().apply(x)
-    }
 }
 
 impl Default for Look {

@@ -155,6 +155,14 @@ fn colour_of(v: &[Real]) -> Vec3 {
     Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
+fn number(v: &[Real]) -> Real {
+    v[0]
+}
+
+fn number_f32(v: &[Real]) -> f32 {
+    v[0] as f32
+}
+
 fn count(v: &[Real]) -> u32 {
     v[0].round().clamp(0.0, u32::MAX as Real) as u32
 }
@@ -469,133 +477,94 @@ pub(super) const SHADOWS: &[Parameter] = &[Parameter {
     set: |s, v| s.effects.shadows.iter_mut().for_each(|x| x.softness = v[0]),
 }];
 
+/// A field of an optional effect: checked and set only where the scene
+/// enables the effect.
+macro_rules! effect_field {
+    ($name:literal, $effect:ident . $field:ident, $shape:ident, $check:path, $value:path) => {
+        Parameter {
+            name: $name,
+            shape: $shape,
+            doc: match $shape {
+                Number => EFFECT_NUMBER,
+                Triple => "triple",
+            },
+            check: |s| {
+                s.effects
+                    .$effect
+                    .as_ref()
+                    .map_or(Ok(()), |e| $check(e.$field))
+            },
+            set: |s, v| {
+                s.effects
+                    .$effect
+                    .iter_mut()
+                    .for_each(|e| e.$field = $value(v))
+            },
+        }
+    };
+}
+
 pub(super) const AMBIENT_OCCLUSION: &[Parameter] = &[
-    Parameter {
-        name: "effects.ambient_occlusion.radius",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            let ao = s.effects.ambient_occlusion.as_ref();
-            ao.map_or(Ok(()), |ao| positive(ao.radius))
-        },
-        set: |s, v| {
-            let ao = s.effects.ambient_occlusion.iter_mut();
-            ao.for_each(|x| x.radius = v[0])
-        },
-    },
-    Parameter {
-        name: "effects.ambient_occlusion.strength",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            let ao = s.effects.ambient_occlusion.as_ref();
-            ao.map_or(Ok(()), |ao| fraction(ao.strength))
-        },
-        set: |s, v| {
-            let ao = s.effects.ambient_occlusion.iter_mut();
-            ao.for_each(|x| x.strength = v[0] as f32)
-        },
-    },
+    effect_field!(
+        "effects.ambient_occlusion.radius",
+        ambient_occlusion.radius,
+        Number,
+        positive,
+        number
+    ),
+    effect_field!(
+        "effects.ambient_occlusion.strength",
+        ambient_occlusion.strength,
+        Number,
+        fraction,
+        number_f32
+    ),
 ];
 
 pub(super) const SPECULAR: &[Parameter] = &[
-    Parameter {
-        name: "effects.specular.strength",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            let sp = s.effects.specular.as_ref();
-            sp.map_or(Ok(()), |sp| non_negative(sp.strength))
-        },
-        set: |s, v| {
-            let sp = s.effects.specular.iter_mut();
-            sp.for_each(|x| x.strength = v[0] as f32)
-        },
-    },
-    Parameter {
-        name: "effects.specular.shininess",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            let sp = s.effects.specular.as_ref();
-            sp.map_or(Ok(()), |sp| positive(sp.shininess))
-        },
-        set: |s, v| {
-            let sp = s.effects.specular.iter_mut();
-            sp.for_each(|x| x.shininess = v[0] as f32)
-        },
-    },
+    effect_field!(
+        "effects.specular.strength",
+        specular.strength,
+        Number,
+        non_negative,
+        number_f32
+    ),
+    effect_field!(
+        "effects.specular.shininess",
+        specular.shininess,
+        Number,
+        positive,
+        number_f32
+    ),
 ];
 
 pub(super) const FOG: &[Parameter] = &[
-    Parameter {
-        name: "effects.fog.density",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            s.effects
-                .fog
-                .as_ref()
-                .map_or(Ok(()), |f| non_negative(f.density))
-        },
-        set: |s, v| s.effects.fog.iter_mut().for_each(|x| x.density = v[0]),
-    },
-    Parameter {
-        name: "effects.fog.colour",
-        shape: Triple,
-        doc: "triple",
-        check: |s| s.effects.fog.as_ref().map_or(Ok(()), |f| colour(f.colour)),
-        set: |s, v| {
-            s.effects
-                .fog
-                .iter_mut()
-                .for_each(|x| x.colour = colour_of(v))
-        },
-    },
+    effect_field!(
+        "effects.fog.density",
+        fog.density,
+        Number,
+        non_negative,
+        number
+    ),
+    effect_field!("effects.fog.colour", fog.colour, Triple, colour, colour_of),
 ];
 
 pub(super) const GLOW: &[Parameter] = &[
-    Parameter {
-        name: "effects.glow.strength",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            s.effects
-                .glow
-                .as_ref()
-                .map_or(Ok(()), |g| non_negative(g.strength))
-        },
-        set: |s, v| {
-            s.effects
-                .glow
-                .iter_mut()
-                .for_each(|x| x.strength = v[0] as f32)
-        },
-    },
-    Parameter {
-        name: "effects.glow.width",
-        shape: Number,
-        doc: EFFECT_NUMBER,
-        check: |s| {
-            s.effects
-                .glow
-                .as_ref()
-                .map_or(Ok(()), |g| positive(g.width))
-        },
-        set: |s, v| s.effects.glow.iter_mut().for_each(|x| x.width = v[0]),
-    },
-    Parameter {
-        name: "effects.glow.colour",
-        shape: Triple,
-        doc: "triple",
-        check: |s| s.effects.glow.as_ref().map_or(Ok(()), |g| colour(g.colour)),
-        set: |s, v| {
-            s.effects
-                .glow
-                .iter_mut()
-                .for_each(|x| x.colour = colour_of(v))
-        },
-    },
+    effect_field!(
+        "effects.glow.strength",
+        glow.strength,
+        Number,
+        non_negative,
+        number_f32
+    ),
+    effect_field!("effects.glow.width", glow.width, Number, positive, number),
+    effect_field!(
+        "effects.glow.colour",
+        glow.colour,
+        Triple,
+        colour,
+        colour_of
+    ),
 ];
 
 #[cfg(test)]
