@@ -76,6 +76,84 @@ impl Display {
 /// exposure times a bright light) is white, not black.
 pub fn linear_to_srgb(x: f32) -> f32 {
     let x = if x.is_nan() { 0.0 } else { x.clamp(0.0, 1.0) };
+    linear_to_srgb_f64(x as f64) as f32
+}
+
+/// The sRGB curve without a `powf` per channel: values from 2⁻¹³ to 1 fall
+/// in buckets of 1/128 of an octave, keyed by the top bits of the float,
+/// and the curve is a straight line across each (within 0.1 of a 16-bit
+/// code of `linear_to_srgb`, tested over every value); below 2⁻¹³ it is the
+/// curve's own straight segment.
+pub struct SrgbCurve {
+    /// The curve at each bucket's start and its slope across the bucket.
+    start: [f32; SRGB_BUCKETS],
+    slope: [f32; SRGB_BUCKETS],
+}
+
+/// Below this the curve is its straight segment, 12.92 x.
+const SRGB_LOWEST: f32 = 1.0 / 8192.0;
+/// Mantissa bits in the bucket key: 128 buckets per octave.
+const SRGB_KEY_SHIFT: u32 = f32::MANTISSA_DIGITS - 1 - 7;
+const SRGB_FIRST_KEY: u32 = SRGB_LOWEST.to_bits() >> SRGB_KEY_SHIFT;
+const SRGB_BUCKETS: usize = ((1.0f32.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
+
+impl SrgbCurve {
+    /// The table, built once (about 2 ms).
+    pub fn get() -> &'static SrgbCurve {
+        static TABLE: std::sync::OnceLock<SrgbCurve> = std::sync::OnceLock::new();
+        TABLE.get_or_init(SrgbCurve::new)
+    }
+
+    fn new() -> SrgbCurve {
+        let exact = |bits: u32| linear_to_srgb_f64(f32::from_bits(bits) as f64);
+        let mut table = SrgbCurve {
+            start: [0.0; SRGB_BUCKETS],
+            slope: [0.0; SRGB_BUCKETS],
+        };
+        for i in 0..SRGB_BUCKETS {
+            let first = (SRGB_FIRST_KEY + i as u32) << SRGB_KEY_SHIFT;
+            let next = first + (1 << SRGB_KEY_SHIFT);
+            let width = f32::from_bits(next) as f64 - f32::from_bits(first) as f64;
+            table.start[i] = exact(first) as f32;
+            table.slope[i] = ((exact(next) - exact(first)) / width) as f32;
+        }
+        table
+    }
+
+    /// `linear_to_srgb(x)`, within 0.1 of a 16-bit code.
+    #[inline]
+    pub fn value(&self, x: f32) -> f32 {
+        // Without branches a predictor would miss: NaN becomes 0, and the
+        // clamp takes 1 and up to the float just below it.
+        let x = if x.is_nan() { 0.0 } else { x };
+        let x = x.clamp(0.0, f32::from_bits(1.0f32.to_bits() - 1));
+        if x < SRGB_LOWEST {
+            return 12.92 * x;
+        }
+        let bits = x.to_bits();
+        let i = ((bits >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
+        let first = f32::from_bits(bits >> SRGB_KEY_SHIFT << SRGB_KEY_SHIFT);
+        (self.start[i] + (x - first) * self.slope[i]).min(1.0)
+    }
+
+    /// The 16-bit sRGB code of linear `x`.
+    #[inline]
+    pub fn code16(&self, x: f32) -> u16 {
+        (self.value(x) * 65535.0 + 0.5) as u16
+    }
+
+    /// The 8-bit sRGB code of linear `x`, dithered by `offset` in [0, 1):
+    /// rounded down after the offset is added, so over many pixels the
+    /// codes average to the exact value (a gradient shows no bands), and
+    /// a value that is a code exactly (black, white) stays that code.
+    #[inline]
+    pub fn dithered_byte(&self, x: f32, offset: f32) -> u8 {
+        (self.value(x) * 255.0 + offset).min(255.0) as u8
+    }
+}
+
+/// `linear_to_srgb` in f64, for building the table.
+fn linear_to_srgb_f64(x: f64) -> f64 {
     if x <= 0.003_130_8 {
         12.92 * x
     } else {
@@ -83,84 +161,19 @@ pub fn linear_to_srgb(x: f32) -> f32 {
     }
 }
 
-/// 8-bit sRGB codes from linear light without a `powf` per channel: equal,
-/// for every f32, to `(linear_to_srgb(x) * 255.0 + 0.5) as u8` (tested over
-/// every value in [2⁻¹³, 1]), so frames keep their bytes. Values from 2⁻¹³
-/// to 1 fall in buckets of 1/128 of an octave, keyed by the top bits of the
-/// float; a bucket spans under one code step of the curve (at most about
-/// two thirds, just below 1), so it holds the code at its start and at most
-/// one threshold where the code goes up by one (checked as the table is built).
-pub struct SrgbBytes {
-    base: [u8; SRGB_BUCKETS],
-    next: [f32; SRGB_BUCKETS],
-}
-
-/// Below this every value codes to 0 (12.92 · 2⁻¹³ · 255 < 0.5).
-const SRGB_LOWEST: f32 = 1.0 / 8192.0;
-/// The float just below 1: the top of the last bucket.
-const SRGB_BELOW_ONE: f32 = f32::from_bits(1.0f32.to_bits() - 1);
-/// Mantissa bits in the bucket key: 128 buckets per octave.
-const SRGB_KEY_SHIFT: u32 = f32::MANTISSA_DIGITS - 1 - 7;
-const SRGB_FIRST_KEY: u32 = SRGB_LOWEST.to_bits() >> SRGB_KEY_SHIFT;
-const SRGB_BUCKETS: usize = ((1.0f32.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
-
-impl SrgbBytes {
-    /// The table, built on first use (a few thousand `powf`s).
-    pub fn get() -> &'static SrgbBytes {
-        static TABLE: std::sync::OnceLock<SrgbBytes> = std::sync::OnceLock::new();
-        TABLE.get_or_init(SrgbBytes::new)
-    }
-
-    /// The code the curve gives `x`, computed the slow way.
-    fn exact(x: f32) -> u8 {
-        (linear_to_srgb(x) * 255.0 + 0.5) as u8
-    }
-
-    fn new() -> SrgbBytes {
-        let mut table = SrgbBytes {
-            base: [0; SRGB_BUCKETS],
-            next: [f32::INFINITY; SRGB_BUCKETS],
-        };
-        for i in 0..SRGB_BUCKETS {
-            let first = (SRGB_FIRST_KEY + i as u32) << SRGB_KEY_SHIFT;
-            let last = first + (1 << SRGB_KEY_SHIFT) - 1;
-            let base = Self::exact(f32::from_bits(first));
-            table.base[i] = base;
-            let end = Self::exact(f32::from_bits(last));
-            assert!(
-                end <= base.saturating_add(1),
-                "an sRGB bucket spans two steps"
-            );
-            if end > base {
-                // The first value of the bucket whose code is above its start.
-                let (mut below, mut above) = (first, last);
-                while above - below > 1 {
-                    let mid = below + (above - below) / 2;
-                    if Self::exact(f32::from_bits(mid)) > base {
-                        above = mid;
-                    } else {
-                        below = mid;
-                    }
-                }
-                table.next[i] = f32::from_bits(above);
-            }
-        }
-        table
-    }
-
-    /// The 8-bit sRGB code of linear `x`: 0 for NaN and anything at or
-    /// below 0, 255 from 1 up, +infinity included.
-    #[inline]
-    pub fn byte(&self, x: f32) -> u8 {
-        // Without branches (a frame's values come in no order a predictor
-        // could follow): NaN becomes 0; the clamp takes all below the lowest
-        // value to it, whose code is 0 too, and 1 and up to the float just
-        // below 1, whose code is 255.
-        let x = if x.is_nan() { 0.0 } else { x };
-        let x = x.clamp(SRGB_LOWEST, SRGB_BELOW_ONE);
-        let i = ((x.to_bits() >> SRGB_KEY_SHIFT) - SRGB_FIRST_KEY) as usize;
-        self.base[i] + (x >= self.next[i]) as u8
-    }
+/// The dither offset of pixel (x, y), in [0, 1): white noise from a hash
+/// of the pixel alone, so a frame's bytes are the same on any thread and
+/// the pattern stands still in a video rather than crawling.
+#[inline]
+pub fn dither_offset(x: u32, y: u32) -> f32 {
+    // lowbias32 (Chris Wellons' integer hash) of the two coordinates.
+    let mut h = x.wrapping_mul(0x9E37_79B9) ^ y.wrapping_mul(0x85EB_CA6B).rotate_left(16);
+    h ^= h >> 16;
+    h = h.wrapping_mul(0x7FEB_352D);
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x846C_A68B);
+    h ^= h >> 16;
+    (h >> 8) as f32 * (1.0 / 16_777_216.0)
 }
 
 #[cfg(test)]
@@ -168,42 +181,50 @@ mod tests {
     use super::*;
 
     #[test]
-    fn srgb_bytes_match_the_curve_for_every_float() {
-        let table = SrgbBytes::get();
-        // Every f32 from 2^-13 to 1, where the table does its work.
+    fn the_srgb_table_follows_the_curve_for_every_float() {
+        let table = SrgbCurve::get();
+        // Every f32 from 0 to 1, in 16-bit codes of the exact curve.
         use rayon::prelude::*;
-        let (from, to) = (SRGB_LOWEST.to_bits(), 1.0f32.to_bits());
-        let wrong = (from..=to)
+        let worst = (0..=1.0f32.to_bits())
             .into_par_iter()
-            .filter(|&bits| {
+            .map(|bits| {
                 let x = f32::from_bits(bits);
-                table.byte(x) != SrgbBytes::exact(x)
+                ((table.value(x) as f64 - linear_to_srgb_f64(x as f64)) * 65535.0).abs()
             })
-            .count();
-        assert_eq!(wrong, 0);
-        // Below, above and beside: a stride through the rest of the floats.
-        let rest = (0..u32::MAX / 9973)
-            .map(|k| f32::from_bits(k * 9973))
-            .chain([
-                0.0,
-                -0.0,
-                -1.0,
-                2.0,
-                f32::MAX,
-                f32::MIN_POSITIVE,
-                f32::EPSILON,
-            ])
-            .chain([f32::NAN, f32::INFINITY, f32::NEG_INFINITY]);
-        for x in rest {
-            assert_eq!(table.byte(x), SrgbBytes::exact(x), "{x:e}");
+            .reduce(|| 0.0, f64::max);
+        assert!(worst < 0.1, "{worst} of a 16-bit code");
+        for (x, v) in [
+            (f32::NAN, 0.0),
+            (f32::NEG_INFINITY, 0.0),
+            (-1.0, 0.0),
+            (2.0, 1.0),
+            (f32::INFINITY, 1.0), // too bright for f32: white
+        ] {
+            assert_eq!(table.value(x), v, "{x}");
         }
-        // The curve's own ends and mid-grey, stated independently.
-        assert_eq!(table.byte(1.0), 255);
-        assert_eq!(table.byte(f32::INFINITY), 255); // too bright for f32: white
-        assert_eq!(table.byte(f32::NAN), 0);
-        assert_eq!(table.byte(f32::NEG_INFINITY), 0);
-        assert_eq!(table.byte(0.18), 118); // 0.4613 · 255 + 0.5
-        assert_eq!(table.byte(0.0031308), 10); // 0.04045 · 255 + 0.5
+        assert_eq!(table.code16(1.0), 65535);
+        assert_eq!(table.code16(0.18), 30235); // 0.461357 · 65535 = 30234.97
+        assert_eq!(table.dithered_byte(1.0, 0.999), 255);
+        assert_eq!(table.dithered_byte(0.0, 0.999), 0);
+    }
+
+    #[test]
+    fn dithered_codes_average_to_the_exact_value() {
+        let table = SrgbCurve::get();
+        // A value between two codes: a third of the way from 117 to 118.
+        let x = 0.178_966; // sRGB 0.460118 · 255 = 117.33
+        let exact = linear_to_srgb_f64(x as f64) * 255.0;
+        let codes: Vec<f64> = (0..256u32)
+            .flat_map(|y| (0..256u32).map(move |x| (x, y)))
+            .map(|(px, py)| table.dithered_byte(x, dither_offset(px, py)) as f64)
+            .collect();
+        let mean = codes.iter().sum::<f64>() / codes.len() as f64;
+        assert!((mean - exact).abs() < 0.01, "mean {mean}, exact {exact}");
+        assert!(codes
+            .iter()
+            .all(|&c| c == exact.floor() || c == exact.ceil()));
+        // Undithered, every code would be the nearest: 0.33 away on average.
+        assert!((exact - exact.round()).abs() > 0.3);
     }
 
     #[test]

@@ -29,4 +29,4 @@ pub mod spans;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.
-pub const RENDERER_REVISION: u32 = 14;
+pub const RENDERER_REVISION: u32 = 15;

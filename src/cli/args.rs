@@ -112,6 +112,16 @@ pub struct SequenceArgs {
     /// Extra EXR layers, comma-separated (needs --format exr): normal, albedo, traps, steps.
     #[arg(long, value_enum, value_delimiter = ',')]
     pub aov: Vec<output::Aov>,
+    /// EXR compression: zip (default), piz, rle, zips and none keep every
+    /// sample; pxr24, b44, b44a, dwaa and dwab are lossy.
+    #[arg(
+        long,
+        value_enum,
+        value_name = "METHOD",
+        default_value_t,
+        hide_possible_values = true
+    )]
+    pub exr_compression: output::exr::ExrCompression,
 }
 
 #[derive(Debug, clap::Args)]
@@ -208,6 +218,7 @@ impl SequenceArgs {
             preview: self.preview,
             samples: self.samples,
             aovs: self.aov.clone(),
+            exr_compression: self.exr_compression,
         }
     }
 }

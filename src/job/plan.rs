@@ -20,6 +20,7 @@ pub struct Plan {
     pub out_dir: PathBuf,
     pub preview: bool,
     pub aovs: Vec<output::Aov>,
+    pub exr_compression: output::exr::ExrCompression,
     /// `--samples`, applied to the timeline's scene (and recorded).
     pub samples: Option<u32>,
     /// `--verify`: frame files are read to their last byte before they
@@ -34,11 +35,25 @@ impl Plan {
         let mut aovs = args.aovs.clone();
         aovs.sort();
         aovs.dedup();
-        let formats = if args.formats.is_empty() {
+        let mut formats = if args.formats.is_empty() {
             vec![Format::Png]
         } else {
             args.formats.clone()
         };
+        formats.sort();
+        formats.dedup();
+        let pngs: Vec<&str> = formats
+            .iter()
+            .filter(|f| f.is_png())
+            .map(|f| f.name())
+            .collect();
+        if pngs.len() > 1 {
+            let message = format!(
+                "{} all write frame_NNNNN.png: choose one of them",
+                pngs.join(" and ")
+            );
+            return Err(Error::usage("--format", message).into());
+        }
         if !aovs.is_empty() && !formats.contains(&Format::Exr) {
             return Err(
                 Error::usage("--aov", "extra layers are EXR channels: add --format exr").into(),
@@ -65,9 +80,7 @@ impl Plan {
             Some(f) => parse_frames(f, timeline.frame_count)?,
             None => 0..timeline.frame_count,
         };
-        let mut formats = formats;
         formats.sort_by_key(|f| f.extension());
-        formats.dedup();
         let mut out_dir = args
             .out
             .clone()
@@ -87,6 +100,7 @@ impl Plan {
             out_dir,
             preview,
             aovs,
+            exr_compression: args.exr_compression,
             samples: args.samples,
             verify: false,
         })
@@ -126,6 +140,7 @@ impl Plan {
                 out_dir: dir.to_path_buf(),
                 preview: job.preview,
                 aovs: o.aovs,
+                exr_compression: o.exr_compression,
                 samples: o.samples,
                 verify: false,
                 timeline,
@@ -158,11 +173,7 @@ impl Plan {
             timeline_text: text,
             width: self.width,
             height: self.height,
-            formats: self
-                .formats
-                .iter()
-                .map(|f| f.extension().to_string())
-                .collect(),
+            formats: self.formats.iter().map(|f| f.name().to_string()).collect(),
             frames: (self.range.start, self.range.end),
             preview: self.preview,
             aovs: self.aovs.clone(),
@@ -171,7 +182,7 @@ impl Plan {
                 .formats
                 .iter()
                 .map(|&f| crate::job::record::OutputRecord {
-                    format: f.extension().to_string(),
+                    format: f.name().to_string(),
                     frames: (self.range.start, self.range.end),
                     // Only EXRs hold extra layers.
                     aovs: if f == Format::Exr {
@@ -180,6 +191,7 @@ impl Plan {
                         Vec::new()
                     },
                     samples: self.samples,
+                    exr_compression: self.exr_compression,
                 })
                 .collect(),
         })
@@ -206,11 +218,8 @@ impl Plan {
 
     /// The format a video is encoded from: the PNGs, where rendered.
     pub fn video_format(&self) -> Format {
-        if self.formats.contains(&Format::Png) {
-            Format::Png
-        } else {
-            Format::Exr
-        }
+        let png = self.formats.iter().find(|f| f.is_png());
+        png.copied().unwrap_or(Format::Exr)
     }
 
     /// Whether `frame`'s file in `format` is whole and current (no hash
@@ -221,7 +230,7 @@ impl Plan {
             return false;
         }
         let (_, hash) = self.frame(frame);
-        let key = output::frames::stored_key(format, &hash, &self.aovs);
+        let key = output::frames::stored_key(format, &hash, &self.aovs, self.exr_compression);
         output::frames::file_state(&path, format, &key, self.verify)
             == output::frames::FileState::Current
     }
@@ -246,7 +255,7 @@ impl Plan {
         self.formats
             .iter()
             .map(|&f| {
-                let key = output::frames::stored_key(f, hash, &self.aovs);
+                let key = output::frames::stored_key(f, hash, &self.aovs, self.exr_compression);
                 output::frames::file_state(&self.path(frame, f), f, &key, self.verify)
             })
             .collect()

@@ -48,7 +48,7 @@ pub struct JobRecord {
 /// or samples, each complete on its own terms.
 #[derive(Clone, Debug, PartialEq, Serialize, serde::Deserialize)]
 pub struct OutputRecord {
-    /// `png` or `exr`.
+    /// `png`, `png16`, `png16alpha` or `exr`.
     pub format: String,
     /// Half-open span of every range rendered in this format.
     pub frames: (u32, u32),
@@ -56,6 +56,9 @@ pub struct OutputRecord {
     pub aovs: Vec<Aov>,
     #[serde(default)]
     pub samples: Option<u32>,
+    /// The EXR compression (an EXR's key records it).
+    #[serde(default)]
+    pub exr_compression: crate::output::exr::ExrCompression,
 }
 
 impl JobRecord {
@@ -144,6 +147,7 @@ impl JobRecord {
                 Vec::new()
             },
             samples: self.samples,
+            exr_compression: Default::default(),
         };
         self.formats.iter().map(output).collect()
     }
@@ -153,6 +157,11 @@ impl JobRecord {
     fn merge_outputs(self, old: &JobRecord) -> JobRecord {
         let mut outputs = old.outputs();
         for new in self.outputs() {
+            // PNG kinds share their files' names: the new one replaces the old.
+            let extension = |name: &str| crate::output::Format::named(name).map(|f| f.extension());
+            outputs.retain(|o| {
+                o.format == new.format || extension(&o.format) != extension(&new.format)
+            });
             match outputs.iter_mut().find(|o| o.format == new.format) {
                 Some(o) => {
                     *o = OutputRecord {

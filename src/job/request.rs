@@ -26,6 +26,7 @@ pub struct Sequence {
     pub samples: Option<u32>,
     /// Extra EXR layers.
     pub aovs: Vec<Aov>,
+    pub exr_compression: crate::output::exr::ExrCompression,
 }
 
 /// A render, as asked for: what `job::run` needs, nothing of how it is shown.

@@ -154,7 +154,7 @@ impl Job {
                 (
                     plan.path(frame, f),
                     f,
-                    output::frames::stored_key(f, hash, &plan.aovs),
+                    output::frames::stored_key(f, hash, &plan.aovs, plan.exr_compression),
                 )
             })
             .collect();
@@ -268,7 +268,7 @@ fn refuse_other_sequence(
     record: &crate::job::record::JobRecord,
     running: usize,
 ) -> crate::error::Result<()> {
-    let frames: usize = [Format::Png, Format::Exr]
+    let frames: usize = [Format::Png, Format::Exr] // by extension: every PNG kind
         .into_iter()
         .map(|f| output::frames::frame_files(out_dir, f).map_or(0, |files| files.len()))
         .sum();

@@ -97,7 +97,11 @@ impl Plan {
                 film,
                 hash,
                 &self.aovs,
-                look.display_transform(),
+                &output::Encoding {
+                    display: look.display_transform(),
+                    transparent: look.transparent_background,
+                    exr_compression: self.exr_compression,
+                },
             )?;
         }
         let _ = std::fs::remove_file(crate::job::checkpoint::checkpoint_path(

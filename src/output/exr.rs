@@ -4,7 +4,7 @@
 //! last chunk does.
 
 use super::frames::FileState;
-use super::{stats_text, Aov, HASH_KEY, STATS_KEY};
+use super::{stats_text, Aov, Encoding, HASH_KEY, STATS_KEY};
 use crate::render::Film;
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -36,7 +36,9 @@ const EXR_CHANNELS: [(&str, exr::meta::attribute::SampleType, Source); 16] = {
         ("G", F16, Colour(1)),
         ("B", F16, Colour(2)),
         ("A", F16, Alpha),
-        ("Z", F32, Depth),
+        // `depth.Z`, not `Z`: ffmpeg takes a bare Z for the third colour
+        // channel; compositors find depth under either name.
+        ("depth.Z", F32, Depth),
         ("N.X", F32, Normal(0)),
         ("N.Y", F32, Normal(1)),
         ("N.Z", F32, Normal(2)),
@@ -71,12 +73,15 @@ pub(crate) fn encode(
     film: &Film,
     hash: &str,
     aovs: &[Aov],
+    encoding: &Encoding,
 ) -> std::result::Result<(), String> {
     use exr::prelude::*;
     // The film's channels, in name order as the format asks.
     let mut channels: Vec<(&str, SampleType, Plane)> = EXR_CHANNELS
         .iter()
-        .filter_map(|&(name, sample, source)| Some((name, sample, Plane::of(film, aovs, source)?)))
+        .filter_map(|&(name, sample, source)| {
+            Some((name, sample, Plane::of(film, aovs, source, encoding)?))
+        })
         .collect();
     channels.sort_by_key(|&(name, ..)| name);
     let mut attributes = LayerAttributes::named("");
@@ -101,11 +106,10 @@ pub(crate) fn encode(
             .map(|&(name, sample, _)| ChannelDescription::named(name, sample))
             .collect(),
     )
-    // RLE in 64-pixel tiles (exrs' `FAST_LOSSLESS`), in increasing line
-    // order: exrs otherwise orders blocks as its threads finish them, and
-    // the bytes would differ run to run.
+    // 64-pixel tiles in increasing line order: exrs otherwise orders
+    // blocks as its threads finish them, and the bytes would differ run to run.
     .with_encoding(
-        Compression::RLE,
+        encoding.exr_compression.exr(),
         exr::meta::BlockDescription::Tiles(exr::meta::attribute::TileDescription {
             tile_size: Vec2(64, 64),
             level_mode: exr::meta::attribute::LevelMode::Singular,
@@ -198,14 +202,18 @@ enum Plane<'f> {
     /// Trap `k` of each pixel.
     Traps(&'f [[f32; 4]], usize),
     Counts(&'f [u32]),
+    /// The same value in every pixel (an opaque frame's alpha).
+    Constant(f32),
 }
 
 impl<'f> Plane<'f> {
     /// The plane `source` names, if the film has it (the steps layer only
-    /// where `aovs` asks for it).
-    fn of(film: &'f Film, aovs: &[Aov], source: Source) -> Option<Plane<'f>> {
+    /// where `aovs` asks for it; alpha the coverage only where the
+    /// background is transparent).
+    fn of(film: &'f Film, aovs: &[Aov], source: Source, encoding: &Encoding) -> Option<Plane<'f>> {
         use Plane::*;
         Some(match source {
+            Source::Alpha if !encoding.transparent => Constant(1.0),
             Source::Colour(k) => Vectors(&film.colour, k),
             Source::Normal(k) => Vectors(film.normal.as_deref()?, k),
             Source::Albedo(k) => Vectors(film.albedo.as_deref()?, k),
@@ -240,6 +248,7 @@ fn film_block(
             match *plane {
                 Plane::Vectors(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
                 Plane::Floats(v) => put_line(line, v[row.clone()].iter().copied(), sample),
+                Plane::Constant(v) => put_line(line, std::iter::repeat(v), sample),
                 Plane::Traps(v, k) => put_line(line, v[row.clone()].iter().map(|p| p[k]), sample),
                 Plane::Counts(v) => {
                     for (out, count) in line.chunks_exact_mut(4).zip(&v[row.clone()]) {
@@ -331,4 +340,88 @@ fn exr_ends_with_its_last_chunk(
     file.read_exact(&mut size)?;
     let size = i32::from_le_bytes(size);
     Ok(size >= 0 && last + coordinates + 4 + size as u64 == length)
+}
+
+/// The compressions `--exr-compression` offers: every one exrs writes.
+#[derive(
+    Clone,
+    Copy,
+    Debug,
+    Default,
+    PartialEq,
+    Eq,
+    Hash,
+    clap::ValueEnum,
+    serde::Serialize,
+    serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum ExrCompression {
+    /// Uncompressed.
+    None,
+    /// Run-length: lossless, fastest, largest.
+    Rle,
+    /// Deflate a line at a time: lossless.
+    Zips,
+    /// Deflate 16 lines at a time: lossless.
+    #[default]
+    Zip,
+    /// Wavelet and Huffman: lossless.
+    Piz,
+    /// 24-bit floats deflated: lossy for float channels (depth, normals, traps).
+    Pxr24,
+    /// 4x4 blocks of half floats: lossy.
+    B44,
+    /// B44 with flat blocks smaller: lossy.
+    B44a,
+    /// DCT, 32 lines at a time (as in JPEG): lossy.
+    Dwaa,
+    /// DCT, 256 lines at a time: lossy.
+    Dwab,
+}
+
+impl ExrCompression {
+    fn exr(self) -> exr::prelude::Compression {
+        use exr::prelude::Compression as C;
+        match self {
+            ExrCompression::None => C::Uncompressed,
+            ExrCompression::Rle => C::RLE,
+            ExrCompression::Zips => C::ZIP1,
+            ExrCompression::Zip => C::ZIP16,
+            ExrCompression::Piz => C::PIZ,
+            ExrCompression::Pxr24 => C::PXR24,
+            ExrCompression::B44 => C::B44,
+            ExrCompression::B44a => C::B44A,
+            ExrCompression::Dwaa => C::DWAA(None),
+            ExrCompression::Dwab => C::DWAB(None),
+        }
+    }
+
+    /// Whether a file keeps every sample exactly as rendered.
+    pub fn is_lossless(self) -> bool {
+        matches!(
+            self,
+            ExrCompression::None
+                | ExrCompression::Rle
+                | ExrCompression::Zips
+                | ExrCompression::Zip
+                | ExrCompression::Piz
+        )
+    }
+
+    /// The name `--exr-compression` takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            ExrCompression::None => "none",
+            ExrCompression::Rle => "rle",
+            ExrCompression::Zips => "zips",
+            ExrCompression::Zip => "zip",
+            ExrCompression::Piz => "piz",
+            ExrCompression::Pxr24 => "pxr24",
+            ExrCompression::B44 => "b44",
+            ExrCompression::B44a => "b44a",
+            ExrCompression::Dwaa => "dwaa",
+            ExrCompression::Dwab => "dwab",
+        }
+    }
 }

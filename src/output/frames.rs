@@ -3,7 +3,7 @@
 //! the ones being written.
 
 use super::atomic::write_atomic;
-use super::{Aov, Format};
+use super::{Aov, Encoding, Format};
 use crate::error::{Error, Result};
 use crate::render::Film;
 use crate::scene::Scene;
@@ -116,22 +116,34 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
         Err(_) => return FileState::Damaged,
     };
     match format {
-        Format::Png => super::png::file_state(file, path, key, thorough),
         Format::Exr => super::exr::file_state(file, path, key, thorough),
+        _ => super::png::file_state(file, path, key, thorough),
     }
 }
 
-/// What a frame file of `format` records of its inputs: the frame's `hash`,
-/// and for an EXR the extra layers it holds too (`hash+normal,steps`), so
-/// asking for other layers re-renders the EXR but not the PNG beside it.
-pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
+/// What a frame file of `format` records of its inputs: the frame's `hash`;
+/// for a PNG other than the 8-bit kind, its kind too (`hash+png16`), and for
+/// an EXR its compression and the extra layers it holds
+/// (`hash+zip+normal,steps`, the light's hash alone, as an EXR holds the
+/// light undisplayed). So asking for other layers, another PNG kind or
+/// another compression re-renders that file but not the one beside it.
+pub fn stored_key(
+    format: Format,
+    hash: &str,
+    aovs: &[Aov],
+    compression: super::exr::ExrCompression,
+) -> String {
     match format {
-        Format::Exr if !aovs.is_empty() => {
-            let names: Vec<&str> = aovs.iter().map(|a| a.name()).collect();
-            format!("{}+{}", light_hash(hash), names.join(","))
+        Format::Exr => {
+            let mut key = format!("{}+{}", light_hash(hash), compression.name());
+            if !aovs.is_empty() {
+                let names: Vec<&str> = aovs.iter().map(|a| a.name()).collect();
+                key = format!("{key}+{}", names.join(","));
+            }
+            key
         }
-        Format::Exr => light_hash(hash).to_string(),
         Format::Png => hash.to_string(),
+        _ => format!("{hash}+{}", format.name()),
     }
 }
 
@@ -139,28 +151,28 @@ pub fn stored_key(format: Format, hash: &str, aovs: &[Aov]) -> String {
 /// temporary file of a unique name in the same folder (so two renders into one
 /// folder never write into each other's file), are flushed to disk, and only
 /// then renamed over the final name.
-/// `display` decides how a PNG shows the film's linear light (exposure and
-/// tone map); an EXR holds the linear light as it is.
+/// `encoding` decides how a PNG shows the film's linear light (exposure and
+/// tone map; an EXR holds the linear light as it is), whether the
+/// background is transparent, and the EXR's compression.
 pub fn write_frame(
     path: &Path,
     format: Format,
     film: &Film,
     hash: &str,
     aovs: &[Aov],
-    display: crate::color::Display,
+    encoding: &Encoding,
 ) -> Result<()> {
     let image_error = |temp: &Path, message: String| Error::Image {
         path: temp.to_path_buf(),
         message,
     };
-    let key = stored_key(format, hash, aovs);
+    let key = stored_key(format, hash, aovs, encoding.exr_compression);
     write_atomic(path, |writer, temp| match format {
-        Format::Png => {
-            super::png::encode(writer, film, &key, display).map_err(|m| image_error(temp, m))
-        }
         Format::Exr => {
-            super::exr::encode(writer, film, &key, aovs).map_err(|m| image_error(temp, m))
+            super::exr::encode(writer, film, &key, aovs, encoding).map_err(|m| image_error(temp, m))
         }
+        _ => super::png::encode(writer, film, &key, format, encoding)
+            .map_err(|m| image_error(temp, m)),
     })
 }
 

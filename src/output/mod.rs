@@ -1,5 +1,6 @@
-//! Frames on disk: one module per file format (`png`: 8-bit sRGB; `exr`:
-//! linear half-float RGBA, a float Z and the layers `--aov` asks for), frame
+//! Frames on disk: one module per file format (`png`: sRGB, 8-bit dithered
+//! or 16-bit, with or without alpha; `exr`: linear half-float premultiplied
+//! RGBA, a float depth and the layers `--aov` asks for), frame
 //! files and the content hash each carries in its own metadata so resume can
 //! tell a current frame from a stale one (`frames`), write-to-temporary-
 //! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
@@ -23,22 +24,59 @@ pub const HASH_KEY: &str = "mandelreel-hash";
 pub const STATS_KEY: &str = "mandelreel-stats";
 
 /// An output file format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum)]
 pub enum Format {
-    /// 8-bit sRGB PNG.
+    /// 8-bit sRGB PNG, dithered (no banding in smooth gradients).
     Png,
-    /// OpenEXR: linear half-float R, G, B, A and a float Z (camera distance),
-    /// plus the layers --aov asks for.
+    /// 16-bit sRGB PNG.
+    Png16,
+    /// 16-bit sRGB PNG with straight (unpremultiplied) alpha.
+    #[value(name = "png16alpha")]
+    Png16Alpha,
+    /// OpenEXR: linear half-float premultiplied R, G, B, A and a float
+    /// depth.Z (camera distance), plus the layers --aov asks for.
     Exr,
 }
 
 impl Format {
     pub fn extension(self) -> &'static str {
         match self {
-            Format::Png => "png",
+            Format::Png | Format::Png16 | Format::Png16Alpha => "png",
             Format::Exr => "exr",
         }
     }
+
+    /// The name `--format` takes and the job record keeps.
+    pub fn name(self) -> &'static str {
+        match self {
+            Format::Png => "png",
+            Format::Png16 => "png16",
+            Format::Png16Alpha => "png16alpha",
+            Format::Exr => "exr",
+        }
+    }
+
+    /// The format `--format` calls `name`.
+    pub fn named(name: &str) -> Option<Format> {
+        [Format::Png, Format::Png16, Format::Png16Alpha, Format::Exr]
+            .into_iter()
+            .find(|f| f.name() == name)
+    }
+
+    pub fn is_png(self) -> bool {
+        self.extension() == "png"
+    }
+}
+
+/// How a finished film is written: shown through `display` (PNG), with
+/// the background kept or made transparent, and the EXR compression.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Encoding {
+    pub display: crate::color::Display,
+    /// The film leaves the background out (its misses hold no sky): alpha
+    /// is the fractal's coverage. Otherwise every pixel is opaque.
+    pub transparent: bool,
+    pub exr_compression: exr::ExrCompression,
 }
 
 /// Extra EXR layers (arbitrary output variables) a render can write.

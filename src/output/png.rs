@@ -1,9 +1,10 @@
-//! PNG frames: 8-bit sRGB through the film's display transform, with the
+//! PNG frames: sRGB through the film's display transform (8-bit dithered,
+//! 16-bit, or 16-bit with alpha), with the
 //! frame's hash and statistics in text chunks, and the checks that tell a
 //! whole PNG from one cut short or damaged.
 
 use super::frames::FileState;
-use super::{stats_text, HASH_KEY, STATS_KEY};
+use super::{stats_text, Encoding, Format, HASH_KEY, STATS_KEY};
 use crate::render::Film;
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -13,11 +14,13 @@ pub(crate) fn encode(
     out: &mut impl Write,
     film: &Film,
     hash: &str,
-    display: crate::color::Display,
+    format: Format,
+    encoding: &Encoding,
 ) -> std::result::Result<(), String> {
+    let kind = Kind::of(format, encoding);
     let mut encoder = png::Encoder::new(out, film.width, film.height);
-    encoder.set_color(png::ColorType::Rgb);
-    encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_color(kind.colour);
+    encoder.set_depth(kind.depth);
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     let text = [
         (HASH_KEY, hash.to_string()),
@@ -40,27 +43,105 @@ pub(crate) fn encode(
     // on S1 and frames of zoom, effects and julia_morph; one-off).
     encoder.set_filter(png::Filter::Paeth);
     let mut writer = encoder.write_header().map_err(|e| e.to_string())?;
-    // The sRGB codes come from a table (a powf per channel cost as much as
-    // a twentieth of a small frame), a row at a time straight into place on
-    // every thread.
-    use rayon::prelude::*;
-    let srgb = crate::color::SrgbBytes::get();
-    let plain = display.is_plain();
-    let row = (film.width as usize).max(1);
-    let mut bytes = vec![0u8; film.colour.len() * 3];
-    bytes
-        .par_chunks_mut(3 * row)
-        .zip(film.colour.par_chunks(row))
-        .for_each(|(bytes, colour)| {
-            for (rgb, c) in bytes.chunks_exact_mut(3).zip(colour) {
-                for (byte, v) in rgb.iter_mut().zip([c.x, c.y, c.z]) {
-                    // At the default display the light is coded as it is.
-                    *byte = srgb.byte(if plain { v } else { display.apply(v) });
-                }
-            }
-        });
+    let bytes = pixel_bytes(film, kind, encoding.display);
     writer.write_image_data(&bytes).map_err(|e| e.to_string())?;
     writer.finish().map_err(|e| e.to_string())
+}
+
+/// What a PNG of `format` holds.
+#[derive(Clone, Copy)]
+struct Kind {
+    colour: png::ColorType,
+    depth: png::BitDepth,
+    /// Alpha is the film's coverage where the background is transparent.
+    transparent: bool,
+}
+
+impl Kind {
+    fn of(format: Format, encoding: &Encoding) -> Kind {
+        let (colour, depth) = match format {
+            Format::Png16 => (png::ColorType::Rgb, png::BitDepth::Sixteen),
+            Format::Png16Alpha => (png::ColorType::Rgba, png::BitDepth::Sixteen),
+            _ => (png::ColorType::Rgb, png::BitDepth::Eight),
+        };
+        Kind {
+            colour,
+            depth,
+            transparent: encoding.transparent,
+        }
+    }
+
+    fn bytes_per_pixel(self) -> usize {
+        let channels = if self.colour == png::ColorType::Rgba {
+            4
+        } else {
+            3
+        };
+        let bytes = if self.depth == png::BitDepth::Sixteen {
+            2
+        } else {
+            1
+        };
+        channels * bytes
+    }
+}
+
+/// The image's bytes, a row at a time straight into place on every thread.
+fn pixel_bytes(film: &Film, kind: Kind, display: crate::color::Display) -> Vec<u8> {
+    use rayon::prelude::*;
+    let row = (film.width as usize).max(1);
+    let size = kind.bytes_per_pixel();
+    let mut bytes = vec![0u8; film.colour.len() * size];
+    bytes
+        .par_chunks_mut(size * row)
+        .zip(film.colour.par_chunks(row).zip(film.alpha.par_chunks(row)))
+        .enumerate()
+        .for_each(|(y, (bytes, (colour, alpha)))| {
+            let pixels = bytes.chunks_exact_mut(size).zip(colour.iter().zip(alpha));
+            for (x, (out, (c, &a))) in pixels.enumerate() {
+                let offset = crate::color::dither_offset(x as u32, y as u32);
+                put_pixel(out, kind, display, [c.x, c.y, c.z], a, offset);
+            }
+        });
+    bytes
+}
+
+/// One pixel's codes into `out`. PNG colour is straight: a pixel with
+/// alpha shows its colour divided by its coverage; one without shows the
+/// film's colour, which, where the background is transparent, is the
+/// fractal over black. 8-bit codes are dithered by `offset`.
+#[inline]
+fn put_pixel(
+    out: &mut [u8],
+    kind: Kind,
+    display: crate::color::Display,
+    rgb: [f32; 3],
+    alpha: f32,
+    offset: f32,
+) {
+    let curve = crate::color::SrgbCurve::get();
+    let plain = display.is_plain();
+    let show = |v: f32| if plain { v } else { display.apply(v) };
+    if kind.depth == png::BitDepth::Eight {
+        for (byte, v) in out.iter_mut().zip(rgb) {
+            *byte = curve.dithered_byte(show(v), offset);
+        }
+        return;
+    }
+    let (rgb, alpha) = match kind.colour {
+        png::ColorType::Rgba if kind.transparent => {
+            let a = alpha.clamp(0.0, 1.0);
+            let straight = if a > 0.0 { 1.0 / a } else { 0.0 };
+            (rgb.map(|v| v * straight), Some(a))
+        }
+        png::ColorType::Rgba => (rgb, Some(1.0)),
+        _ => (rgb, None),
+    };
+    let codes = rgb.map(|v| curve.code16(show(v)));
+    let alpha = alpha.map(|a| (a * 65535.0 + 0.5) as u16);
+    for (pair, code) in out.chunks_exact_mut(2).zip(codes.into_iter().chain(alpha)) {
+        pair.copy_from_slice(&code.to_be_bytes());
+    }
 }
 
 /// `frames::file_state` for a PNG opened as `file`: stale unless its text

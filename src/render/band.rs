@@ -407,6 +407,7 @@ fn trace(
 ) -> Vec3 {
     let Some(at) = at else {
         let sky = match &scene.effects.path_tracing {
+            _ if scene.look.transparent_background => Vec3::ZERO,
             Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
             None => scene.look.background(ray.dir, up),
         };

@@ -38,6 +38,11 @@ pub struct Look {
     pub tone_map: ToneMap,
     #[serde(skip_serializing_if = "is_one")]
     pub exposure: f32,
+    /// Leave the background out: misses add no sky (glow stays, as light
+    /// with no coverage), and alpha is the fractal's coverage, for
+    /// compositing. Otherwise the background is drawn and every pixel is opaque.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub transparent_background: bool,
 }
 
 pub(super) fn is_one(x: &f32) -> bool {
@@ -70,6 +75,7 @@ impl Default for Look {
             background_bottom: Vec3::new(0.10, 0.09, 0.12),
             tone_map: ToneMap::Clip,
             exposure: 1.0,
+            transparent_background: false,
         }
     }
 }

@@ -184,7 +184,8 @@ fn path_traced_frame_is_byte_identical_with_one_or_two_threads() {
 #[test]
 fn frames_have_no_nan_and_show_the_bulb() {
     let d = Dir::new();
-    d.write("t.ron", &tiny_timeline(1, 8.0));
+    let transparent = "look: (transparent_background: true)";
+    d.write("t.ron", &with_scene(&tiny_timeline(1, 8.0), transparent));
     d.ok(&["render", "t.ron", "--format", "exr"]);
     let image =
         exr::prelude::read_all_flat_layers_from_file(d.path().join("out/t/frame_00000.exr"))
@@ -640,7 +641,7 @@ fn a_membership_walk_renders_deeper_and_the_same_on_any_thread_count() {
     d.same_on_one_and_two_threads("walk.ron", &["--format", "exr"], &["frame_00000.exr"]);
     d.ok(&["render", "trust.ron", "--format", "exr", "--out", "trust"]);
     let (trust, walk) = (d.exr("trust/frame_00000.exr"), d.exr("one/frame_00000.exr"));
-    let (a, b) = (trust.channel("Z"), walk.channel("Z"));
+    let (a, b) = (trust.channel("depth.Z"), walk.channel("depth.Z"));
     let both: Vec<(f32, f32)> = a
         .iter()
         .zip(b)

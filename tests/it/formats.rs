@@ -1,6 +1,7 @@
 //! PNG and EXR output decode, with the channels and metadata promised.
 
 use crate::util::{says, stderr, tiny_timeline, with_scene, Dir};
+use std::process::Command;
 
 #[test]
 fn png_and_exr_decode_with_expected_channels() {
@@ -23,10 +24,10 @@ fn png_and_exr_decode_with_expected_channels() {
 
     let exr = d.exr("out/t/frame_00000.exr");
     assert_eq!(exr.size, (48, 27));
-    assert_eq!(exr.names(), ["A", "B", "G", "R", "Z"]);
+    assert_eq!(exr.names(), ["A", "B", "G", "R", "depth.Z"]);
     let channel = |name: &str| exr.channel(name);
-    let z = channel("Z");
-    // Z is the camera distance: about 2 in the middle (camera 3 from the centre), huge for background.
+    let z = channel("depth.Z");
+    // depth.Z is the camera distance: about 2 in the middle (camera 3 from the centre), huge for background.
     assert!(
         z[13 * 48 + 24] > 1.0 && z[13 * 48 + 24] < 3.1,
         "{}",
@@ -75,7 +76,7 @@ fn extra_layers_are_written_only_when_asked() {
         "trap.y",
         "trap.z",
         "DE",
-        "Z",
+        "depth.Z",
     ] {
         assert!(names.contains(&n), "{n} missing from {names:?}");
     }
@@ -99,7 +100,7 @@ fn extra_layers_are_written_only_when_asked() {
     // … and without them the file holds only the standard channels.
     assert_eq!(
         d.exr("out/t/frame_00000.exr").names(),
-        ["A", "B", "G", "R", "Z"]
+        ["A", "B", "G", "R", "depth.Z"]
     );
 }
 
@@ -228,4 +229,104 @@ fn a_change_of_grade_rerenders_pngs_but_leaves_exrs_and_fades_to_black() {
         frame(1).as_raw().iter().all(|&b| b == 0),
         "frame 1 is not black"
     );
+}
+
+/// A frame `size` of background alone (the camera looks away from the bulb).
+fn background_only(size: &str) -> String {
+    let away = "camera: (position: (0, 0, 3), target: (0, 0, 10))";
+    tiny_timeline(1, 8.0)
+        .replace("camera: (position: (0, 0.5, 3.0))", away)
+        .replace("size: (48, 27)", &format!("size: {size}"))
+}
+
+#[test]
+fn eight_bit_pngs_are_dithered_so_a_gradient_does_not_band() {
+    // 1,080 rows of the background gradient: in 8 bits a few dozen codes,
+    // each held for many rows. Dithered, each row's codes average to the
+    // exact value, which the 16-bit PNG of the same frame gives.
+    let d = Dir::new();
+    d.write("t.ron", &background_only("(256, 1080)"));
+    d.ok(&["render", "t.ron", "--out", "eight"]);
+    d.ok(&["render", "t.ron", "--out", "sixteen", "--format", "png16"]);
+    let eight = image::open(d.path().join("eight/frame_00000.png")).unwrap();
+    let sixteen = image::open(d.path().join("sixteen/frame_00000.png")).unwrap();
+    assert_eq!(eight.color(), image::ColorType::Rgb8);
+    assert_eq!(sixteen.color(), image::ColorType::Rgb16);
+    let (eight, sixteen) = (eight.to_rgb8(), sixteen.to_rgb16());
+    let row_mean = |code: &dyn Fn(u32) -> f64| (0..256).map(code).sum::<f64>() / 256.0;
+    let mut worst: f64 = 0.0;
+    for y in 0..1080 {
+        for k in 0..3 {
+            let dithered = row_mean(&|x| eight.get_pixel(x, y)[k] as f64);
+            let exact = row_mean(&|x| sixteen.get_pixel(x, y)[k] as f64 / 257.0);
+            worst = worst.max((dithered - exact).abs());
+        }
+    }
+    // Rounded to the nearest code, rows err by up to half a code.
+    assert!(worst < 0.15, "a row's mean is {worst} of a code off");
+}
+
+#[test]
+fn sixteen_bit_pngs_hold_the_light_and_the_coverage_as_straight_alpha() {
+    if !crate::util::tool("oiiotool", "--help") {
+        return;
+    }
+    let d = Dir::new();
+    let clear = with_scene(
+        &tiny_timeline(1, 8.0),
+        "samples_per_pixel: 4, look: (transparent_background: true)",
+    );
+    d.write("t.ron", &clear);
+    d.ok(&["render", "t.ron", "--format", "png16alpha,exr"]);
+    let info = Command::new("oiiotool")
+        .args(["--info", "out/t/frame_00000.png"])
+        .current_dir(d.path())
+        .output()
+        .unwrap();
+    let info = String::from_utf8_lossy(&info.stdout);
+    assert!(info.contains("4 channel, uint16 png"), "{info}");
+    let png = image::open(d.path().join("out/t/frame_00000.png"))
+        .unwrap()
+        .to_rgba16();
+    let exr = d.exr("out/t/frame_00000.exr");
+    let (alpha, red) = (exr.channel("A"), exr.channel("R"));
+    let linear = |code: u16| {
+        let s = code as f32 / 65535.0;
+        if s <= 0.04045 {
+            s / 12.92
+        } else {
+            ((s + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let mut partial = 0;
+    for (i, p) in png.pixels().enumerate() {
+        let a = p[3] as f32 / 65535.0;
+        assert!(
+            (a - alpha[i]).abs() < 1e-3,
+            "alpha at {i}: {a} vs {}",
+            alpha[i]
+        );
+        if alpha[i] > 0.0 {
+            // Straight colour times coverage is the EXR's premultiplied colour.
+            let premultiplied = linear(p[0]) * a;
+            assert!(
+                (premultiplied - red[i]).abs() < 2e-3 * red[i].max(1.0),
+                "red at {i}"
+            );
+            partial += (alpha[i] < 1.0) as usize;
+        }
+    }
+    assert!(partial > 10, "{partial} partly covered pixels");
+    assert_eq!(png.get_pixel(0, 0).0, [0; 4], "a corner is transparent");
+}
+
+#[test]
+fn two_png_kinds_in_one_render_are_refused() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 8.0));
+    let out = d.run(&["render", "t.ron", "--format", "png,png16"]);
+    assert_eq!(out.status.code(), Some(2));
+    says(&out, "--format");
+    says(&out, "png and png16 all write frame_NNNNN.png");
+    assert!(d.files("out/t").is_empty(), "{:?}", d.files("out/t"));
 }

@@ -5,6 +5,7 @@ mod util;
 mod accuracy;
 mod bench;
 mod cli;
+mod compositing;
 mod farm;
 mod formats;
 mod fuzz;

@@ -9,10 +9,16 @@ fn finite_channels(d: &Dir, rel: &str) -> (Vec<f32>, Vec<f32>) {
     for (name, v) in &exr.channels {
         assert!(v.iter().all(|x| x.is_finite()), "{rel}: {name} not finite");
     }
-    (exr.channel("A").to_vec(), exr.channel("Z").to_vec())
+    (exr.channel("A").to_vec(), exr.channel("depth.Z").to_vec())
 }
 
+/// A one-frame timeline of `body`, its background transparent so that an
+/// EXR's alpha is the fractal's coverage.
 fn scene(body: &str) -> String {
+    let body = match body.strip_prefix("look: (") {
+        Some(look) => format!("look: (transparent_background: true, {look}"),
+        None => format!("{body}, look: (transparent_background: true)"),
+    };
     format!("(fps: 24, frames: 1, size: (32, 18), scene: ({body}))")
 }
 
@@ -246,8 +252,12 @@ fn light_too_bright_for_the_file_is_white_and_finite() {
     assert!(alpha.contains(&1.0), "the bulb is in view");
     let exr = d.exr("out/t/frame_00000.exr");
     assert!(exr.channel("R").contains(&65504.0));
+    // Every pixel the bulb covers whole (the background is transparent:
+    // black in an RGB PNG).
     let png = image::open(d.path().join("out/t/frame_00000.png")).unwrap();
-    let black = png.to_rgb8().pixels().filter(|p| p.0 != [255; 3]).count();
+    let rgb = png.to_rgb8();
+    let covered = rgb.pixels().zip(&alpha).filter(|(_, &a)| a == 1.0);
+    let black = covered.filter(|(p, _)| p.0 != [255; 3]).count();
     assert_eq!(black, 0, "pixels not white");
 }
 

@@ -254,3 +254,18 @@ pub fn says(out: &Output, what: &str) {
     let err = stderr(out);
     assert!(err.contains(what), "missing {what:?} in: {err}");
 }
+
+/// Whether the real tool `program` runs here (`probe` is an argument it
+/// answers at once). `.ci/run` installs every tool the tests use, so in CI
+/// a missing one fails the test; elsewhere the test says so and passes.
+pub fn tool(program: &str, probe: &str) -> bool {
+    let found = Command::new(program).arg(probe).output().is_ok();
+    if !found {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "{program} is missing in CI"
+        );
+        eprintln!("{program} not installed: skipping (.ci/run installs it)");
+    }
+    found
+}

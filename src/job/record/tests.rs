@@ -29,6 +29,7 @@ fn each_format_keeps_its_own_range_layers_and_samples() {
         frames: (0, 3),
         aovs: vec![Aov::Normal],
         samples: Some(2),
+        exr_compression: Default::default(),
     };
     let few_exrs = JobRecord {
         formats: vec!["exr".into()],
@@ -44,6 +45,7 @@ fn each_format_keeps_its_own_range_layers_and_samples() {
         frames: (0, 120),
         aovs: Vec::new(),
         samples: None,
+        exr_compression: Default::default(),
     };
     let merged = JobRecord::read(dir.path()).unwrap();
     assert_eq!(merged.outputs(), [exr.clone(), png.clone()]);

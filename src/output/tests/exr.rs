@@ -5,6 +5,9 @@ use crate::output::{Aov, Format, HASH_KEY};
 use crate::render::{Film, FrameStats};
 use std::path::Path;
 
+/// What an EXR written by `write_plain` with hash "abc" records.
+const EXR_KEY: &str = "abc+zip";
+
 #[test]
 fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
     // A size of 3×2 of exrs' 64-pixel tiles, cut short at the right and
@@ -45,6 +48,11 @@ fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
         ..full.clone()
     };
     let all = [Aov::Normal, Aov::Albedo, Aov::Traps, Aov::Steps];
+    // Alpha is the film's where the background is transparent.
+    let transparent = crate::output::Encoding {
+        transparent: true,
+        ..Default::default()
+    };
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("tiles.exr");
     // The film's layers are written wherever it has them; the step
@@ -55,22 +63,14 @@ fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
         (&plain, &[][..], 5),
     ];
     for (film, aovs, channels) in cases {
-        write_frame(
-            &path,
-            Format::Exr,
-            film,
-            "h",
-            aovs,
-            crate::color::Display::default(),
-        )
-        .unwrap();
+        write_frame(&path, Format::Exr, film, "h", aovs, &transparent).unwrap();
         let image = exr::prelude::read_all_flat_layers_from_file(&path).unwrap();
         let layer = &image.layer_data[0];
         assert_eq!(layer.size, exr::math::Vec2(w as usize, h as usize));
         assert_eq!(layer.channel_data.list.len(), channels);
         if channels == 5 {
             let names = layer.channel_data.list.iter().map(|c| c.name.to_string());
-            assert_eq!(names.collect::<Vec<_>>(), ["A", "B", "G", "R", "Z"]);
+            assert_eq!(names.collect::<Vec<_>>(), ["A", "B", "G", "R", "depth.Z"]);
         }
         for i in 0..n {
             for (name, value) in expected_samples(film, !aovs.is_empty(), i) {
@@ -97,7 +97,7 @@ fn expected_samples(film: &Film, steps: bool, i: usize) -> Vec<(&'static str, f3
         ("G", half(film.colour[i].y)),
         ("B", half(film.colour[i].z)),
         ("A", half(film.alpha[i])),
-        ("Z", film.depth[i]),
+        ("depth.Z", film.depth[i]),
     ];
     if let Some(normal) = &film.normal {
         expected.extend([
@@ -163,7 +163,7 @@ fn an_exr_whose_offset_table_is_damaged_is_not_current() {
     };
     write_plain(&path, Format::Exr, &film, "abc");
     assert_eq!(
-        file_state(&path, Format::Exr, "abc", true),
+        file_state(&path, Format::Exr, EXR_KEY, true),
         FileState::Current
     );
     let mut bytes = std::fs::read(&path).unwrap();
@@ -180,7 +180,7 @@ fn an_exr_whose_offset_table_is_damaged_is_not_current() {
     bytes[last..last + 8].copy_from_slice(&previous);
     std::fs::write(&path, &bytes).unwrap();
     for thorough in [false, true] {
-        let state = file_state(&path, Format::Exr, "abc", thorough);
+        let state = file_state(&path, Format::Exr, EXR_KEY, thorough);
         assert_eq!(state, FileState::Damaged, "thorough: {thorough}");
     }
 }

@@ -1,4 +1,5 @@
 use super::{film, write_plain};
+use crate::output::exr::ExrCompression::{Piz, Zip};
 use crate::output::frames::*;
 use crate::output::{Aov, Format};
 use crate::scene::Scene;
@@ -18,12 +19,17 @@ fn hash_changes_with_any_input() {
     assert_ne!(h, frame_hash(&[t], 0, 4, 3));
     // Extra layers are the EXR's alone: its key names them, in order.
     let layers = [Aov::Normal, Aov::Steps];
-    assert_eq!(stored_key(Format::Png, &h, &layers), h);
-    assert_eq!(stored_key(Format::Exr, &h, &[]), h);
+    let key = |format, hash: &str, aovs: &[Aov]| stored_key(format, hash, aovs, Zip);
+    assert_eq!(key(Format::Png, &h, &layers), h);
+    assert_eq!(key(Format::Exr, &h, &[]), format!("{h}+zip"));
     assert_eq!(
-        stored_key(Format::Exr, &h, &layers),
-        format!("{h}+normal,steps")
+        key(Format::Exr, &h, &layers),
+        format!("{h}+zip+normal,steps")
     );
+    // So are the compression, and a PNG's kind where not the 8-bit one.
+    assert_eq!(stored_key(Format::Exr, &h, &[], Piz), format!("{h}+piz"));
+    assert_eq!(key(Format::Png16, &h, &[]), format!("{h}+png16"));
+    assert_eq!(key(Format::Png16Alpha, &h, &[]), format!("{h}+png16alpha"));
     // A grade other than the default follows the light's hash in the
     // PNG's key alone: the EXR's and the checkpoint's are the light's.
     let mut g = s.clone();
@@ -32,8 +38,8 @@ fn hash_changes_with_any_input() {
     let graded = frame_hash(std::slice::from_ref(&g), 0, 4, 3);
     assert_eq!(graded, format!("{h}~exposure=2,Filmic"));
     assert_eq!(light_hash(&graded), h);
-    assert_eq!(stored_key(Format::Exr, &graded, &[]), h);
-    assert_eq!(stored_key(Format::Png, &graded, &[]), graded);
+    assert_eq!(key(Format::Exr, &graded, &[]), format!("{h}+zip"));
+    assert_eq!(key(Format::Png, &graded, &[]), graded);
 }
 
 #[test]
@@ -51,7 +57,8 @@ fn written_frames_carry_their_hash_and_leave_no_temporary() {
         assert!(leftovers.is_empty(), "temporary files left behind");
         for thorough in [false, true] {
             let state = |path: &Path, key| file_state(path, format, key, thorough);
-            assert_eq!(state(&path, "abc123"), FileState::Current);
+            let key = stored_key(format, "abc123", &[], Default::default());
+            assert_eq!(state(&path, &key), FileState::Current);
             assert_eq!(state(&path, "other"), FileState::Stale);
             let missing = dir.path().join(frame_file_name(1, format));
             assert_eq!(state(&missing, "abc123"), FileState::Missing);

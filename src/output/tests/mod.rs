@@ -13,15 +13,7 @@ use std::path::Path;
 
 /// `write_frame` without layers, shown as by default.
 fn write_plain(path: &Path, format: Format, film: &Film, hash: &str) {
-    write_frame(
-        path,
-        format,
-        film,
-        hash,
-        &[],
-        crate::color::Display::default(),
-    )
-    .unwrap();
+    write_frame(path, format, film, hash, &[], &super::Encoding::default()).unwrap();
 }
 
 fn film() -> Film {

@@ -1,0 +1,207 @@
+//! EXR frames as compositors and other tools read them: premultiplied
+//! alpha laid over a plate by oiiotool, depth under a name every reader
+//! takes, and each compression read back by OpenEXR's own tools.
+
+use crate::util::{tiny_timeline, tool, with_scene, Dir};
+use std::process::Command;
+
+/// A 48×27 frame with four samples a pixel (so edges are partly
+/// covered), its background transparent or not.
+fn frame(transparent: bool) -> String {
+    let look = format!("samples_per_pixel: 4, look: (transparent_background: {transparent})");
+    with_scene(&tiny_timeline(1, 8.0), &look)
+}
+
+/// Runs `program` with `args` in `d`, failing the test unless it succeeds;
+/// returns its stdout and stderr.
+fn run_tool(d: &Dir, program: &str, args: &[&str]) -> (String, String) {
+    let out = Command::new(program)
+        .args(args)
+        .current_dir(d.path())
+        .output()
+        .unwrap_or_else(|e| panic!("{program}: {e}"));
+    let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+    assert!(
+        out.status.success(),
+        "{program} {args:?}: {}",
+        text(&out.stderr)
+    );
+    (text(&out.stdout), text(&out.stderr))
+}
+
+#[test]
+fn oiiotool_lays_a_transparent_frame_over_a_plate_as_premultiplied() {
+    if !tool("oiiotool", "--help") {
+        return;
+    }
+    let d = Dir::new();
+    d.write("t.ron", &frame(true));
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let plate = [0.2f32, 0.5, 0.8];
+    let pattern = format!("constant:color={},{},{},1", plate[0], plate[1], plate[2]);
+    run_tool(
+        &d,
+        "oiiotool",
+        &[
+            "out/t/frame_00000.exr",
+            "--ch",
+            "R,G,B,A",
+            "--pattern",
+            &pattern,
+            "48x27",
+            "4",
+            "--over",
+            "-d",
+            "float",
+            "-o",
+            "comp.exr",
+        ],
+    );
+    let (fg, comp) = (d.exr("out/t/frame_00000.exr"), d.exr("comp.exr"));
+    let alpha = fg.channel("A");
+    assert_eq!(alpha[0], 0.0, "a corner sees background");
+    let partial = alpha.iter().filter(|&&a| a > 0.0 && a < 1.0).count();
+    assert!(partial > 10, "{partial} partly covered pixels");
+    // Over: the frame's colour plus the plate where the frame lets it through.
+    for (k, name) in ["R", "G", "B"].into_iter().enumerate() {
+        let (f, c) = (fg.channel(name), comp.channel(name));
+        for i in 0..alpha.len() {
+            let expected = f[i] + (1.0 - alpha[i]) * plate[k];
+            let tolerance = 2e-3 * expected.abs().max(1.0);
+            assert!(
+                (c[i] - expected).abs() < tolerance,
+                "{name} at pixel {i}: {} over the plate is {}, not {expected}",
+                f[i],
+                c[i]
+            );
+        }
+        // Where the frame shows background, the plate alone.
+        assert!((c[0] - plate[k]).abs() < 1e-3, "{name}: {}", c[0]);
+    }
+}
+
+#[test]
+fn an_opaque_frame_covers_the_plate_and_keeps_its_background() {
+    let d = Dir::new();
+    d.write("opaque.ron", &frame(false));
+    d.write("clear.ron", &frame(true));
+    d.ok(&["render", "opaque.ron", "--format", "exr"]);
+    d.ok(&["render", "clear.ron", "--format", "exr"]);
+    let (opaque, clear) = (
+        d.exr("out/opaque/frame_00000.exr"),
+        d.exr("out/clear/frame_00000.exr"),
+    );
+    assert!(opaque.channel("A").iter().all(|&a| a == 1.0));
+    // The background is drawn into the opaque frame's colour and left out
+    // of the transparent one's, which where the bulb covers a pixel whole
+    // is the same.
+    let (a, r_opaque, r_clear) = (clear.channel("A"), opaque.channel("R"), clear.channel("R"));
+    assert!(
+        r_opaque[0] > 0.0 && r_clear[0] == 0.0,
+        "{} {}",
+        r_opaque[0],
+        r_clear[0]
+    );
+    let whole: Vec<usize> = (0..a.len()).filter(|&i| a[i] == 1.0).collect();
+    assert!(whole.len() > 100);
+    assert!(whole.iter().all(|&i| r_opaque[i] == r_clear[i]));
+}
+
+#[test]
+fn depth_reads_without_complaint_in_exrheader_oiiotool_and_ffmpeg() {
+    if !tool("exrheader", "--help") || !tool("oiiotool", "--help") || !tool("ffmpeg", "-version") {
+        return;
+    }
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 7.0));
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let (header, _) = run_tool(&d, "exrheader", &["out/t/frame_00000.exr"]);
+    assert!(
+        header.contains("depth.Z, 32-bit floating-point"),
+        "{header}"
+    );
+    let (info, _) = run_tool(&d, "oiiotool", &["--info", "-v", "out/t/frame_00000.exr"]);
+    assert!(
+        info.contains("R (half), G (half), B (half), A (half), depth.Z (float)"),
+        "{info}"
+    );
+    // ffmpeg takes a bare Z for a third colour channel and says so on
+    // every frame; it passes over depth.Z.
+    let args = [
+        "-v",
+        "warning",
+        "-i",
+        "out/t/frame_%05d.exr",
+        "-f",
+        "null",
+        "-",
+    ];
+    let (_, said) = run_tool(&d, "ffmpeg", &args);
+    assert!(!said.contains("Multiple channels"), "{said}");
+}
+
+#[test]
+fn every_exr_compression_reads_back_in_openexr_and_oiiotool() {
+    if !tool("exrheader", "--help") || !tool("oiiotool", "--help") {
+        return;
+    }
+    let d = Dir::new();
+    d.write("t.ron", &frame(true));
+    let cases = [
+        ("none", "none", true),
+        ("rle", "run-length encoding", true),
+        ("zips", "zip, individual scanlines", true),
+        ("zip", "zip, multi-scanline blocks", true),
+        ("piz", "piz", true),
+        ("pxr24", "pxr24", false),
+        ("b44", "b44", false),
+        ("b44a", "b44a", false),
+        ("dwaa", "dwa, small scanline blocks", false),
+        ("dwab", "dwa, medium scanline blocks", false),
+    ];
+    let mut reference: Option<Vec<f32>> = None;
+    for (name, described, lossless) in cases {
+        let out = format!("c_{name}");
+        let args = [
+            "render",
+            "t.ron",
+            "--format",
+            "exr",
+            "--exr-compression",
+            name,
+        ];
+        d.ok(&[&args[..], &["--out", &out]].concat());
+        let file = format!("{out}/frame_00000.exr");
+        let (header, _) = run_tool(&d, "exrheader", &[&file]);
+        let expected = format!("compression (type compression): {described}\n");
+        assert!(header.contains(&expected), "{name}: {header}");
+        // oiiotool decodes every pixel: it fails on a damaged block.
+        run_tool(&d, "oiiotool", &[&file, "--printstats"]);
+        let red = d.exr(&file).channel("R").to_vec();
+        let reference = reference.get_or_insert_with(|| red.clone());
+        let squares: f32 = red
+            .iter()
+            .zip(reference.iter())
+            .map(|(a, b)| (a - b) * (a - b))
+            .sum();
+        let rms = (squares / red.len() as f32).sqrt();
+        if lossless {
+            assert_eq!(rms, 0.0, "{name} is lossless");
+        } else {
+            // B44's 4×4 blocks blur this tiny frame's sharp edges most: 0.014.
+            assert!(rms < 0.03, "{name}: rms error {rms}");
+        }
+    }
+    // The compression is part of what a file records: another re-renders it.
+    let again = d.ok(&[
+        "render",
+        "t.ron",
+        "--format",
+        "exr",
+        "--exr-compression",
+        "piz",
+        "--out",
+        "c_zip",
+    ]);
+    assert!(!crate::util::stderr(&again).contains("already complete"));
+}
