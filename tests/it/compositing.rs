@@ -205,3 +205,18 @@ fn every_exr_compression_reads_back_in_openexr_and_oiiotool() {
     ]);
     assert!(!crate::util::stderr(&again).contains("already complete"));
 }
+
+#[test]
+fn glow_around_a_transparent_frame_is_light_without_coverage() {
+    let d = Dir::new();
+    let glow = "effects: (glow: (colour: (0.9, 0.6, 0.3), strength: 0.6, width: 4))";
+    d.write("t.ron", &with_scene(&frame(true), glow));
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let exr = d.exr("out/t/frame_00000.exr");
+    let (alpha, red) = (exr.channel("A"), exr.channel("R"));
+    // Misses near the bulb carry the glow, with alpha 0: "over" adds it.
+    let glowing = (0..alpha.len())
+        .filter(|&i| alpha[i] == 0.0 && red[i] > 0.0)
+        .count();
+    assert!(glowing > 10, "{glowing} glowing pixels with no coverage");
+}
