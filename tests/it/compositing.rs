@@ -220,3 +220,23 @@ fn glow_around_a_transparent_frame_is_light_without_coverage() {
         .count();
     assert!(glowing > 10, "{glowing} glowing pixels with no coverage");
 }
+
+#[test]
+fn every_new_kind_of_file_is_the_same_on_any_thread_count() {
+    let d = Dir::new();
+    d.write("t.ron", &frame(true));
+    for (format, compression) in [("png16alpha,exr", "piz"), ("png16,exr", "dwaa")] {
+        let extra = [
+            "--format",
+            format,
+            "--exr-compression",
+            compression,
+            "--force",
+        ];
+        let files = ["frame_00000.png", "frame_00000.exr"];
+        d.same_on_one_and_two_threads("t.ron", &extra, &files);
+    }
+    // The dithered 8-bit PNG too, at a size whose rows split unevenly.
+    d.write("wide.ron", &frame(false).replace("(48, 27)", "(203, 77)"));
+    d.same_on_one_and_two_threads("wide.ron", &["--replace"], &["frame_00000.png"]);
+}
