@@ -274,6 +274,18 @@ pub fn shell_quote(s: &str) -> String {
     }
 }
 
+/// Makes odd sizes even (yuv420p needs it), then converts to YUV by the
+/// BT.709 matrix into limited range: ffmpeg's default matrix is BT.601,
+/// which players of HD video, taking it for 709, show with shifted greens.
+const VIDEO_FILTER: &str =
+    "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv,format=yuv420p";
+
+/// The stream's colour tags, saying what `VIDEO_FILTER` made. The transfer
+/// is sRGB's (iec61966-2-1), not bt709: the frames hold sRGB-coded values,
+/// and colour-managed players decode a bt709 tag with its camera curve.
+const VIDEO_TAGS: &str =
+    "-colorspace bt709 -color_primaries bt709 -color_trc iec61966-2-1 -color_range tv";
+
 /// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
 pub fn ffmpeg_command(
     dir: &Path,
@@ -295,7 +307,7 @@ pub fn ffmpeg_command(
     };
     format!(
         "ffmpeg -y -framerate {fps} -start_number {start} {trc}-i {input} -frames:v {count} \
-         -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
+         -vf '{VIDEO_FILTER}' -c:v libx264 -crf 18 {VIDEO_TAGS} {movie}",
         start = range.start,
         count = range.end - range.start,
         input = shell_quote(&input.to_string_lossy()),
@@ -315,6 +327,13 @@ mod tests {
             "{c}"
         );
         assert!(c.ends_with("out/zoom/zoom.mp4"));
+        // Converted by the BT.709 matrix into limited range, and tagged so.
+        assert!(
+            c.contains(",scale=out_color_matrix=bt709:out_range=tv,format=yuv420p' ")
+                && c.contains(" -colorspace bt709 -color_primaries bt709 ")
+                && c.contains(" -color_trc iec61966-2-1 -color_range tv "),
+            "{c}"
+        );
         let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
         assert!(
             spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),

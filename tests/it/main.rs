@@ -15,3 +15,4 @@ mod resume;
 mod stability;
 mod surface;
 mod validation;
+mod video;

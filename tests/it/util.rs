@@ -241,6 +241,35 @@ impl Dir {
     }
 }
 
+/// Whether ffmpeg and ffprobe run here; in CI they must (.ci/run installs
+/// them), elsewhere a test that needs them skips with a note.
+pub fn ffmpeg_installed() -> bool {
+    let runs = |tool: &str| Command::new(tool).arg("-version").output().is_ok();
+    let have = runs("ffmpeg") && runs("ffprobe");
+    if !have {
+        assert!(std::env::var_os("CI").is_none(), "ffmpeg is missing in CI");
+        eprintln!("ffmpeg not installed: skipping the encode");
+    }
+    have
+}
+
+impl Dir {
+    /// Runs an ffmpeg `command` as mandelreel printed it, through the shell,
+    /// quietly, and panics with what it said unless it succeeds.
+    pub fn run_printed(&self, command: &str) {
+        let quiet = command
+            .trim()
+            .replacen("ffmpeg ", "ffmpeg -loglevel error ", 1);
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(&quiet)
+            .current_dir(self.path())
+            .output()
+            .expect("run sh");
+        assert!(out.status.success(), "{quiet}: {}", stderr(&out));
+    }
+}
+
 pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
