@@ -182,10 +182,12 @@ impl Scan {
 
     /// Once the video's frames are all there: the command that encodes them.
     pub fn video_command(&self, formats: &BTreeMap<&str, FormatStatus<'_>>) -> Option<String> {
+        // The PNGs where there are any (`Plan::video_format`): `plan` has
+        // only the first part's format, and EXR sorts first.
         let video = self
             .parts
             .iter()
-            .find(|p| p.formats[0] == self.plan.video_format())
+            .find(|p| p.formats[0] == output::Format::Png)
             .unwrap_or(&self.parts[0]);
         formats
             .get(video.formats[0].extension())
