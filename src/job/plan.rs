@@ -5,6 +5,7 @@
 use crate::error::Error;
 use crate::job::frames::{frames_text, parse_frames};
 use crate::job::request::{parse_size, Sequence};
+use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use crate::timeline::Timeline;
 use std::path::{Path, PathBuf};
@@ -25,6 +26,9 @@ pub struct Plan {
     /// `--verify`: frame files are read to their last byte before they
     /// count as complete (`output::frames::file_state`).
     pub verify: bool,
+    /// `--frame-name`: how the frame files, and the hidden files kept for
+    /// each frame (claim, checkpoint), are named.
+    pub frame_name: FrameName,
 }
 
 impl Plan {
@@ -89,6 +93,7 @@ impl Plan {
             aovs,
             samples: args.samples,
             verify: false,
+            frame_name: args.frame_name.clone().unwrap_or_default(),
         })
     }
 
@@ -128,6 +133,7 @@ impl Plan {
                 aovs: o.aovs,
                 samples: o.samples,
                 verify: false,
+                frame_name: o.frame_name,
                 timeline,
             })
         };
@@ -180,6 +186,7 @@ impl Plan {
                         Vec::new()
                     },
                     samples: self.samples,
+                    frame_name: self.frame_name.clone(),
                 })
                 .collect(),
         })
@@ -200,8 +207,17 @@ impl Plan {
     }
 
     pub fn path(&self, frame: u32, format: Format) -> PathBuf {
-        self.out_dir
-            .join(output::frames::frame_file_name(frame, format))
+        self.out_dir.join(self.frame_name.file_name(frame, format))
+    }
+
+    /// `frame`'s claim (`job::claim`): `.frame_00042.claim`.
+    pub fn claim_path(&self, frame: u32) -> PathBuf {
+        self.out_dir.join(self.frame_name.hidden(frame, "claim"))
+    }
+
+    /// `frame`'s checkpoint (`job::checkpoint`): `.frame_00042.ckpt`.
+    pub fn checkpoint_path(&self, frame: u32) -> PathBuf {
+        self.out_dir.join(self.frame_name.hidden(frame, "ckpt"))
     }
 
     /// The format a video is encoded from: the PNGs, where rendered.
@@ -237,7 +253,8 @@ impl Plan {
             format!("{name}_{}", frames_text(range).replace(' ', "_"))
         };
         let fps = self.timeline.fps;
-        ffmpeg_command(&self.out_dir, &movie, fps, range, format)
+        let input = self.frame_name.ffmpeg_input(format);
+        ffmpeg_command(&self.out_dir, &movie, fps, range, format, &input)
     }
 
     /// The state of each format's file of `frame` against these inputs
@@ -286,18 +303,19 @@ const VIDEO_FILTER: &str =
 const VIDEO_TAGS: &str =
     "-colorspace bt709 -color_primaries bt709 -color_trc iec61966-2-1 -color_range tv";
 
-/// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
+/// The ffmpeg command that encodes frames `range` in `dir`, `format`
+/// files named by the ffmpeg pattern `input` (`frame_%05d.png`), as an MP4.
 pub fn ffmpeg_command(
     dir: &Path,
     name: &str,
     fps: f64,
     range: &std::ops::Range<u32>,
     format: Format,
+    input: &str,
 ) -> String {
     // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
     // own `%` is written `%%`.
-    let input = Path::new(&dir.to_string_lossy().replace('%', "%%"))
-        .join(output::frames::frame_pattern(format));
+    let input = Path::new(&dir.to_string_lossy().replace('%', "%%")).join(input);
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
     let trc = if format == Format::Exr {
@@ -321,7 +339,12 @@ mod tests {
 
     #[test]
     fn ffmpeg_command_has_rate_start_and_count() {
-        let c = ffmpeg_command(Path::new("out/zoom"), "zoom", 24.0, &(10..20), Format::Png);
+        // Frames 10..20 at 24 fps, named by default.
+        let command = |dir: &str, name: &str, format| {
+            let input = FrameName::default().ffmpeg_input(format);
+            ffmpeg_command(Path::new(dir), name, 24.0, &(10..20), format, &input)
+        };
+        let c = command("out/zoom", "zoom", Format::Png);
         assert!(
             c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"),
             "{c}"
@@ -334,12 +357,12 @@ mod tests {
                 && c.contains(" -color_trc iec61966-2-1 -color_range tv "),
             "{c}"
         );
-        let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
+        let spaced = command("my out", "z", Format::Exr);
         assert!(
             spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),
             "{spaced}"
         );
-        let percent = ffmpeg_command(Path::new("take 100%"), "z", 24.0, &(0..5), Format::Png);
+        let percent = command("take 100%", "z", Format::Png);
         assert!(
             percent.contains("-i 'take 100%%/frame_%05d.png'")
                 && percent.ends_with("'take 100%/z.mp4'"),

@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::output::atomic::write_atomic;
+use crate::output::names::FrameName;
 use crate::output::Aov;
 use serde::Serialize;
 use std::io::Write;
@@ -56,6 +57,10 @@ pub struct OutputRecord {
     pub aovs: Vec<Aov>,
     #[serde(default)]
     pub samples: Option<u32>,
+    /// `--frame-name`: how its frames are named (`frame_#####` in a
+    /// record written before it was recorded, as frames then were).
+    #[serde(default)]
+    pub frame_name: FrameName,
 }
 
 impl JobRecord {
@@ -144,16 +149,20 @@ impl JobRecord {
                 Vec::new()
             },
             samples: self.samples,
+            frame_name: FrameName::default(),
         };
         self.formats.iter().map(output).collect()
     }
 
     /// This record, keeping the formats of `old` (the same sequence) that
-    /// it does not render, and the span of its own formats' ranges there.
+    /// it does not render, and the span of its own formats' ranges there
+    /// (not where it names its frames otherwise: the old span's frames
+    /// are not the ones it names).
     fn merge_outputs(self, old: &JobRecord) -> JobRecord {
         let mut outputs = old.outputs();
         for new in self.outputs() {
             match outputs.iter_mut().find(|o| o.format == new.format) {
+                Some(o) if o.frame_name != new.frame_name => *o = new,
                 Some(o) => {
                     *o = OutputRecord {
                         frames: (o.frames.0.min(new.frames.0), o.frames.1.max(new.frames.1)),

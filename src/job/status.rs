@@ -107,13 +107,14 @@ fn folder_plans(
         ("--aov", !s.aovs.is_empty()),
         ("--preview", s.preview),
         ("--samples", s.samples.is_some()),
+        ("--frame-name", s.frame_name.is_some()),
     ];
     if let Some((option, _)) = given.iter().find(|(_, given)| *given) {
         return Err(Error::usage(
             option,
             format!(
-                "{} is an output folder, which records its own size, samples, formats and layers: \
-                 give the timeline instead (status TIMELINE {option} …) or leave {option} out",
+                "{} is an output folder, which records its own size, samples, formats, layers \
+                 and frame names: give the timeline instead (status TIMELINE {option} …) or leave {option} out",
                 target.display()
             ),
         )
@@ -136,8 +137,12 @@ fn frame_states(
     parts: &[Plan],
     claim_timeout: Duration,
 ) -> (ByState, Vec<ByState>, BTreeSet<String>) {
-    // Fresh temporary files, by frame: a writer is finishing that frame.
-    let writing = output::frames::frames_being_written(&plan.out_dir);
+    // Fresh temporary files, by frame: a writer is finishing that frame
+    // (found by each part's frame names).
+    let writing: Vec<HashSet<u32>> = parts
+        .iter()
+        .map(|p| output::frames::frames_being_written(&p.out_dir, &p.frame_name))
+        .collect();
     let mut by_state = ByState::new();
     let mut by_format = vec![ByState::new(); parts.len()];
     let mut workers: BTreeSet<String> = crate::job::claim::live_runs(&plan.out_dir, claim_timeout)
@@ -146,9 +151,9 @@ fn frame_states(
         .collect();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
-        for (part, by_state) in parts.iter().zip(&mut by_format) {
+        for ((part, by_state), writing) in parts.iter().zip(&mut by_format).zip(&writing) {
             if part.range.contains(&frame) {
-                let (state, worker) = frame_state(part, frame, &writing, claim_timeout);
+                let (state, worker) = frame_state(part, frame, writing, claim_timeout);
                 workers.extend(worker);
                 by_state.entry(state).or_insert_with(Vec::new).push(frame);
                 states.push(state);
@@ -260,7 +265,7 @@ pub fn frame_state(
     {
         return (FrameState::Complete, None);
     }
-    let claim = crate::job::claim::read_claim(&crate::job::claim::claim_path(&part.out_dir, frame))
+    let claim = crate::job::claim::read_claim(&part.claim_path(frame))
         .filter(|c| crate::job::claim::is_live(c, claim_timeout));
     if let Some(claim) = claim {
         return (FrameState::InProgress, Some(claim.who()));
@@ -268,7 +273,7 @@ pub fn frame_state(
     let state = if writing.contains(&frame) {
         FrameState::InProgress
     } else if crate::job::checkpoint::checkpoint_is_for(
-        &crate::job::checkpoint::checkpoint_path(&part.out_dir, frame),
+        &part.checkpoint_path(frame),
         output::frames::light_hash(&hash),
         part.width,
         part.height,

@@ -1,13 +1,15 @@
 //! Frames on disk: one module per file format (`png`: 8-bit sRGB; `exr`:
 //! linear half-float RGBA, a float Z and the layers `--aov` asks for), frame
 //! files and the content hash each carries in its own metadata so resume can
-//! tell a current frame from a stale one (`frames`), write-to-temporary-
+//! tell a current frame from a stale one (`frames`), their names (`names`:
+//! the `--frame-name` pattern), write-to-temporary-
 //! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
 
 pub mod atomic;
 pub mod csv;
 pub mod exr;
 pub mod frames;
+pub mod names;
 pub mod png;
 pub mod sheet;
 

@@ -409,7 +409,10 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
             "at most 32768",
         ),
         (&["sheet", "out/t", "--out", "sheet.jpg"], "name it .png"),
-        (&["sheet", "."], "no frame_NNNNN.png files"),
+        (
+            &["sheet", "."],
+            "no PNG frames named frame_##### in this folder",
+        ),
     ];
     for (args, what) in refused {
         let out = d.run(args);

@@ -11,6 +11,7 @@ mod fuzz;
 mod layers;
 mod limits;
 mod locations;
+mod names;
 mod resume;
 mod stability;
 mod surface;

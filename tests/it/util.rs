@@ -213,6 +213,11 @@ impl Dir {
     /// Writes a fresh claim on `frame` in out/t, held by a worker on
     /// another machine (node7:42).
     pub fn claim_elsewhere(&self, frame: u32) {
+        self.claim_named_elsewhere(&format!(".frame_{frame:05}.claim"), frame);
+    }
+
+    /// `claim_elsewhere` for frames of another name: `name` is the claim's.
+    pub fn claim_named_elsewhere(&self, name: &str, frame: u32) {
         let now_ms = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .unwrap()
@@ -221,7 +226,7 @@ impl Dir {
             "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t{frame}\",\"heartbeat_ms\":{now_ms}}}"
         );
         std::fs::create_dir_all(self.path().join("out/t")).unwrap();
-        self.write(&format!("out/t/.frame_{frame:05}.claim"), &claim);
+        self.write(&format!("out/t/{name}"), &claim);
     }
 
     /// Reads the EXR file at `rel`.
