@@ -7,6 +7,7 @@ use crate::job::frames::parse_frames;
 use crate::job::plan::Plan;
 use crate::job::request::Sequence;
 use crate::output;
+use crate::output::names::FrameName;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
@@ -33,6 +34,10 @@ pub struct Scan {
     /// The timeline the folder was last rendered from, where that is
     /// another file (rendered with --force).
     pub other_timeline: Option<PathBuf>,
+    /// Formats whose frames the folder's record names otherwise than the
+    /// scan does (a timeline's scan without its render's `--frame-name`),
+    /// with the names recorded.
+    pub other_names: Vec<(String, FrameName)>,
     /// Whether the timeline changed since the folder's last render started.
     pub changed: bool,
 }
@@ -75,6 +80,7 @@ pub fn scan(
         .as_ref()
         .filter(|job| !job.of_timeline(&plan.timeline.source))
         .map(|job| job.timeline_path.clone());
+    let other_names = job.as_ref().map_or(Vec::new(), |job| renamed(job, &parts));
     let changed = other_timeline.is_none()
         && crate::timeline::read_text(&plan.timeline.source)
             .ok()
@@ -89,8 +95,21 @@ pub fn scan(
         total,
         complete,
         other_timeline,
+        other_names,
         changed,
     })
+}
+
+/// The formats of `parts` whose frames `job` records under other names,
+/// with those names.
+fn renamed(job: &crate::job::record::JobRecord, parts: &[Plan]) -> Vec<(String, FrameName)> {
+    let outputs = job.outputs();
+    let scanned = |o: &&crate::job::record::OutputRecord| {
+        let part = parts.iter().find(|p| p.formats[0].extension() == o.format);
+        part.is_some_and(|p| p.frame_name != o.frame_name)
+    };
+    let named = |o: &crate::job::record::OutputRecord| (o.format.clone(), o.frame_name.clone());
+    outputs.iter().filter(scanned).map(named).collect()
 }
 
 /// The plans an output folder records, narrowed to `--frames` where given,

@@ -52,6 +52,8 @@ fn frames_named_by_a_pattern_are_found_resumed_and_encoded() {
     d.ok(&[&["status", "t.ron"][..], &shot].concat());
     let out = d.run(&["status", "t.ron"]);
     assert_eq!(out.status.code(), Some(4), "no frame_##### there");
+    let note = "note: the folder's png frames are named shot_####: add --frame-name shot_####";
+    assert!(stdout(&out).contains(note), "{}", stdout(&out));
     let out = d.ok(&["sheet", "out/t"]);
     assert!(stdout(&out).contains("3 frames of 3"), "{}", stdout(&out));
     // A resume skips them, rewriting none.
