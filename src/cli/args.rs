@@ -2,6 +2,7 @@
 //! into the job's plain `Request` and `Sequence`.
 
 use crate::job::{Request, Sequence};
+use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use std::path::PathBuf;
 
@@ -69,8 +70,12 @@ pub struct AccuracyArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct SheetArgs {
-    /// Folder holding frame_NNNNN.png files.
+    /// Folder holding PNG frames (frame_00000.png, …).
     pub dir: PathBuf,
+    /// How the frames are named, as render's --frame-name [default: what the
+    /// folder's mandelreel-job.json records, else frame_#####].
+    #[arg(long, value_name = "PATTERN")]
+    pub frame_name: Option<FrameName>,
     /// Number of frames to show, evenly spaced over the sequence (first and last included).
     #[arg(long, default_value_t = 12)]
     pub count: usize,
@@ -122,6 +127,10 @@ pub struct SequenceArgs {
         hide_possible_values = true
     )]
     pub exr_compression: output::exr::ExrCompression,
+    /// Name frame files by this pattern: one run of # is the frame number,
+    /// zero-padded to its length (shot_#### gives shot_0042.png) [default: frame_#####].
+    #[arg(long, value_name = "PATTERN")]
+    pub frame_name: Option<FrameName>,
 }
 
 #[derive(Debug, clap::Args)]
@@ -219,6 +228,7 @@ impl SequenceArgs {
             samples: self.samples,
             aovs: self.aov.clone(),
             exr_compression: self.exr_compression,
+            frame_name: self.frame_name.clone(),
         }
     }
 }

@@ -1,7 +1,9 @@
-//! `sheet`: tiles rendered PNG frames from a folder into one contact sheet.
+//! `sheet`: tiles rendered PNG frames from a folder into one contact sheet,
+//! finding them by the names the folder records (or `--frame-name`).
 
 use super::SheetArgs;
 use crate::error::Error;
+use crate::output::names::FrameName;
 use crate::output::{self, Format};
 
 /// Writes the contact sheet and says what it holds.
@@ -17,21 +19,19 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         let message = format!("the sheet is a PNG: name it .png, not {}", out.display());
         return Err(Error::usage("--out", message).into());
     }
-    let frames = output::frames::frame_files(&args.dir, Format::Png)?;
+    let names = args.frame_name.unwrap_or_else(|| recorded_names(&args.dir));
+    let frames = output::frames::frame_files(&args.dir, Format::Png, &names)?;
     if frames.is_empty() {
         // A --preview render's frames are a folder further down.
         let preview = args.dir.join("preview");
-        let hint =
-            if output::frames::frame_files(&preview, Format::Png).is_ok_and(|f| !f.is_empty()) {
-                format!(" (a preview's are in {})", preview.display())
-            } else {
-                String::new()
-            };
-        return Err(Error::usage(
-            &args.dir.display().to_string(),
-            format!("no frame_NNNNN.png files in this folder{hint}"),
-        )
-        .into());
+        let in_preview = output::frames::frame_files(&preview, Format::Png, &names);
+        let hint = if in_preview.is_ok_and(|f| !f.is_empty()) {
+            format!(" (a preview's are in {})", preview.display())
+        } else {
+            String::new()
+        };
+        let message = format!("no PNG frames named {names} in this folder{hint}");
+        return Err(Error::usage(&args.dir.display().to_string(), message).into());
     }
     let shown = output::sheet::evenly_spaced(&frames, args.count);
     output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
@@ -42,4 +42,16 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         out.display()
     );
     Ok(())
+}
+
+/// How the PNG frames in `dir` are named, by its job record: the default
+/// where it has none, or records none (it predates `--frame-name`).
+fn recorded_names(dir: &std::path::Path) -> FrameName {
+    let record = crate::job::record::JobRecord::read(dir).ok();
+    let outputs = record.map(|r| r.outputs()).unwrap_or_default();
+    outputs
+        .into_iter()
+        .find(|o| o.format == Format::Png.extension())
+        .map(|o| o.frame_name)
+        .unwrap_or_default()
 }

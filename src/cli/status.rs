@@ -53,6 +53,9 @@ fn print_json(
         /// The timeline the folder was last rendered from, where that
         /// is another file.
         folder_rendered_from: Option<&'a Path>,
+        /// Formats whose frames the folder names otherwise than asked,
+        /// with the names it records.
+        folder_frame_names: BTreeMap<&'a str, String>,
         /// Each format's frames, counted on their own.
         formats: &'a BTreeMap<&'a str, FormatStatus<'a>>,
         /// The ffmpeg command for the frames counted, once they
@@ -72,6 +75,11 @@ fn print_json(
             workers: s.workers.iter().cloned().collect(),
             timeline_changed_since_render: s.changed,
             folder_rendered_from: s.other_timeline.as_deref(),
+            folder_frame_names: s
+                .other_names
+                .iter()
+                .map(|(f, n)| (f.as_str(), n.to_string()))
+                .collect(),
             formats,
             video_command,
         })?
@@ -147,6 +155,9 @@ fn print_text(
             "  note: {} has changed since this folder's last render started",
             plan.timeline.source.display()
         );
+    }
+    for (format, names) in &s.other_names {
+        out!("  note: the folder's {format} frames are named {names}: add --frame-name {names}");
     }
     if let Some(other) = &s.other_timeline {
         out!(

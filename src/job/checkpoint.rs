@@ -3,19 +3,10 @@
 
 use crate::error::{Error, Result};
 use crate::output::atomic::write_atomic;
-use crate::output::frames::FRAME_DIGITS;
 use serde::Serialize;
 use std::fs::File;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-
-/// `.frame_00042.ckpt`: the saved accumulation of a frame still rendering.
-pub fn checkpoint_path(dir: &Path, frame_index: u32) -> PathBuf {
-    dir.join(format!(
-        ".frame_{frame_index:0width$}.ckpt",
-        width = FRAME_DIGITS
-    ))
-}
+use std::path::Path;
 
 const CHECKPOINT_MAGIC: &[u8] = b"mandelreel-checkpoint-1\n";
 
@@ -190,7 +181,7 @@ mod tests {
         };
         let mut acc = Accumulation::new(12, 8, layers);
         render_samples(std::slice::from_ref(&scene), 0, &mut acc, 2, &|| {});
-        let path = checkpoint_path(dir.path(), 0);
+        let path = dir.path().join(".frame_00000.ckpt");
         write_checkpoint(&path, &acc, "h1").unwrap();
         assert_eq!(
             read_checkpoint(&path, "h1", 12, 8, layers).as_ref(),

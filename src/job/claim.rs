@@ -11,6 +11,8 @@
 //! writing its claim; the next generation's marker (`.1`, …) decides then.
 //! Markers are never deleted while a takeover may be deciding, so no two
 //! workers can win one generation.
+//! Claims are named after the frame's files (`--frame-name shot_####`:
+//! `.shot_0042.claim`), so workers on frames of other names never meet.
 //! Heartbeats compare clocks across machines: cluster nodes must keep them in
 //! step (NTP), to well within the timeout.
 
@@ -116,19 +118,12 @@ fn runs(dir: &Path) -> Vec<(PathBuf, ClaimRecord)> {
         .collect()
 }
 
-/// `.frame_00042.claim` for frame 42.
-pub fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
-    dir.join(format!(
-        ".frame_{frame_index:0width$}.claim",
-        width = crate::output::frames::FRAME_DIGITS
-    ))
-}
-
-fn takeover_path(dir: &Path, frame_index: u32, token: &str, generation: u32) -> PathBuf {
-    dir.join(format!(
-        ".frame_{frame_index:0width$}.takeover-{token}.{generation}",
-        width = crate::output::frames::FRAME_DIGITS
-    ))
+/// The marker that decides who takes over the claim at `claim` held by
+/// `token`: `.frame_00042.takeover-<token>.0` beside `.frame_00042.claim`.
+fn takeover_path(claim: &Path, token: &str, generation: u32) -> PathBuf {
+    let name = claim.file_name().unwrap_or_default().to_string_lossy();
+    let stem = name.strip_suffix(".claim").unwrap_or(&name);
+    claim.with_file_name(format!("{stem}.takeover-{token}.{generation}"))
 }
 
 fn now_ms() -> u64 {
@@ -276,10 +271,11 @@ impl Drop for Claim {
     }
 }
 
-/// Tries to claim `frame_index` in `dir`. A claim older than `timeout` is
-/// taken over; the heartbeat is refreshed every quarter timeout.
-pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Attempt> {
-    let path = claim_path(dir, frame_index);
+/// Tries to claim a frame by its claim file, `path` (`Plan::claim_path`).
+/// A claim older than `timeout` is taken over; the heartbeat is refreshed
+/// every quarter timeout.
+pub fn try_claim(path: &Path, timeout: Duration) -> Result<Attempt> {
+    let path = path.to_path_buf();
     let record = ClaimRecord::mine();
     let interval = timeout / 4;
     for _ in 0..3 {
@@ -341,7 +337,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
         // next generation's.
         let mut generation = 0;
         let (marker, release) = loop {
-            let marker = takeover_path(dir, frame_index, &held.token, generation);
+            let marker = takeover_path(&path, &held.token, generation);
             let mut lock = crate::interrupt::hold();
             match OpenOptions::new()
                 .write(true)
@@ -350,7 +346,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             {
                 Ok(_) => {
                     let markers: Vec<PathBuf> = (0..=generation)
-                        .map(|g| takeover_path(dir, frame_index, &held.token, g))
+                        .map(|g| takeover_path(&path, &held.token, g))
                         .collect();
                     let release = releaser(&path, &record.token, &markers);
                     break (marker, lock.on_interrupt(release));
@@ -374,7 +370,7 @@ pub fn try_claim(dir: &Path, frame_index: u32, timeout: Duration) -> Result<Atte
             return Err(e);
         }
         let markers = (0..=generation)
-            .map(|g| takeover_path(dir, frame_index, &held.token, g))
+            .map(|g| takeover_path(&path, &held.token, g))
             .collect();
         return Ok(Attempt::Claimed(Claim::start(
             path, record, interval, markers, true, release,

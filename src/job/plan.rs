@@ -5,6 +5,7 @@
 use crate::error::Error;
 use crate::job::frames::{frames_text, parse_frames};
 use crate::job::request::{parse_size, Sequence};
+use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use crate::timeline::Timeline;
 use std::path::{Path, PathBuf};
@@ -26,6 +27,9 @@ pub struct Plan {
     /// `--verify`: frame files are read to their last byte before they
     /// count as complete (`output::frames::file_state`).
     pub verify: bool,
+    /// `--frame-name`: how the frame files, and the hidden files kept for
+    /// each frame (claim, checkpoint), are named.
+    pub frame_name: FrameName,
 }
 
 impl Plan {
@@ -103,6 +107,7 @@ impl Plan {
             exr_compression: args.exr_compression,
             samples: args.samples,
             verify: false,
+            frame_name: args.frame_name.clone().unwrap_or_default(),
         })
     }
 
@@ -143,6 +148,7 @@ impl Plan {
                 exr_compression: o.exr_compression,
                 samples: o.samples,
                 verify: false,
+                frame_name: o.frame_name,
                 timeline,
             })
         };
@@ -192,6 +198,7 @@ impl Plan {
                     },
                     samples: self.samples,
                     exr_compression: self.exr_compression,
+                    frame_name: self.frame_name.clone(),
                 })
                 .collect(),
         })
@@ -212,8 +219,17 @@ impl Plan {
     }
 
     pub fn path(&self, frame: u32, format: Format) -> PathBuf {
-        self.out_dir
-            .join(output::frames::frame_file_name(frame, format))
+        self.out_dir.join(self.frame_name.file_name(frame, format))
+    }
+
+    /// `frame`'s claim (`job::claim`): `.frame_00042.claim`.
+    pub fn claim_path(&self, frame: u32) -> PathBuf {
+        self.out_dir.join(self.frame_name.hidden(frame, "claim"))
+    }
+
+    /// `frame`'s checkpoint (`job::checkpoint`): `.frame_00042.ckpt`.
+    pub fn checkpoint_path(&self, frame: u32) -> PathBuf {
+        self.out_dir.join(self.frame_name.hidden(frame, "ckpt"))
     }
 
     /// The format a video is encoded from: the PNGs, where rendered.
@@ -246,7 +262,8 @@ impl Plan {
             format!("{name}_{}", frames_text(range).replace(' ', "_"))
         };
         let fps = self.timeline.fps;
-        ffmpeg_command(&self.out_dir, &movie, fps, range, format)
+        let input = self.frame_name.ffmpeg_input(format);
+        ffmpeg_command(&self.out_dir, &movie, fps, range, format, &input)
     }
 
     /// The state of each format's file of `frame` against these inputs
@@ -283,18 +300,31 @@ pub fn shell_quote(s: &str) -> String {
     }
 }
 
-/// The ffmpeg command that encodes frames `range` in `dir` as an MP4.
+/// Makes odd sizes even (yuv420p needs it), then converts to YUV by the
+/// BT.709 matrix into limited range: ffmpeg's default matrix is BT.601,
+/// which players of HD video, taking it for 709, show with shifted greens.
+const VIDEO_FILTER: &str =
+    "pad=ceil(iw/2)*2:ceil(ih/2)*2,scale=out_color_matrix=bt709:out_range=tv,format=yuv420p";
+
+/// The stream's colour tags, saying what `VIDEO_FILTER` made. The transfer
+/// is sRGB's (iec61966-2-1), not bt709: the frames hold sRGB-coded values,
+/// and colour-managed players decode a bt709 tag with its camera curve.
+const VIDEO_TAGS: &str =
+    "-colorspace bt709 -color_primaries bt709 -color_trc iec61966-2-1 -color_range tv";
+
+/// The ffmpeg command that encodes frames `range` in `dir`, `format`
+/// files named by the ffmpeg pattern `input` (`frame_%05d.png`), as an MP4.
 pub fn ffmpeg_command(
     dir: &Path,
     name: &str,
     fps: f64,
     range: &std::ops::Range<u32>,
     format: Format,
+    input: &str,
 ) -> String {
     // ffmpeg reads `%` in an image sequence's name as a pattern: a folder's
     // own `%` is written `%%`.
-    let input = Path::new(&dir.to_string_lossy().replace('%', "%%"))
-        .join(output::frames::frame_pattern(format));
+    let input = Path::new(&dir.to_string_lossy().replace('%', "%%")).join(input);
     let movie = dir.join(format!("{name}.mp4"));
     // EXR frames are linear light; ask ffmpeg to apply the sRGB curve.
     let trc = if format == Format::Exr {
@@ -304,7 +334,7 @@ pub fn ffmpeg_command(
     };
     format!(
         "ffmpeg -y -framerate {fps} -start_number {start} {trc}-i {input} -frames:v {count} \
-         -vf 'pad=ceil(iw/2)*2:ceil(ih/2)*2' -c:v libx264 -pix_fmt yuv420p -crf 18 {movie}",
+         -vf '{VIDEO_FILTER}' -c:v libx264 -crf 18 {VIDEO_TAGS} {movie}",
         start = range.start,
         count = range.end - range.start,
         input = shell_quote(&input.to_string_lossy()),
@@ -318,18 +348,30 @@ mod tests {
 
     #[test]
     fn ffmpeg_command_has_rate_start_and_count() {
-        let c = ffmpeg_command(Path::new("out/zoom"), "zoom", 24.0, &(10..20), Format::Png);
+        // Frames 10..20 at 24 fps, named by default.
+        let command = |dir: &str, name: &str, format| {
+            let input = FrameName::default().ffmpeg_input(format);
+            ffmpeg_command(Path::new(dir), name, 24.0, &(10..20), format, &input)
+        };
+        let c = command("out/zoom", "zoom", Format::Png);
         assert!(
             c.contains("-framerate 24 -start_number 10 -i out/zoom/frame_%05d.png -frames:v 10"),
             "{c}"
         );
         assert!(c.ends_with("out/zoom/zoom.mp4"));
-        let spaced = ffmpeg_command(Path::new("my out"), "z", 30.0, &(0..5), Format::Exr);
+        // Converted by the BT.709 matrix into limited range, and tagged so.
+        assert!(
+            c.contains(",scale=out_color_matrix=bt709:out_range=tv,format=yuv420p' ")
+                && c.contains(" -colorspace bt709 -color_primaries bt709 ")
+                && c.contains(" -color_trc iec61966-2-1 -color_range tv "),
+            "{c}"
+        );
+        let spaced = command("my out", "z", Format::Exr);
         assert!(
             spaced.contains("-apply_trc iec61966_2_1 -i 'my out/frame_%05d.exr'"),
             "{spaced}"
         );
-        let percent = ffmpeg_command(Path::new("take 100%"), "z", 24.0, &(0..5), Format::Png);
+        let percent = command("take 100%", "z", Format::Png);
         assert!(
             percent.contains("-i 'take 100%%/frame_%05d.png'")
                 && percent.ends_with("'take 100%/z.mp4'"),

@@ -4,6 +4,7 @@
 
 use crate::error::{Error, Result};
 use crate::output::atomic::write_atomic;
+use crate::output::names::FrameName;
 use crate::output::Aov;
 use serde::Serialize;
 use std::io::Write;
@@ -59,6 +60,10 @@ pub struct OutputRecord {
     /// The EXR compression (an EXR's key records it).
     #[serde(default)]
     pub exr_compression: crate::output::exr::ExrCompression,
+    /// `--frame-name`: how its frames are named (`frame_#####` in a
+    /// record written before it was recorded, as frames then were).
+    #[serde(default)]
+    pub frame_name: FrameName,
 }
 
 impl JobRecord {
@@ -148,12 +153,15 @@ impl JobRecord {
             },
             samples: self.samples,
             exr_compression: Default::default(),
+            frame_name: FrameName::default(),
         };
         self.formats.iter().map(output).collect()
     }
 
     /// This record, keeping the formats of `old` (the same sequence) that
-    /// it does not render, and the span of its own formats' ranges there.
+    /// it does not render, and the span of its own formats' ranges there
+    /// (not where it names its frames otherwise: the old span's frames
+    /// are not the ones it names).
     fn merge_outputs(self, old: &JobRecord) -> JobRecord {
         let mut outputs = old.outputs();
         for new in self.outputs() {
@@ -163,6 +171,7 @@ impl JobRecord {
                 o.format == new.format || extension(&o.format) != extension(&new.format)
             });
             match outputs.iter_mut().find(|o| o.format == new.format) {
+                Some(o) if o.frame_name != new.frame_name => *o = new,
                 Some(o) => {
                     *o = OutputRecord {
                         frames: (o.frames.0.min(new.frames.0), o.frames.1.max(new.frames.1)),

@@ -3,6 +3,7 @@
 //! (sizes, shards, thread counts) into checked ones.
 
 use crate::error::{Error, Result};
+use crate::output::names::FrameName;
 use crate::output::{Aov, Format};
 use crate::timeline::Timeline;
 use std::path::PathBuf;
@@ -27,6 +28,8 @@ pub struct Sequence {
     /// Extra EXR layers.
     pub aovs: Vec<Aov>,
     pub exr_compression: crate::output::exr::ExrCompression,
+    /// How frame files are named [default: `frame_#####`].
+    pub frame_name: Option<FrameName>,
 }
 
 /// A render, as asked for: what `job::run` needs, nothing of how it is shown.

@@ -82,8 +82,11 @@ impl Job {
         // cannot both pass it.
         let replacing = request.force || request.replace;
         self.record.clone().record_in(out_dir, |old| {
-            if old.same_sequence(&self.record) || replacing {
+            if replacing {
                 return Ok(());
+            }
+            if old.same_sequence(&self.record) {
+                return refuse_other_names(out_dir, old, &self.record);
             }
             let running = crate::job::claim::live_runs(out_dir, request.claim_timeout);
             refuse_other_sequence(out_dir, old, &self.record, running.len())
@@ -203,7 +206,7 @@ impl Job {
                     lock(tally).complete += 1;
                     continue;
                 }
-                match crate::job::claim::try_claim(&plan.out_dir, *frame, timeout)? {
+                match crate::job::claim::try_claim(&plan.claim_path(*frame), timeout)? {
                     crate::job::claim::Attempt::Claimed(claim) => {
                         // It may have been finished between the check and the claim.
                         if force || !plan.is_complete(*frame, hash) {
@@ -268,10 +271,7 @@ fn refuse_other_sequence(
     record: &crate::job::record::JobRecord,
     running: usize,
 ) -> crate::error::Result<()> {
-    let frames: usize = [Format::Png, Format::Exr] // by extension: every PNG kind
-        .into_iter()
-        .map(|f| output::frames::frame_files(out_dir, f).map_or(0, |files| files.len()))
-        .sum();
+    let frames: usize = old.outputs().iter().map(|o| frame_count(out_dir, o)).sum();
     if frames == 0 && running == 0 {
         return Ok(());
     }
@@ -296,6 +296,42 @@ fn refuse_other_sequence(
             what(record),
         ),
     ))
+}
+
+/// How many frame files of `output` (its format, named its way) `out_dir` holds.
+fn frame_count(out_dir: &Path, output: &crate::job::record::OutputRecord) -> usize {
+    let format = <Format as clap::ValueEnum>::from_str(&output.format, true);
+    format.map_or(0, |f| {
+        output::frames::frame_files(out_dir, f, &output.frame_name).map_or(0, |v| v.len())
+    })
+}
+
+/// Refuses a render (`record`) of the sequence in `out_dir` that names a
+/// format's frames otherwise than the frames there (`old`): it would
+/// render them all again under the new names, and the folder's record
+/// could count only one naming. `--replace` does that on purpose.
+fn refuse_other_names(
+    out_dir: &Path,
+    old: &crate::job::record::JobRecord,
+    record: &crate::job::record::JobRecord,
+) -> crate::error::Result<()> {
+    for new in record.outputs() {
+        let renamed = old.outputs().into_iter().find(|o| {
+            o.format == new.format && o.frame_name != new.frame_name && frame_count(out_dir, o) > 0
+        });
+        let Some(o) = renamed else { continue };
+        let (was, now, format) = (&o.frame_name, &new.frame_name, &o.format);
+        let message = format!(
+            "{} holds {} {format} frame(s) named {was} (by its {}), not {now}: pass \
+             --frame-name {was} to resume them, or --replace to render them again as {now} \
+             (the {was} files stay, no longer counted)",
+            out_dir.display(),
+            frame_count(out_dir, &o),
+            crate::job::record::JOB_FILE,
+        );
+        return Err(Error::usage("--frame-name", message));
+    }
+    Ok(())
 }
 
 /// How far a render has got, for what an interrupt says (`report_interrupt`).

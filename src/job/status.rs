@@ -7,6 +7,7 @@ use crate::job::frames::parse_frames;
 use crate::job::plan::Plan;
 use crate::job::request::Sequence;
 use crate::output;
+use crate::output::names::FrameName;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
@@ -33,6 +34,10 @@ pub struct Scan {
     /// The timeline the folder was last rendered from, where that is
     /// another file (rendered with --force).
     pub other_timeline: Option<PathBuf>,
+    /// Formats whose frames the folder's record names otherwise than the
+    /// scan does (a timeline's scan without its render's `--frame-name`),
+    /// with the names recorded.
+    pub other_names: Vec<(String, FrameName)>,
     /// Whether the timeline changed since the folder's last render started.
     pub changed: bool,
 }
@@ -75,6 +80,7 @@ pub fn scan(
         .as_ref()
         .filter(|job| !job.of_timeline(&plan.timeline.source))
         .map(|job| job.timeline_path.clone());
+    let other_names = job.as_ref().map_or(Vec::new(), |job| renamed(job, &parts));
     let changed = other_timeline.is_none()
         && crate::timeline::read_text(&plan.timeline.source)
             .ok()
@@ -89,8 +95,21 @@ pub fn scan(
         total,
         complete,
         other_timeline,
+        other_names,
         changed,
     })
+}
+
+/// The formats of `parts` whose frames `job` records under other names,
+/// with those names.
+fn renamed(job: &crate::job::record::JobRecord, parts: &[Plan]) -> Vec<(String, FrameName)> {
+    let outputs = job.outputs();
+    let scanned = |o: &&crate::job::record::OutputRecord| {
+        let part = parts.iter().find(|p| p.formats[0].extension() == o.format);
+        part.is_some_and(|p| p.frame_name != o.frame_name)
+    };
+    let named = |o: &crate::job::record::OutputRecord| (o.format.clone(), o.frame_name.clone());
+    outputs.iter().filter(scanned).map(named).collect()
 }
 
 /// The plans an output folder records, narrowed to `--frames` where given,
@@ -107,13 +126,14 @@ fn folder_plans(
         ("--aov", !s.aovs.is_empty()),
         ("--preview", s.preview),
         ("--samples", s.samples.is_some()),
+        ("--frame-name", s.frame_name.is_some()),
     ];
     if let Some((option, _)) = given.iter().find(|(_, given)| *given) {
         return Err(Error::usage(
             option,
             format!(
-                "{} is an output folder, which records its own size, samples, formats and layers: \
-                 give the timeline instead (status TIMELINE {option} …) or leave {option} out",
+                "{} is an output folder, which records its own size, samples, formats, layers \
+                 and frame names: give the timeline instead (status TIMELINE {option} …) or leave {option} out",
                 target.display()
             ),
         )
@@ -136,8 +156,12 @@ fn frame_states(
     parts: &[Plan],
     claim_timeout: Duration,
 ) -> (ByState, Vec<ByState>, BTreeSet<String>) {
-    // Fresh temporary files, by frame: a writer is finishing that frame.
-    let writing = output::frames::frames_being_written(&plan.out_dir);
+    // Fresh temporary files, by frame: a writer is finishing that frame
+    // (found by each part's frame names).
+    let writing: Vec<HashSet<u32>> = parts
+        .iter()
+        .map(|p| output::frames::frames_being_written(&p.out_dir, &p.frame_name))
+        .collect();
     let mut by_state = ByState::new();
     let mut by_format = vec![ByState::new(); parts.len()];
     let mut workers: BTreeSet<String> = crate::job::claim::live_runs(&plan.out_dir, claim_timeout)
@@ -146,9 +170,9 @@ fn frame_states(
         .collect();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
-        for (part, by_state) in parts.iter().zip(&mut by_format) {
+        for ((part, by_state), writing) in parts.iter().zip(&mut by_format).zip(&writing) {
             if part.range.contains(&frame) {
-                let (state, worker) = frame_state(part, frame, &writing, claim_timeout);
+                let (state, worker) = frame_state(part, frame, writing, claim_timeout);
                 workers.extend(worker);
                 by_state.entry(state).or_insert_with(Vec::new).push(frame);
                 states.push(state);
@@ -182,10 +206,12 @@ impl Scan {
 
     /// Once the video's frames are all there: the command that encodes them.
     pub fn video_command(&self, formats: &BTreeMap<&str, FormatStatus<'_>>) -> Option<String> {
+        // The PNGs where there are any (`Plan::video_format`): `plan` has
+        // only the first part's format, and EXR sorts first.
         let video = self
             .parts
             .iter()
-            .find(|p| p.formats[0] == self.plan.video_format())
+            .find(|p| p.formats[0] == output::Format::Png)
             .unwrap_or(&self.parts[0]);
         formats
             .get(video.formats[0].extension())
@@ -258,7 +284,7 @@ pub fn frame_state(
     {
         return (FrameState::Complete, None);
     }
-    let claim = crate::job::claim::read_claim(&crate::job::claim::claim_path(&part.out_dir, frame))
+    let claim = crate::job::claim::read_claim(&part.claim_path(frame))
         .filter(|c| crate::job::claim::is_live(c, claim_timeout));
     if let Some(claim) = claim {
         return (FrameState::InProgress, Some(claim.who()));
@@ -266,7 +292,7 @@ pub fn frame_state(
     let state = if writing.contains(&frame) {
         FrameState::InProgress
     } else if crate::job::checkpoint::checkpoint_is_for(
-        &crate::job::checkpoint::checkpoint_path(&part.out_dir, frame),
+        &part.checkpoint_path(frame),
         output::frames::light_hash(&hash),
         part.width,
         part.height,

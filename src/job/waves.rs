@@ -44,7 +44,7 @@ impl Plan {
             );
             return self.write_film(frame, film, hash, &scenes[0].look);
         }
-        let checkpoint = crate::job::checkpoint::checkpoint_path(&self.out_dir, frame);
+        let checkpoint = self.checkpoint_path(frame);
         // A checkpoint holds linear light: how a PNG shows it is not its key.
         let light = output::frames::light_hash(hash);
         let saved_acc = crate::job::checkpoint::read_checkpoint(
@@ -104,10 +104,7 @@ impl Plan {
                 },
             )?;
         }
-        let _ = std::fs::remove_file(crate::job::checkpoint::checkpoint_path(
-            &self.out_dir,
-            frame,
-        ));
+        let _ = std::fs::remove_file(self.checkpoint_path(frame));
         Ok(film.stats)
     }
 }

@@ -3,6 +3,7 @@
 //! the ones being written.
 
 use super::atomic::write_atomic;
+use super::names::FrameName;
 use super::{Aov, Encoding, Format};
 use crate::error::{Error, Result};
 use crate::render::Film;
@@ -10,23 +11,6 @@ use crate::scene::Scene;
 use serde::Serialize;
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
-
-/// Digits in frame numbers: `frame_00042.png`.
-pub const FRAME_DIGITS: usize = 5;
-
-/// `frame_00042.png` for frame 42.
-pub fn frame_file_name(frame_index: u32, format: Format) -> String {
-    format!(
-        "frame_{frame_index:0width$}.{}",
-        format.extension(),
-        width = FRAME_DIGITS
-    )
-}
-
-/// The ffmpeg input pattern matching `frame_file_name`.
-pub fn frame_pattern(format: Format) -> String {
-    format!("frame_%0{FRAME_DIGITS}d.{}", format.extension())
-}
 
 /// Hash of everything that decides a frame's pixels: the effective scenes
 /// (one, or one per sample under motion blur), the frame index (it seeds the
@@ -176,40 +160,28 @@ pub fn write_frame(
     })
 }
 
-/// Frames a live writer is working on: those with a temporary file (frame,
-/// claim or checkpoint) that is not stale.
-pub fn frames_being_written(dir: &Path) -> std::collections::HashSet<u32> {
+/// Frames of `names` a live writer is working on: those with a temporary
+/// file (frame, claim or checkpoint) that is not stale.
+pub fn frames_being_written(dir: &Path, names: &FrameName) -> std::collections::HashSet<u32> {
     super::atomic::partials(dir)
         .unwrap_or_default()
         .into_iter()
         .filter(|(_, _, stale)| !stale)
-        .filter_map(|(_, name, _)| {
-            name.strip_prefix(".frame_")?
-                .get(..FRAME_DIGITS)?
-                .parse::<u32>()
-                .ok()
-        })
+        .filter_map(|(_, name, _)| names.frame_of_hidden(&name))
         .collect()
 }
 
-/// The final frame files of `format` in `dir`, in frame order.
-pub fn frame_files(dir: &Path, format: Format) -> Result<Vec<PathBuf>> {
+/// The final frame files of `format` named by `names` in `dir`, in frame
+/// order (frames of other names beside them are not listed).
+pub fn frame_files(dir: &Path, format: Format, names: &FrameName) -> Result<Vec<PathBuf>> {
     let entries = std::fs::read_dir(dir).map_err(|e| Error::io(dir, e))?;
-    let suffix = format!(".{}", format.extension());
-    let mut frames: Vec<PathBuf> = entries
+    let mut frames: Vec<(u32, PathBuf)> = entries
         .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| {
-            let name = p
-                .file_name()
-                .map(|n| n.to_string_lossy().into_owned())
-                .unwrap_or_default();
-            name.strip_prefix("frame_")
-                .and_then(|rest| rest.strip_suffix(&suffix))
-                .is_some_and(|digits| {
-                    !digits.is_empty() && digits.bytes().all(|b| b.is_ascii_digit())
-                })
+        .filter_map(|p| {
+            let name = p.file_name()?.to_string_lossy().into_owned();
+            Some((names.frame_of(&name, format)?, p))
         })
         .collect();
     frames.sort();
-    Ok(frames)
+    Ok(frames.into_iter().map(|(_, p)| p).collect())
 }

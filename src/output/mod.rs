@@ -2,13 +2,15 @@
 //! or 16-bit, with or without alpha; `exr`: linear half-float premultiplied
 //! RGBA, a float depth and the layers `--aov` asks for), frame
 //! files and the content hash each carries in its own metadata so resume can
-//! tell a current frame from a stale one (`frames`), write-to-temporary-
+//! tell a current frame from a stale one (`frames`), their names (`names`:
+//! the `--frame-name` pattern), write-to-temporary-
 //! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
 
 pub mod atomic;
 pub mod csv;
 pub mod exr;
 pub mod frames;
+pub mod names;
 pub mod png;
 pub mod sheet;
 

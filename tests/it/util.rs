@@ -213,6 +213,11 @@ impl Dir {
     /// Writes a fresh claim on `frame` in out/t, held by a worker on
     /// another machine (node7:42).
     pub fn claim_elsewhere(&self, frame: u32) {
+        self.claim_named_elsewhere(&format!(".frame_{frame:05}.claim"), frame);
+    }
+
+    /// `claim_elsewhere` for frames of another name: `name` is the claim's.
+    pub fn claim_named_elsewhere(&self, name: &str, frame: u32) {
         let now_ms = std::time::SystemTime::now()
             .duration_since(std::time::UNIX_EPOCH)
             .unwrap()
@@ -221,7 +226,7 @@ impl Dir {
             "{{\"host\":\"node7\",\"pid\":42,\"token\":\"t{frame}\",\"heartbeat_ms\":{now_ms}}}"
         );
         std::fs::create_dir_all(self.path().join("out/t")).unwrap();
-        self.write(&format!("out/t/.frame_{frame:05}.claim"), &claim);
+        self.write(&format!("out/t/{name}"), &claim);
     }
 
     /// Reads the EXR file at `rel`.
@@ -238,6 +243,35 @@ impl Dir {
                 .map(|c| (c.name.to_string(), c.sample_data.values_as_f32().collect()))
                 .collect(),
         }
+    }
+}
+
+/// Whether ffmpeg and ffprobe run here; in CI they must (.ci/run installs
+/// them), elsewhere a test that needs them skips with a note.
+pub fn ffmpeg_installed() -> bool {
+    let runs = |tool: &str| Command::new(tool).arg("-version").output().is_ok();
+    let have = runs("ffmpeg") && runs("ffprobe");
+    if !have {
+        assert!(std::env::var_os("CI").is_none(), "ffmpeg is missing in CI");
+        eprintln!("ffmpeg not installed: skipping the encode");
+    }
+    have
+}
+
+impl Dir {
+    /// Runs an ffmpeg `command` as mandelreel printed it, through the shell,
+    /// quietly, and panics with what it said unless it succeeds.
+    pub fn run_printed(&self, command: &str) {
+        let quiet = command
+            .trim()
+            .replacen("ffmpeg ", "ffmpeg -loglevel error ", 1);
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(&quiet)
+            .current_dir(self.path())
+            .output()
+            .expect("run sh");
+        assert!(out.status.success(), "{quiet}: {}", stderr(&out));
     }
 }
 

@@ -1,5 +1,11 @@
 use super::*;
 
+/// Frame `frame_index`'s claim in `dir`, named as frames are by default.
+fn claim_path(dir: &Path, frame_index: u32) -> PathBuf {
+    let name = crate::output::names::FrameName::default().hidden(frame_index, "claim");
+    dir.join(name)
+}
+
 #[test]
 fn a_run_record_comes_back_after_another_render_removed_it() {
     // A render stopped past the timeout (SIGSTOP) has its record removed
@@ -22,18 +28,18 @@ fn a_run_record_comes_back_after_another_render_removed_it() {
 fn one_claim_at_a_time_released_on_drop() {
     let dir = tempfile::tempdir().unwrap();
     let timeout = Duration::from_secs(60);
-    let Attempt::Claimed(claim) = try_claim(dir.path(), 3, timeout).unwrap() else {
+    let Attempt::Claimed(claim) = try_claim(&claim_path(dir.path(), 3), timeout).unwrap() else {
         panic!("a free frame can be claimed");
     };
     assert!(claim_path(dir.path(), 3).exists());
     assert!(matches!(
-        try_claim(dir.path(), 3, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 3), timeout).unwrap(),
         Attempt::Held(_)
     ));
     drop(claim);
     assert!(!claim_path(dir.path(), 3).exists());
     assert!(matches!(
-        try_claim(dir.path(), 3, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 3), timeout).unwrap(),
         Attempt::Claimed(_)
     ));
 }
@@ -58,10 +64,10 @@ fn a_takeover_marker_blocks_until_it_is_older_than_the_timeout() {
     let dead = write_dead_claim(dir.path(), 5);
     let timeout = Duration::from_secs(60);
     // Another worker has just begun taking the dead claim over.
-    let marker = takeover_path(dir.path(), 5, "dead-token", 0);
+    let marker = takeover_path(&claim_path(dir.path(), 5), "dead-token", 0);
     let file = std::fs::File::create(&marker).unwrap();
     assert!(matches!(
-        try_claim(dir.path(), 5, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 5), timeout).unwrap(),
         Attempt::Held(_)
     ));
     assert_eq!(read_claim(&claim_path(dir.path(), 5)).unwrap(), dead);
@@ -70,7 +76,7 @@ fn a_takeover_marker_blocks_until_it_is_older_than_the_timeout() {
     file.set_modified(std::time::SystemTime::now() - Duration::from_secs(120))
         .unwrap();
     drop(file);
-    let Attempt::Claimed(ours) = try_claim(dir.path(), 5, timeout).unwrap() else {
+    let Attempt::Claimed(ours) = try_claim(&claim_path(dir.path(), 5), timeout).unwrap() else {
         panic!("a stale marker does not block the frame");
     };
     assert_eq!(
@@ -80,12 +86,12 @@ fn a_takeover_marker_blocks_until_it_is_older_than_the_timeout() {
     // The stale marker stays (deleting it could let a second taker win
     // it too): this takeover won the next generation's, which blocks a
     // worker that still sees the dead claim (put back here for it).
-    let next = takeover_path(dir.path(), 5, "dead-token", 1);
+    let next = takeover_path(&claim_path(dir.path(), 5), "dead-token", 1);
     assert!(marker.exists() && next.exists());
     let ours_record = read_claim(&claim_path(dir.path(), 5)).unwrap();
     let seen = write_dead_claim(dir.path(), 5);
     assert!(matches!(
-        try_claim(dir.path(), 5, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 5), timeout).unwrap(),
         Attempt::Held(held) if held == seen
     ));
     write_record(&claim_path(dir.path(), 5), &ours_record).unwrap();
@@ -100,7 +106,7 @@ fn a_dead_claim_is_taken_over_exactly_once() {
     let dir = tempfile::tempdir().unwrap();
     write_dead_claim(dir.path(), 7);
     let timeout = Duration::from_secs(60);
-    let first = try_claim(dir.path(), 7, timeout).unwrap();
+    let first = try_claim(&claim_path(dir.path(), 7), timeout).unwrap();
     let Attempt::Claimed(ours) = first else {
         panic!("a claim two minutes old is taken over");
     };
@@ -109,9 +115,9 @@ fn a_dead_claim_is_taken_over_exactly_once() {
     // for that dead claim stands, and it is told the frame is held.
     let ours_record = read_claim(&claim_path(dir.path(), 7)).unwrap();
     let dead = write_dead_claim(dir.path(), 7);
-    assert!(takeover_path(dir.path(), 7, &dead.token, 0).exists());
+    assert!(takeover_path(&claim_path(dir.path(), 7), &dead.token, 0).exists());
     assert!(matches!(
-        try_claim(dir.path(), 7, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 7), timeout).unwrap(),
         Attempt::Held(held) if held == dead
     ));
     write_record(&claim_path(dir.path(), 7), &ours_record).unwrap();
@@ -129,7 +135,7 @@ fn an_empty_claim_left_by_a_crash_is_taken_over_once_it_is_old() {
     let timeout = Duration::from_secs(60);
     // Fresh: it may be being written; leave it.
     assert!(matches!(
-        try_claim(dir.path(), 2, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 2), timeout).unwrap(),
         Attempt::Held(_)
     ));
     // Two minutes old: dead; taken over.
@@ -140,7 +146,7 @@ fn an_empty_claim_left_by_a_crash_is_taken_over_once_it_is_old() {
         .unwrap()
         .set_modified(old)
         .unwrap();
-    let Attempt::Claimed(claim) = try_claim(dir.path(), 2, timeout).unwrap() else {
+    let Attempt::Claimed(claim) = try_claim(&claim_path(dir.path(), 2), timeout).unwrap() else {
         panic!("an old empty claim is taken over");
     };
     assert_eq!(read_claim(&path).unwrap().pid, std::process::id());
@@ -176,7 +182,7 @@ fn a_claim_of_an_ended_process_on_this_machine_is_taken_over_at_once() {
     let here = fresh(crate::host::host_name(), crate::host::pid_space());
     write_record(&claim_path(dir.path(), 4), &here).unwrap();
     assert!(matches!(
-        try_claim(dir.path(), 4, timeout).unwrap(),
+        try_claim(&claim_path(dir.path(), 4), timeout).unwrap(),
         Attempt::Held(_)
     ));
     worker.kill().unwrap();
@@ -192,7 +198,7 @@ fn a_claim_of_an_ended_process_on_this_machine_is_taken_over_at_once() {
         timeout
     ));
     assert!(is_live(&fresh(crate::host::host_name(), None), timeout));
-    let Attempt::Claimed(claim) = try_claim(dir.path(), 4, timeout).unwrap() else {
+    let Attempt::Claimed(claim) = try_claim(&claim_path(dir.path(), 4), timeout).unwrap() else {
         panic!("the ended worker's claim is taken over");
     };
     let ours = read_claim(&claim_path(dir.path(), 4)).unwrap();
@@ -204,7 +210,7 @@ fn a_claim_of_an_ended_process_on_this_machine_is_taken_over_at_once() {
 fn heartbeat_keeps_a_long_claim_alive() {
     let dir = tempfile::tempdir().unwrap();
     let timeout = Duration::from_millis(400);
-    let Attempt::Claimed(_claim) = try_claim(dir.path(), 1, timeout).unwrap() else {
+    let Attempt::Claimed(_claim) = try_claim(&claim_path(dir.path(), 1), timeout).unwrap() else {
         panic!("free frame");
     };
     let first = read_claim(&claim_path(dir.path(), 1)).unwrap();

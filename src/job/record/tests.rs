@@ -1,4 +1,5 @@
 use super::*;
+use crate::output::names::FrameName;
 use crate::output::Aov;
 use std::fs::File;
 
@@ -30,6 +31,7 @@ fn each_format_keeps_its_own_range_layers_and_samples() {
         aovs: vec![Aov::Normal],
         samples: Some(2),
         exr_compression: Default::default(),
+        frame_name: FrameName::default(),
     };
     let few_exrs = JobRecord {
         formats: vec!["exr".into()],
@@ -46,6 +48,7 @@ fn each_format_keeps_its_own_range_layers_and_samples() {
         aovs: Vec::new(),
         samples: None,
         exr_compression: Default::default(),
+        frame_name: FrameName::default(),
     };
     let merged = JobRecord::read(dir.path()).unwrap();
     assert_eq!(merged.outputs(), [exr.clone(), png.clone()]);
@@ -68,6 +71,30 @@ fn each_format_keeps_its_own_range_layers_and_samples() {
         ..more
     };
     assert_eq!(merged.outputs(), [widened, png]);
+}
+
+#[test]
+fn frames_named_otherwise_replace_the_formats_range_not_widen_it() {
+    let dir = tempfile::tempdir().unwrap();
+    record((0, 120)).write(dir.path()).unwrap();
+    let shots = OutputRecord {
+        format: "png".into(),
+        frames: (5, 8),
+        aovs: Vec::new(),
+        samples: None,
+        exr_compression: Default::default(),
+        frame_name: FrameName::parse("shot_####").unwrap(),
+    };
+    JobRecord {
+        outputs: vec![shots.clone()],
+        ..record((5, 8))
+    }
+    .record_in(dir.path(), |_| Ok(()))
+    .unwrap();
+    let merged = JobRecord::read(dir.path()).unwrap();
+    assert_eq!(merged.outputs(), [shots]);
+    let text = std::fs::read_to_string(dir.path().join(JOB_FILE)).unwrap();
+    assert!(text.contains(r#""frame_name": "shot_####""#), "{text}");
 }
 
 #[test]

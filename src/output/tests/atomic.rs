@@ -1,12 +1,8 @@
 use crate::host::writer_tag;
 use crate::output::atomic::{remove_stale_partials, write_atomic};
-use crate::output::frames::frame_file_name;
-use crate::output::Format;
 
 #[test]
-fn names_are_zero_padded_and_temporaries_hidden() {
-    assert_eq!(frame_file_name(42, Format::Png), "frame_00042.png");
-    assert_eq!(frame_file_name(7, Format::Exr), "frame_00007.exr");
+fn temporaries_are_hidden_beside_the_final_file() {
     // While it is written, a file is a hidden temporary beside the final one.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame_00042.png");

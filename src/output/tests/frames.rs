@@ -1,6 +1,7 @@
 use super::{film, write_plain};
 use crate::output::exr::ExrCompression::{Piz, Zip};
 use crate::output::frames::*;
+use crate::output::names::FrameName;
 use crate::output::{Aov, Format};
 use crate::scene::Scene;
 use std::path::Path;
@@ -46,7 +47,7 @@ fn hash_changes_with_any_input() {
 fn written_frames_carry_their_hash_and_leave_no_temporary() {
     let dir = tempfile::tempdir().unwrap();
     for format in [Format::Png, Format::Exr] {
-        let path = dir.path().join(frame_file_name(0, format));
+        let path = dir.path().join(FrameName::default().file_name(0, format));
         write_plain(&path, format, &film(), "abc123");
         assert!(path.exists());
         let leftovers: Vec<_> = std::fs::read_dir(dir.path())
@@ -60,7 +61,7 @@ fn written_frames_carry_their_hash_and_leave_no_temporary() {
             let key = stored_key(format, "abc123", &[], Default::default());
             assert_eq!(state(&path, &key), FileState::Current);
             assert_eq!(state(&path, "other"), FileState::Stale);
-            let missing = dir.path().join(frame_file_name(1, format));
+            let missing = dir.path().join(FrameName::default().file_name(1, format));
             assert_eq!(state(&missing, "abc123"), FileState::Missing);
         }
     }
@@ -72,16 +73,28 @@ fn frame_files_ignore_temporaries_and_other_names() {
     for name in [
         "frame_00001.png",
         "frame_00000.png",
+        "frame_100000.png",
         ".frame_00002.png.partial",
         "frame_x.png",
+        "frame_01.png",
+        "shot_0003.png",
         "sheet.png",
     ] {
         std::fs::write(dir.path().join(name), b"").unwrap();
     }
-    let names: Vec<_> = frame_files(dir.path(), Format::Png)
-        .unwrap()
-        .iter()
-        .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
-        .collect();
-    assert_eq!(names, ["frame_00000.png", "frame_00001.png"]);
+    let names = |pattern: &str| -> Vec<String> {
+        let pattern = FrameName::parse(pattern).unwrap();
+        frame_files(dir.path(), Format::Png, &pattern)
+            .unwrap()
+            .iter()
+            .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
+            .collect()
+    };
+    // In frame order, not name order; each pattern's own names only.
+    assert_eq!(
+        names("frame_#####"),
+        ["frame_00000.png", "frame_00001.png", "frame_100000.png"]
+    );
+    assert_eq!(names("frame_##"), ["frame_01.png", "frame_100000.png"]);
+    assert_eq!(names("shot_####"), ["shot_0003.png"]);
 }
