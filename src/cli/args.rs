@@ -119,14 +119,8 @@ pub struct SequenceArgs {
     pub aov: Vec<output::Aov>,
     /// EXR compression: zip (default), piz, rle, zips and none keep every
     /// sample; pxr24, b44, b44a, dwaa and dwab are lossy.
-    #[arg(
-        long,
-        value_enum,
-        value_name = "METHOD",
-        default_value_t,
-        hide_possible_values = true
-    )]
-    pub exr_compression: output::exr::ExrCompression,
+    #[arg(long, value_enum, value_name = "METHOD", hide_possible_values = true)]
+    pub exr_compression: Option<output::exr::ExrCompression>,
     /// Name frame files by this pattern: one run of # is the frame number,
     /// zero-padded to its length (shot_#### gives shot_0042.png) [default: frame_#####].
     #[arg(long, value_name = "PATTERN")]

@@ -51,7 +51,7 @@ fn recorded_names(dir: &std::path::Path) -> FrameName {
     let outputs = record.map(|r| r.outputs()).unwrap_or_default();
     outputs
         .into_iter()
-        .find(|o| o.format == Format::Png.extension())
+        .find(|o| o.files_like(Format::Png))
         .map(|o| o.frame_name)
         .unwrap_or_default()
 }

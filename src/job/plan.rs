@@ -52,9 +52,11 @@ impl Plan {
             .map(|f| f.name())
             .collect();
         if pngs.len() > 1 {
+            let names = args.frame_name.clone().unwrap_or_default();
             let message = format!(
-                "{} all write frame_NNNNN.png: choose one of them",
-                pngs.join(" and ")
+                "{} all write {}.png: choose one of them",
+                pngs.join(" and "),
+                names.to_string().replace('#', "N")
             );
             return Err(Error::usage("--format", message).into());
         }
@@ -104,7 +106,7 @@ impl Plan {
             out_dir,
             preview,
             aovs,
-            exr_compression: args.exr_compression,
+            exr_compression: args.exr_compression.unwrap_or_default(),
             samples: args.samples,
             verify: false,
             frame_name: args.frame_name.clone().unwrap_or_default(),

@@ -66,6 +66,20 @@ pub struct OutputRecord {
     pub frame_name: FrameName,
 }
 
+impl OutputRecord {
+    /// Whether this format's frames are files of the same kind as
+    /// `format`'s (every PNG kind writes `.png`).
+    pub fn files_like(&self, format: crate::output::Format) -> bool {
+        let mine = crate::output::Format::named(&self.format).map(|f| f.extension());
+        mine == Some(format.extension())
+    }
+
+    /// Whether `other`'s frames are files of the same kind as these.
+    pub fn same_files(&self, other: &OutputRecord) -> bool {
+        crate::output::Format::named(&other.format).is_some_and(|f| self.files_like(f))
+    }
+}
+
 impl JobRecord {
     /// Writes the record into `dir` atomically (concurrent workers of one job
     /// write the same record; the last rename wins whole).
@@ -165,12 +179,9 @@ impl JobRecord {
     fn merge_outputs(self, old: &JobRecord) -> JobRecord {
         let mut outputs = old.outputs();
         for new in self.outputs() {
-            // PNG kinds share their files' names: the new one replaces the old.
-            let extension = |name: &str| crate::output::Format::named(name).map(|f| f.extension());
-            outputs.retain(|o| {
-                o.format == new.format || extension(&o.format) != extension(&new.format)
-            });
-            match outputs.iter_mut().find(|o| o.format == new.format) {
+            // PNG kinds share their files: another kind takes the old one's
+            // place, keeping its span, whose frames are then stale.
+            match outputs.iter_mut().find(|o| o.same_files(&new)) {
                 Some(o) if o.frame_name != new.frame_name => *o = new,
                 Some(o) => {
                     *o = OutputRecord {

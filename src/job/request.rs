@@ -27,7 +27,8 @@ pub struct Sequence {
     pub samples: Option<u32>,
     /// Extra EXR layers.
     pub aovs: Vec<Aov>,
-    pub exr_compression: crate::output::exr::ExrCompression,
+    /// [default: zip]
+    pub exr_compression: Option<crate::output::exr::ExrCompression>,
     /// How frame files are named [default: `frame_#####`].
     pub frame_name: Option<FrameName>,
 }

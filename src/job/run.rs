@@ -317,7 +317,7 @@ fn refuse_other_names(
 ) -> crate::error::Result<()> {
     for new in record.outputs() {
         let renamed = old.outputs().into_iter().find(|o| {
-            o.format == new.format && o.frame_name != new.frame_name && frame_count(out_dir, o) > 0
+            o.same_files(&new) && o.frame_name != new.frame_name && frame_count(out_dir, o) > 0
         });
         let Some(o) = renamed else { continue };
         let (was, now, format) = (&o.frame_name, &new.frame_name, &o.format);

@@ -105,7 +105,7 @@ pub fn scan(
 fn renamed(job: &crate::job::record::JobRecord, parts: &[Plan]) -> Vec<(String, FrameName)> {
     let outputs = job.outputs();
     let scanned = |o: &&crate::job::record::OutputRecord| {
-        let part = parts.iter().find(|p| p.formats[0].extension() == o.format);
+        let part = parts.iter().find(|p| o.files_like(p.formats[0]));
         part.is_some_and(|p| p.frame_name != o.frame_name)
     };
     let named = |o: &crate::job::record::OutputRecord| (o.format.clone(), o.frame_name.clone());
@@ -127,13 +127,14 @@ fn folder_plans(
         ("--preview", s.preview),
         ("--samples", s.samples.is_some()),
         ("--frame-name", s.frame_name.is_some()),
+        ("--exr-compression", s.exr_compression.is_some()),
     ];
     if let Some((option, _)) = given.iter().find(|(_, given)| *given) {
         return Err(Error::usage(
             option,
             format!(
-                "{} is an output folder, which records its own size, samples, formats, layers \
-                 and frame names: give the timeline instead (status TIMELINE {option} …) or leave {option} out",
+                "{} is an output folder, which records its own size, samples, formats, layers, \
+                 frame names and EXR compression: give the timeline instead (status TIMELINE {option} …) or leave {option} out",
                 target.display()
             ),
         )
@@ -190,17 +191,12 @@ fn frame_states(
 }
 
 impl Scan {
-    /// Each format's frames, by its extension.
+    /// Each format's frames, by its name.
     pub fn formats(&self) -> BTreeMap<&str, FormatStatus<'_>> {
         self.parts
             .iter()
             .zip(&self.by_format)
-            .map(|(part, by_state)| {
-                (
-                    part.formats[0].extension(),
-                    FormatStatus::of(part, by_state),
-                )
-            })
+            .map(|(part, by_state)| (part.formats[0].name(), FormatStatus::of(part, by_state)))
             .collect()
     }
 
@@ -211,10 +207,10 @@ impl Scan {
         let video = self
             .parts
             .iter()
-            .find(|p| p.formats[0] == output::Format::Png)
+            .find(|p| p.formats[0].is_png())
             .unwrap_or(&self.parts[0]);
         formats
-            .get(video.formats[0].extension())
+            .get(video.formats[0].name())
             .filter(|f| f.total > 0 && f.complete == f.total)
             .map(|_| video.video_command(&video.range, video.formats[0]))
     }

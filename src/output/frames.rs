@@ -107,10 +107,10 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
 
 /// What a frame file of `format` records of its inputs: the frame's `hash`;
 /// for a PNG other than the 8-bit kind, its kind too (`hash+png16`), and for
-/// an EXR its compression and the extra layers it holds
-/// (`hash+zip+normal,steps`, the light's hash alone, as an EXR holds the
-/// light undisplayed). So asking for other layers, another PNG kind or
-/// another compression re-renders that file but not the one beside it.
+/// an EXR a lossy compression and the extra layers it holds
+/// (`hash+dwaa+normal,steps`, the light's hash alone, as an EXR holds the
+/// light undisplayed). So asking for other layers, another PNG kind or a
+/// lossy compression re-renders that file but not the one beside it.
 pub fn stored_key(
     format: Format,
     hash: &str,
@@ -119,7 +119,11 @@ pub fn stored_key(
 ) -> String {
     match format {
         Format::Exr => {
-            let mut key = format!("{}+{}", light_hash(hash), compression.name());
+            // Lossless compressions hold the same samples: any of them is current.
+            let mut key = light_hash(hash).to_string();
+            if !compression.is_lossless() {
+                key = format!("{key}+{}", compression.name());
+            }
             if !aovs.is_empty() {
                 let names: Vec<&str> = aovs.iter().map(|a| a.name()).collect();
                 key = format!("{key}+{}", names.join(","));

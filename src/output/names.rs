@@ -54,9 +54,11 @@ impl FrameName {
                 "{digits} # are more digits than any frame number has (10)"
             ));
         }
-        if suffix.starts_with(|c: char| c.is_ascii_digit()) {
+        // v2# frame 5 and v# frame 25 would both be v25.
+        let digit = |c: char| c.is_ascii_digit();
+        if suffix.starts_with(digit) || prefix.ends_with(digit) {
             return Err(format!(
-                "a digit right after the #s would read as part of the frame number in {text:?}"
+                "a digit right beside the #s would read as part of the frame number in {text:?}"
             ));
         }
         check_parts(text)?;
@@ -305,7 +307,8 @@ mod tests {
         refused("shot_####.", "ends with '.'");
         refused("shot_####.png", "holds .png");
         refused("shot.CLAIM.####", "holds .CLAIM");
-        refused("shot_####1", "a digit right after");
+        refused("shot_####1", "a digit right beside");
+        refused("v2#", "a digit right beside");
         refused("###########", "11 # are more");
         refused(&format!("{}#", "a".repeat(100)), "longer than 100");
         for good in ["####", "shot_####", "v2_#", "a.####.b-c", "##########"] {

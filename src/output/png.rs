@@ -128,19 +128,38 @@ fn put_pixel(
         }
         return;
     }
-    let (rgb, alpha) = match kind.colour {
+    let (shown, alpha) = match kind.colour {
         png::ColorType::Rgba if kind.transparent => {
             let a = alpha.clamp(0.0, 1.0);
-            let straight = if a > 0.0 { 1.0 / a } else { 0.0 };
-            (rgb.map(|v| v * straight), Some(a))
+            (straight_shown(rgb, a, show), Some(a))
         }
-        png::ColorType::Rgba => (rgb, Some(1.0)),
-        _ => (rgb, None),
+        png::ColorType::Rgba => (rgb.map(show), Some(1.0)),
+        _ => (rgb.map(show), None),
     };
-    let codes = rgb.map(|v| curve.code16(show(v)));
+    let codes = shown.map(|v| curve.code16(v));
     let alpha = alpha.map(|a| (a * 65535.0 + 0.5) as u16);
     for (pair, code) in out.chunks_exact_mut(2).zip(codes.into_iter().chain(alpha)) {
         pair.copy_from_slice(&code.to_be_bytes());
+    }
+}
+
+/// The straight colour of premultiplied `rgb` at coverage `a`, as shown.
+/// Light with no coverage (glow at a partly covered pixel) can make it
+/// brighter than the display holds: it is then scaled down whole, keeping
+/// its hue (clipped channel by channel it would turn white), to what a
+/// fully covered pixel of the same light would show.
+fn straight_shown(rgb: [f32; 3], a: f32, show: impl Fn(f32) -> f32) -> [f32; 3] {
+    if a <= 0.0 {
+        return [0.0; 3];
+    }
+    let peak = |c: [f32; 3]| c[0].max(c[1]).max(c[2]);
+    let shown = rgb.map(|v| show(v / a));
+    let limit = peak(rgb.map(&show)).max(1.0);
+    if peak(shown) > limit {
+        let scale = limit / peak(shown);
+        shown.map(|v| v * scale)
+    } else {
+        shown
     }
 }
 

@@ -192,18 +192,15 @@ fn every_exr_compression_reads_back_in_openexr_and_oiiotool() {
             assert!(rms < 0.03, "{name}: rms error {rms}");
         }
     }
-    // The compression is part of what a file records: another re-renders it.
-    let again = d.ok(&[
-        "render",
-        "t.ron",
-        "--format",
-        "exr",
-        "--exr-compression",
-        "piz",
-        "--out",
-        "c_zip",
-    ]);
-    assert!(!crate::util::stderr(&again).contains("already complete"));
+    // A lossy compression is part of what a file records: another
+    // re-renders it; lossless ones hold the same samples and do not.
+    let again = |compression: &str| {
+        let args = ["render", "t.ron", "--format", "exr", "--out", "c_zip"];
+        let out = d.ok(&[&args[..], &["--exr-compression", compression]].concat());
+        crate::util::stderr(&out).contains("already complete")
+    };
+    assert!(again("piz"), "a lossless change keeps the frame");
+    assert!(!again("dwaa"), "a lossy one re-renders it");
 }
 
 #[test]
@@ -211,9 +208,32 @@ fn glow_around_a_transparent_frame_is_light_without_coverage() {
     let d = Dir::new();
     let glow = "effects: (glow: (colour: (0.9, 0.6, 0.3), strength: 0.6, width: 4))";
     d.write("t.ron", &with_scene(&frame(true), glow));
-    d.ok(&["render", "t.ron", "--format", "exr"]);
+    d.ok(&["render", "t.ron", "--format", "exr,png16alpha"]);
     let exr = d.exr("out/t/frame_00000.exr");
     let (alpha, red) = (exr.channel("A"), exr.channel("R"));
+    // Where glow falls on a partly covered pixel, its straight colour in
+    // the PNG keeps the glow's hue (red over blue), not clipped to white.
+    let png = image::open(d.path().join("out/t/frame_00000.png"))
+        .unwrap()
+        .to_rgba16();
+    let blue = exr.channel("B");
+    let edges =
+        (0..alpha.len()).filter(|&i| alpha[i] > 0.0 && alpha[i] < 0.5 && red[i] > 2.0 * blue[i]);
+    let (mut seen, mut white) = (0, 0);
+    for i in edges {
+        let p = png.get_pixel(i as u32 % 48, i as u32 / 48);
+        seen += 1;
+        white += (p[2] > 60000) as usize;
+        assert!(
+            p[0] > p[2],
+            "pixel {i}: straight {:?} lost the glow's hue",
+            p.0
+        );
+    }
+    assert!(
+        seen > 0 && white == 0,
+        "{seen} glowing edge pixels, {white} white"
+    );
     // Misses near the bulb carry the glow, with alpha 0: "over" adds it.
     let glowing = (0..alpha.len())
         .filter(|&i| alpha[i] == 0.0 && red[i] > 0.0)

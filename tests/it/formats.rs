@@ -330,3 +330,37 @@ fn two_png_kinds_in_one_render_are_refused() {
     says(&out, "png and png16 all write frame_NNNNN.png");
     assert!(d.files("out/t").is_empty(), "{:?}", d.files("out/t"));
 }
+
+#[test]
+fn a_sixteen_bit_png_sequence_is_found_by_status_and_sheet_like_any_other() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(4, 7.0));
+    let named = ["--frame-name", "shot_####"];
+    d.ok(&[&["render", "t.ron", "--format", "png16,exr"][..], &named].concat());
+    // The video is made from the PNGs, whatever their kind.
+    let status = crate::util::stdout(&d.ok(&["status", "out/t"]));
+    assert!(
+        status.contains("shot_%04d.png") && !status.contains("apply_trc"),
+        "{status}"
+    );
+    d.ok(&["sheet", "out/t", "--out", "sheet.png"]);
+    // Another PNG kind over part of the film keeps the film's span: the
+    // frames it did not render are stale, not forgotten.
+    d.ok(&[
+        &["render", "t.ron", "--format", "png", "--frames", "1"][..],
+        &named,
+    ]
+    .concat());
+    let json = crate::util::stdout(&d.run(&["status", "out/t", "--json"]));
+    let v: serde_json::Value = serde_json::from_str(&json).unwrap();
+    let png = &v["formats"]["png"];
+    assert_eq!(
+        (png["total"].as_u64(), png["complete"].as_u64()),
+        (Some(4), Some(1)),
+        "{json}"
+    );
+    // Changing the names and the kind at once is refused like a rename.
+    let out = d.run(&["render", "t.ron", "--format", "png16alpha"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    says(&out, "--frame-name");
+}

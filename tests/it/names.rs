@@ -169,6 +169,7 @@ fn bad_frame_names_are_refused_naming_the_option() {
         "shot_%04d",
         ".shot_##",
         "shot_##.png",
+        "v2#",
     ];
     for pattern in bad {
         for command in [
@@ -187,5 +188,5 @@ fn bad_frame_names_are_refused_naming_the_option() {
     let out = d.run(&["status", "out/t", "--frame-name", "shot_####"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     says(&out, "--frame-name");
-    says(&out, "layers and frame names");
+    says(&out, "layers, frame names and EXR compression");
 }
