@@ -34,7 +34,7 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         .into());
     }
     let shown = output::sheet::evenly_spaced(&frames, args.count);
-    output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
+    output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, args.labels, &out)?;
     out!(
         "{} frames of {} tiled into {}",
         shown.len(),

@@ -23,6 +23,15 @@ pub fn frame_file_name(frame_index: u32, format: Format) -> String {
     )
 }
 
+/// The frame number a frame file's name carries: its last run of digits
+/// before the extension, whatever comes first (`frame_00042.png` and
+/// `shot_v2_0042.exr` are both 42), so names from any pattern are read.
+pub fn frame_number(path: &Path) -> Option<u64> {
+    let stem = path.file_stem()?.to_str()?;
+    let before_digits = stem.trim_end_matches(|c: char| c.is_ascii_digit());
+    stem[before_digits.len()..].parse().ok()
+}
+
 /// The ffmpeg input pattern matching `frame_file_name`.
 pub fn frame_pattern(format: Format) -> String {
     format!("frame_%0{FRAME_DIGITS}d.{}", format.extension())

@@ -2,11 +2,13 @@
 //! linear half-float RGBA, a float Z and the layers `--aov` asks for), frame
 //! files and the content hash each carries in its own metadata so resume can
 //! tell a current frame from a stale one (`frames`), write-to-temporary-
-//! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
+//! then-rename (`atomic`), contact sheets (`sheet`), CSV tables (`csv`) and
+//! the font drawn text uses (`font`).
 
 pub mod atomic;
 pub mod csv;
 pub mod exr;
+pub mod font;
 pub mod frames;
 pub mod png;
 pub mod sheet;

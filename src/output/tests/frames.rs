@@ -78,3 +78,13 @@ fn frame_files_ignore_temporaries_and_other_names() {
         .collect();
     assert_eq!(names, ["frame_00000.png", "frame_00001.png"]);
 }
+
+#[test]
+fn a_frame_number_is_the_last_digit_run_before_the_extension() {
+    let number = |name: &str| frame_number(Path::new(name));
+    assert_eq!(number("out/frame_00042.png"), Some(42));
+    assert_eq!(number("shot_v2_0007.exr"), Some(7));
+    assert_eq!(number("0119"), Some(119));
+    assert_eq!(number("frame_00042_v2b.png"), None);
+    assert_eq!(number("sheet.png"), None);
+}
