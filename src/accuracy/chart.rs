@@ -11,8 +11,6 @@ use crate::error::{Error, Result};
 use plotters::prelude::*;
 use std::path::Path;
 
-static FONT: &[u8] = include_bytes!("../../assets/fonts/DejaVuSansMono.ttf");
-
 /// The PNG's size in pixels.
 pub const CHART_SIZE: (u32, u32) = (1600, 1000);
 /// Height of the title and the two panels; the key fills the rest below.
@@ -365,9 +363,7 @@ impl<'r> Variants<'r> {
 }
 
 fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geometry), String> {
-    // Registering twice is harmless; a bad font would be a build error in practice.
-    plotters::style::register_font("sans-serif", FontStyle::Normal, FONT)
-        .map_err(|_| "the embedded font is unreadable".to_string())?;
+    crate::output::font::register()?;
     let (w, h) = CHART_SIZE;
     let mut pixels = vec![255u8; (w * h * 3) as usize];
     let mut geometry = Geometry::default();

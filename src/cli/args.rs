@@ -88,6 +88,10 @@ pub struct SheetArgs {
     /// Where to write the sheet [default: <dir>/sheet.png].
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Mark each thumbnail with its frame number (the last digits of its file name),
+    /// light on a dark box in its top-left corner.
+    #[arg(long)]
+    pub labels: bool,
 }
 
 /// What a sequence is made of: shared by `render` and `status`, so both

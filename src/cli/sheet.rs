@@ -34,7 +34,13 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         return Err(Error::usage(&args.dir.display().to_string(), message).into());
     }
     let shown = output::sheet::evenly_spaced(&frames, args.count);
-    output::sheet::write_contact_sheet(&shown, args.columns, args.thumb_width, &out)?;
+    output::sheet::write_contact_sheet(
+        &shown,
+        args.columns,
+        args.thumb_width,
+        args.labels.then_some(&names),
+        &out,
+    )?;
     out!(
         "{} frames of {} tiled into {}",
         shown.len(),

@@ -3,12 +3,14 @@
 //! RGBA, a float depth and the layers `--aov` asks for), frame
 //! files and the content hash each carries in its own metadata so resume can
 //! tell a current frame from a stale one (`frames`), their names (`names`:
-//! the `--frame-name` pattern), write-to-temporary-
-//! then-rename (`atomic`), contact sheets (`sheet`) and CSV tables (`csv`).
+//! the `--frame-name` pattern), write-to-temporary-then-rename (`atomic`),
+//! contact sheets (`sheet`), CSV tables (`csv`) and the font drawn text
+//! uses (`font`).
 
 pub mod atomic;
 pub mod csv;
 pub mod exr;
+pub mod font;
 pub mod frames;
 pub mod names;
 pub mod png;

@@ -428,6 +428,61 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
 }
 
 #[test]
+fn labels_mark_each_thumbnail_in_its_corner_and_nowhere_else() {
+    // Three frames as 192×108 thumbnails, one row, 2 px apart, with and
+    // without labels: they differ only in a small box at each thumbnail's
+    // top-left corner, dark at its corners, with light text inside, and
+    // each box shows its own frame's number.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 6.0));
+    d.ok(&["render", "t.ron", "--quiet"]);
+    let sheet = |labels: &[&str], name: &str| {
+        let mut args = vec!["sheet", "out/t", "--columns", "3", "--thumb-width", "192"];
+        args.extend(["--out", name]);
+        args.extend(labels);
+        d.ok(&args);
+        image::open(d.path().join(name)).unwrap().to_rgb8()
+    };
+    let plain = &sheet(&[], "plain.png");
+    let labelled = &sheet(&["--labels"], "labelled.png");
+    assert_eq!(plain.dimensions(), labelled.dimensions());
+    let mut boxes = Vec::new();
+    for thumb in 0..3u32 {
+        let x0 = thumb * 194;
+        let changed: Vec<(u32, u32)> = (0..108)
+            .flat_map(|y| (x0..(x0 + 194).min(plain.width())).map(move |x| (x, y)))
+            .filter(|&(x, y)| plain[(x, y)] != labelled[(x, y)])
+            .collect();
+        let box_w = changed.iter().map(|p| p.0).max().expect("a label") + 1 - x0;
+        let box_h = changed.iter().map(|p| p.1).max().expect("a label") + 1;
+        assert!(
+            box_w < 96 && box_h < 54,
+            "thumbnail {thumb}: box {box_w}x{box_h}"
+        );
+        let inside: Vec<[u8; 3]> = (0..box_h)
+            .flat_map(|y| (x0..x0 + box_w).map(move |x| labelled[(x, y)].0))
+            .collect();
+        for corner in [(x0, 0), (x0 + box_w - 1, 0), (x0, box_h - 1)] {
+            assert_eq!(
+                labelled[corner].0,
+                [16, 16, 16],
+                "{thumb}: corner {corner:?}"
+            );
+        }
+        let text = inside
+            .iter()
+            .filter(|p| p.iter().all(|&c| c >= 200))
+            .count();
+        assert!(text >= 3, "thumbnail {thumb}: {text} text pixels");
+        boxes.push(inside);
+    }
+    assert!(
+        boxes[0] != boxes[1] && boxes[1] != boxes[2],
+        "each box its own number"
+    );
+}
+
+#[test]
 fn effects_declared_with_too_few_samples_render_with_a_warning() {
     // A lens with 1 sample a pixel, motion blur with 4: rendered, but each
     // says what it needs; with enough samples, or as a preview (one sample
