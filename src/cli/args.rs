@@ -88,7 +88,7 @@ pub struct SheetArgs {
     /// Where to write the sheet [default: <dir>/sheet.png].
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Mark each thumbnail with its frame number (the last digits of its file name),
+    /// Mark each thumbnail with its frame number (the number its name's # run holds),
     /// light on a dark box in its top-left corner.
     #[arg(long)]
     pub labels: bool,

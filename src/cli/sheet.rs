@@ -19,12 +19,17 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         let message = format!("the sheet is a PNG: name it .png, not {}", out.display());
         return Err(Error::usage("--out", message).into());
     }
-    let names = args.frame_name.unwrap_or_else(|| recorded_names(&args.dir));
+    let names = (args.frame_name.clone()).unwrap_or_else(|| recorded_names(&args.dir));
     let frames = output::frames::frame_files(&args.dir, Format::Png, &names)?;
     if frames.is_empty() {
         // A --preview render's frames are a folder further down.
         let preview = args.dir.join("preview");
-        let in_preview = output::frames::frame_files(&preview, Format::Png, &names);
+        // The preview's own record names its frames, unless --frame-name did.
+        let preview_names = match &args.frame_name {
+            Some(names) => names.clone(),
+            None => recorded_names(&preview),
+        };
+        let in_preview = output::frames::frame_files(&preview, Format::Png, &preview_names);
         let hint = if in_preview.is_ok_and(|f| !f.is_empty()) {
             format!(" (a preview's are in {})", preview.display())
         } else {
@@ -41,8 +46,9 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
         args.labels.then_some(&names),
         &out,
     )?;
+    let plural = if frames.len() == 1 { "" } else { "s" };
     out!(
-        "{} frames of {} tiled into {}",
+        "{} of {} frame{plural} tiled into {}",
         shown.len(),
         frames.len(),
         out.display()

@@ -54,7 +54,7 @@ impl Plan {
         if pngs.len() > 1 {
             let names = args.frame_name.clone().unwrap_or_default();
             let message = format!(
-                "{} all write {}.png: choose one of them",
+                "{} would write the same files, {}.png: choose one of them",
                 pngs.join(" and "),
                 names.to_string().replace('#', "N")
             );

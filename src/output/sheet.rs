@@ -12,6 +12,13 @@ use std::path::{Path, PathBuf};
 pub const LABEL_BOX: Rgb<u8> = Rgb([16, 16, 16]);
 pub const LABEL_TEXT: Rgb<u8> = Rgb([240, 240, 240]);
 
+/// Thumbnails lower than this get no label: its box, at least 13 pixels
+/// high, would cover most of them.
+pub const MIN_LABELLED_HEIGHT: u32 = 30;
+
+/// The most pixels a sheet may have (3 bytes each in memory).
+const MAX_PIXELS: u64 = 1 << 27;
+
 /// Up to `count` items spread evenly from the first to the last.
 pub fn evenly_spaced<T: Clone>(items: &[T], count: usize) -> Vec<T> {
     if items.len() <= count || count < 2 {
@@ -59,10 +66,13 @@ pub fn write_contact_sheet(
         columns as u64 * (thumb_width as u64 + gap as u64) - gap as u64,
         rows as u64 * (thumb_height as u64 + gap as u64) - gap as u64,
     );
-    if w > MAX_SIDE || h > MAX_SIDE {
+    if w > MAX_SIDE || h > MAX_SIDE || w * h > MAX_PIXELS {
         return Err(Error::usage(
             "--thumb-width/--columns/--count",
-            format!("the sheet would be {w}x{h} pixels; it may be at most {MAX_SIDE} a side"),
+            format!(
+                "the sheet would be {w}x{h} pixels; it may be at most {MAX_SIDE} a side \
+                 and {MAX_PIXELS} pixels in all"
+            ),
         ));
     }
     let mut sheet = RgbImage::new(w as u32, h as u32);
@@ -78,7 +88,8 @@ pub fn write_contact_sheet(
             .file_name()
             .and_then(|n| n.to_str())
             .unwrap_or_default();
-        if let Some(number) = labels.and_then(|names| names.frame_of(name, Format::Png)) {
+        let number = labels.and_then(|names| names.frame_of(name, Format::Png));
+        if let Some(number) = number.filter(|_| thumb_height >= MIN_LABELLED_HEIGHT) {
             draw_label(&mut thumb, &number.to_string()).map_err(|message| Error::Image {
                 path: path.clone(),
                 message,

@@ -389,7 +389,7 @@ fn sheet_tiles_frames_and_refuses_what_it_cannot_make() {
         "24",
     ]);
     assert!(
-        stdout(&out).contains("3 frames of 3 tiled into"),
+        stdout(&out).contains("3 of 3 frames tiled into"),
         "{}",
         stdout(&out)
     );

@@ -55,7 +55,7 @@ fn frames_named_by_a_pattern_are_found_resumed_and_encoded() {
     let note = "note: the folder's png frames are named shot_####: add --frame-name shot_####";
     assert!(stdout(&out).contains(note), "{}", stdout(&out));
     let out = d.ok(&["sheet", "out/t"]);
-    assert!(stdout(&out).contains("3 frames of 3"), "{}", stdout(&out));
+    assert!(stdout(&out).contains("3 of 3 frames"), "{}", stdout(&out));
     // A resume skips them, rewriting none.
     let modified = |f: &str| {
         std::fs::metadata(d.path().join("out/t").join(f))
