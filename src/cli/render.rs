@@ -6,7 +6,7 @@ use super::RenderArgs;
 use crate::job::frames::{frame_summary, frames_text, ranges};
 use crate::job::plan::{shell_quote, Plan};
 use crate::job::run::{lock, Folder, Job, Tally};
-use crate::job::warnings::{out_of_steps_matters, out_of_steps_warning, warnings};
+use crate::job::warnings::{opaque_alpha, out_of_steps_matters, out_of_steps_warning, warnings};
 use crate::job::waves::{waves, Said};
 use crate::render::FrameStats;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -212,7 +212,11 @@ fn say_before(
 ) {
     let plan = &job.plan;
     let planned: Vec<u32> = todo.iter().map(|(frame, _)| *frame).collect();
-    for warning in warnings(&plan.timeline, &planned, !plan.preview) {
+    let alpha = opaque_alpha(&plan.timeline, &plan.formats);
+    for warning in warnings(&plan.timeline, &planned, !plan.preview)
+        .into_iter()
+        .chain(alpha)
+    {
         bars.say(format!("warning: {warning}"));
     }
     let others = job.others(folder, todo);

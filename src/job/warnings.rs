@@ -234,3 +234,15 @@ pub fn out_of_steps_warning(frames: &[u32], timeline: &Timeline) -> String {
         }
     )
 }
+
+/// An alpha channel asked of a scene that draws its background: every
+/// pixel is opaque, which is seldom why a format with alpha was chosen.
+pub fn opaque_alpha(timeline: &Timeline, formats: &[crate::output::Format]) -> Option<String> {
+    let with_alpha = formats.contains(&crate::output::Format::Png16Alpha);
+    (with_alpha && !timeline.base.look.transparent_background).then(|| {
+        "png16alpha of a scene that draws its background: alpha is 1 in every pixel; \
+         set look: (transparent_background: true) in the timeline for alpha that is the \
+         fractal's coverage"
+            .to_string()
+    })
+}

@@ -378,3 +378,25 @@ fn a_sheet_too_big_for_memory_is_refused_before_it_is_made() {
     says(&out, "pixels in all");
     assert!(!d.path().join("out/t/sheet.png").exists());
 }
+
+#[test]
+fn alpha_asked_of_a_scene_that_draws_its_background_is_warned_of() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(1, 8.0));
+    let out = d.ok(&["render", "t.ron", "--format", "png16alpha"]);
+    says(
+        &out,
+        "alpha is 1 in every pixel; set look: (transparent_background: true)",
+    );
+    let png = image::open(d.path().join("out/t/frame_00000.png"))
+        .unwrap()
+        .to_rgba16();
+    assert!(png.pixels().all(|p| p[3] == 65535));
+    let clear = with_scene(
+        &tiny_timeline(1, 8.0),
+        "look: (transparent_background: true)",
+    );
+    d.write("clear.ron", &clear);
+    let out = d.ok(&["render", "clear.ron", "--format", "png16alpha"]);
+    assert!(!stderr(&out).contains("alpha is 1"), "{}", stderr(&out));
+}
