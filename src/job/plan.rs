@@ -136,8 +136,9 @@ impl Plan {
         let job = crate::job::record::JobRecord::read(dir)?;
         let timeline = Timeline::parse(&job.timeline_text, &job.timeline_path)?;
         let plan = |o: crate::job::record::OutputRecord| -> anyhow::Result<Plan> {
-            let format = <Format as clap::ValueEnum>::from_str(&o.format, true)
-                .map_err(|e| anyhow::anyhow!(e))?;
+            let format = Format::named(&o.format).ok_or_else(|| {
+                anyhow::anyhow!("unknown format {:?} in the job record", o.format)
+            })?;
             let timeline = timeline.clone().with_samples(o.samples);
             Ok(Plan {
                 width: job.width,

@@ -300,8 +300,7 @@ fn refuse_other_sequence(
 
 /// How many frame files of `output` (its format, named its way) `out_dir` holds.
 fn frame_count(out_dir: &Path, output: &crate::job::record::OutputRecord) -> usize {
-    let format = <Format as clap::ValueEnum>::from_str(&output.format, true);
-    format.map_or(0, |f| {
+    Format::named(&output.format).map_or(0, |f| {
         output::frames::frame_files(out_dir, f, &output.frame_name).map_or(0, |v| v.len())
     })
 }

@@ -62,9 +62,7 @@ impl Format {
 
     /// The format `--format` calls `name`.
     pub fn named(name: &str) -> Option<Format> {
-        [Format::Png, Format::Png16, Format::Png16Alpha, Format::Exr]
-            .into_iter()
-            .find(|f| f.name() == name)
+        <Format as clap::ValueEnum>::from_str(name, true).ok()
     }
 
     pub fn is_png(self) -> bool {

@@ -89,6 +89,12 @@ impl Kind {
 /// The image's bytes, a row at a time straight into place on every thread.
 fn pixel_bytes(film: &Film, kind: Kind, display: crate::color::Display) -> Vec<u8> {
     use rayon::prelude::*;
+    let painter = Painter {
+        kind,
+        display,
+        plain: display.is_plain(),
+        curve: crate::color::SrgbCurve::get(),
+    };
     let row = (film.width as usize).max(1);
     let size = kind.bytes_per_pixel();
     let mut bytes = vec![0u8; film.colour.len() * size];
@@ -99,47 +105,61 @@ fn pixel_bytes(film: &Film, kind: Kind, display: crate::color::Display) -> Vec<u
         .for_each(|(y, (bytes, (colour, alpha)))| {
             let pixels = bytes.chunks_exact_mut(size).zip(colour.iter().zip(alpha));
             for (x, (out, (c, &a))) in pixels.enumerate() {
-                let offset = crate::color::dither_offset(x as u32, y as u32);
-                put_pixel(out, kind, display, [c.x, c.y, c.z], a, offset);
+                painter.put(out, [c.x, c.y, c.z], a, (x as u32, y as u32));
             }
         });
     bytes
 }
 
-/// One pixel's codes into `out`. PNG colour is straight: a pixel with
-/// alpha shows its colour divided by its coverage; one without shows the
-/// film's colour, which, where the background is transparent, is the
-/// fractal over black. 8-bit codes are dithered by `offset`.
-#[inline]
-fn put_pixel(
-    out: &mut [u8],
+/// What turns a frame's pixels into one kind of PNG's codes, set up once
+/// a frame.
+struct Painter {
     kind: Kind,
     display: crate::color::Display,
-    rgb: [f32; 3],
-    alpha: f32,
-    offset: f32,
-) {
-    let curve = crate::color::SrgbCurve::get();
-    let plain = display.is_plain();
-    let show = |v: f32| if plain { v } else { display.apply(v) };
-    if kind.depth == png::BitDepth::Eight {
-        for (byte, v) in out.iter_mut().zip(rgb) {
-            *byte = curve.dithered_byte(show(v), offset);
+    /// The display changes nothing: light is coded as it is.
+    plain: bool,
+    curve: &'static crate::color::SrgbCurve,
+}
+
+impl Painter {
+    #[inline]
+    fn show(&self, v: f32) -> f32 {
+        if self.plain {
+            v
+        } else {
+            self.display.apply(v)
         }
-        return;
     }
-    let (shown, alpha) = match kind.colour {
-        png::ColorType::Rgba if kind.transparent => {
-            let a = alpha.clamp(0.0, 1.0);
-            (straight_shown(rgb, a, show), Some(a))
+
+    /// One pixel's codes into `out`. PNG colour is straight: a pixel with
+    /// alpha shows its colour divided by its coverage; one without shows
+    /// the film's colour, which, where the background is transparent, is
+    /// the fractal over black. 8-bit codes are dithered by the pixel's
+    /// offset.
+    #[inline]
+    fn put(&self, out: &mut [u8], rgb: [f32; 3], alpha: f32, (x, y): (u32, u32)) {
+        let (kind, curve) = (self.kind, self.curve);
+        let show = |v: f32| self.show(v);
+        if kind.depth == png::BitDepth::Eight {
+            let offset = crate::color::dither_offset(x, y);
+            for (byte, v) in out.iter_mut().zip(rgb) {
+                *byte = curve.dithered_byte(show(v), offset);
+            }
+            return;
         }
-        png::ColorType::Rgba => (rgb.map(show), Some(1.0)),
-        _ => (rgb.map(show), None),
-    };
-    let codes = shown.map(|v| curve.code16(v));
-    let alpha = alpha.map(|a| (a * 65535.0 + 0.5) as u16);
-    for (pair, code) in out.chunks_exact_mut(2).zip(codes.into_iter().chain(alpha)) {
-        pair.copy_from_slice(&code.to_be_bytes());
+        let (shown, alpha) = match kind.colour {
+            png::ColorType::Rgba if kind.transparent => {
+                let a = alpha.clamp(0.0, 1.0);
+                (straight_shown(rgb, a, show), Some(a))
+            }
+            png::ColorType::Rgba => (rgb.map(show), Some(1.0)),
+            _ => (rgb.map(show), None),
+        };
+        let codes = shown.map(|v| curve.code16(v));
+        let alpha = alpha.map(|a| (a * 65535.0 + 0.5) as u16);
+        for (pair, code) in out.chunks_exact_mut(2).zip(codes.into_iter().chain(alpha)) {
+            pair.copy_from_slice(&code.to_be_bytes());
+        }
     }
 }
 

@@ -406,10 +406,12 @@ fn trace(
     stats: &mut FrameStats,
 ) -> Vec3 {
     let Some(at) = at else {
-        let sky = match &scene.effects.path_tracing {
-            _ if scene.look.transparent_background => Vec3::ZERO,
-            Some(pt) => pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity,
-            None => scene.look.background(ray.dir, up),
+        let sky = if scene.look.transparent_background {
+            Vec3::ZERO
+        } else if let Some(pt) = &scene.effects.path_tracing {
+            pt.sky.radiance(&scene.look, ray.dir, up, environment) * pt.sky_intensity
+        } else {
+            scene.look.background(ray.dir, up)
         };
         let colour = match &scene.effects.glow {
             Some(g) => sky + glow(g, result.closest),

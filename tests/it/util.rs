@@ -249,13 +249,7 @@ impl Dir {
 /// Whether ffmpeg and ffprobe run here; in CI they must (.ci/run installs
 /// them), elsewhere a test that needs them skips with a note.
 pub fn ffmpeg_installed() -> bool {
-    let runs = |tool: &str| Command::new(tool).arg("-version").output().is_ok();
-    let have = runs("ffmpeg") && runs("ffprobe");
-    if !have {
-        assert!(std::env::var_os("CI").is_none(), "ffmpeg is missing in CI");
-        eprintln!("ffmpeg not installed: skipping the encode");
-    }
-    have
+    tool("ffmpeg", "-version") && tool("ffprobe", "-version")
 }
 
 impl Dir {
