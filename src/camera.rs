@@ -1,16 +1,25 @@
 //! The camera: where it stands and looks, its lens, and the ray through
 //! each pixel (a pinhole's, or a thin lens's from a point on the aperture).
 
+use crate::exact::{Coordinates, Digits};
 use crate::march::Ray;
 use crate::math::{normalize_or, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
 /// A camera: a pinhole, or a thin lens when its aperture is open.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(from = "CameraForm", into = "CameraForm")]
 pub struct Camera {
     pub position: DVec3,
     pub target: DVec3,
+    /// The digits of `position` and of `target` where the timeline wrote
+    /// them as strings, for deep frames (`crate::exact`).
+    pub position_digits: Option<Digits>,
+    pub target_digits: Option<Digits>,
+    /// The position relative to the target, exactly, where `camera.distance`
+    /// placed the camera: `position` is `target` plus this, rounded, which
+    /// keeps nothing of it once it is below f64's resolution of `target`.
+    pub offset: Option<DVec3>,
     /// Approximate up direction; the true up is made perpendicular to the view.
     pub up: DVec3,
     /// Rotation about the viewing direction, counter-clockwise as seen by the camera.
@@ -33,23 +42,100 @@ impl Default for Camera {
             fov_degrees: 45.0,
             aperture_radius: 0.0,
             focus_distance: None,
+            position_digits: None,
+            target_digits: None,
+            offset: None,
         }
     }
 }
 
-/// Orthonormal camera frame with the image-plane half-height.
-#[derive(Clone, Copy, Debug)]
-pub struct CameraFrame {
-    pub origin: DVec3,
-    pub forward: DVec3,
-    pub right: DVec3,
-    pub up: DVec3,
-    pub tan_half_fov: Real,
-    pub aperture_radius: Real,
-    pub focus_distance: Real,
+/// The camera as a timeline writes it: position and target may be numbers
+/// or strings of digits.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+struct CameraForm {
+    position: Coordinates,
+    target: Coordinates,
+    up: DVec3,
+    roll_degrees: Real,
+    fov_degrees: Real,
+    aperture_radius: Real,
+    focus_distance: Option<Real>,
+    /// Written into a scene's hash only where f64 cannot hold the position
+    /// (`Camera::offset`), so frames of ordinary zooms keep their hashes.
+    #[serde(skip_deserializing, skip_serializing_if = "Option::is_none")]
+    offset: Option<DVec3>,
 }
 
+impl Default for CameraForm {
+    fn default() -> Self {
+        Camera::default().into()
+    }
+}
+
+impl From<CameraForm> for Camera {
+    fn from(form: CameraForm) -> Camera {
+        Camera {
+            position: form.position.value,
+            target: form.target.value,
+            position_digits: form.position.digits,
+            target_digits: form.target.digits,
+            up: form.up,
+            roll_degrees: form.roll_degrees,
+            fov_degrees: form.fov_degrees,
+            aperture_radius: form.aperture_radius,
+            focus_distance: form.focus_distance,
+            offset: None,
+        }
+    }
+}
+
+impl From<Camera> for CameraForm {
+    fn from(c: Camera) -> CameraForm {
+        let unresolved = |o: &DVec3| {
+            let scale = c.target.abs().max_element();
+            o.abs().max_element() < OFFSET_IN_HASH * scale
+        };
+        CameraForm {
+            position: Coordinates {
+                value: c.position,
+                digits: c.position_digits,
+            },
+            target: Coordinates {
+                value: c.target,
+                digits: c.target_digits,
+            },
+            up: c.up,
+            roll_degrees: c.roll_degrees,
+            fov_degrees: c.fov_degrees,
+            aperture_radius: c.aperture_radius,
+            focus_distance: c.focus_distance,
+            offset: c.offset.filter(unresolved),
+        }
+    }
+}
+
+/// An offset below this share of the target's size is written into the
+/// scene's hash: f64's position keeps only a few of its bits.
+const OFFSET_IN_HASH: Real = 1.0 / (1u64 << 30) as Real;
+
 impl Camera {
+    /// The position relative to the target as exactly as the scene knows
+    /// it: `offset`, or the difference of the digits (or of the f64 values,
+    /// which is exact where they are close) computed in `bits`.
+    pub fn relative_position(&self) -> DVec3 {
+        if let Some(offset) = self.offset {
+            return offset;
+        }
+        if self.position_digits.is_none() && self.target_digits.is_none() {
+            return self.position - self.target;
+        }
+        let bits = 64 + crate::exact::MAX_DIGITS * 4;
+        let p = crate::exact::big_point(self.position, self.position_digits.as_ref(), bits);
+        let t = crate::exact::big_point(self.target, self.target_digits.as_ref(), bits);
+        DVec3::from_array([0, 1, 2].map(|i| (&p[i] - &t[i]).to_f64().value()))
+    }
+
     /// Builds the camera's orthonormal frame. Validation guarantees position ≠
     /// target and an up vector not parallel to the view; the fallbacks only keep
     /// the maths finite.
@@ -73,6 +159,18 @@ impl Camera {
                 .unwrap_or_else(|| (self.target - self.position).length()),
         }
     }
+}
+
+/// Orthonormal camera frame with the image-plane half-height.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFrame {
+    pub origin: DVec3,
+    pub forward: DVec3,
+    pub right: DVec3,
+    pub up: DVec3,
+    pub tan_half_fov: Real,
+    pub aperture_radius: Real,
+    pub focus_distance: Real,
 }
 
 impl CameraFrame {

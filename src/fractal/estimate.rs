@@ -2,7 +2,7 @@
 //! bounds that keep an estimate safe where its formula fails.
 
 use super::orbit::Orbit;
-use super::{DeMethod, Estimate, Fractal, Precision};
+use super::{DeMethod, Estimate, Fractal, Precision, Triplex};
 use crate::math::{DVec3, Dual, Number, Real};
 
 impl Fractal {
@@ -139,6 +139,7 @@ impl Fractal {
         // The common case, a point near the set off Julia's critical point,
         // in few operations: every estimate of a march comes through here.
         let critical = near_critical && self.julia.is_some();
+        let p = self.world(p);
         if no_bound_applies(p, iterations, escape.min(2.0), critical) {
             return (distance, 0);
         }
@@ -157,7 +158,7 @@ impl Fractal {
                     return (gap, 0);
                 }
                 let projected = p * (radius / length);
-                let e = self.estimate_raw::<T>(projected, scale);
+                let e = self.estimate_raw::<T>(self.local(projected), scale);
                 let near = if e.escaped { e.distance } else { 0.0 };
                 return (near.hypot(gap), e.orbits);
             }
@@ -178,7 +179,7 @@ impl Fractal {
                         false,
                     );
                     let z1 = DVec3::new(first.z[0].value(), first.z[1].value(), first.z[2].value());
-                    let e = self.estimate_in::<T>(z1, scale, false);
+                    let e = self.estimate_in::<T>(self.local(z1), scale, false);
                     (if e.escaped { e.distance } else { 0.0 }, 1 + e.orbits)
                 };
             let stretch = |delta: Real| n * (length + delta).powf(n - 1.0) * delta;
@@ -207,11 +208,48 @@ impl Fractal {
     /// inside by its estimate bisects the same set.
     pub fn contains(&self, p: DVec3) -> bool {
         match self.precision {
-            Precision::F64 => !self.orbit([p.x, p.y, p.z], self.iterations, true).escaped,
+            Precision::F64 => {
+                !self
+                    .orbit_at([p.x, p.y, p.z], self.iterations, true)
+                    .escaped
+            }
             Precision::F32 => {
                 let q = [p.x as f32, p.y as f32, p.z as f32];
-                !self.orbit(q, self.iterations, true).escaped
+                !self.orbit_at(q, self.iterations, true).escaped
             }
+        }
+    }
+
+    /// The orbit of the frame's point `p`: itself, or in a deep frame the
+    /// anchor plus `p`, by perturbation.
+    #[inline]
+    pub fn orbit_at<T: Number>(
+        &self,
+        p: Triplex<T>,
+        limit: u32,
+        stop_at_bailout: bool,
+    ) -> Orbit<T> {
+        match &self.deep {
+            None => self.orbit(p, limit, stop_at_bailout),
+            Some(reference) => reference.orbit(self, p, limit, stop_at_bailout),
+        }
+    }
+
+    /// The world position of the frame's point `p` (to f64, for bounds).
+    #[inline(always)]
+    pub fn world(&self, p: DVec3) -> DVec3 {
+        match &self.deep {
+            None => p,
+            Some(reference) => reference.anchor + p,
+        }
+    }
+
+    /// The frame's point at world position `w`: `world`'s inverse.
+    #[inline(always)]
+    pub fn local(&self, w: DVec3) -> DVec3 {
+        match &self.deep {
+            None => w,
+            Some(reference) => w - reference.anchor,
         }
     }
 
@@ -254,7 +292,7 @@ impl Fractal {
         // The Jacobian method runs its one orbit in dual numbers: their values
         // are the plain orbit, so no second orbit is needed.
         let (centre, jacobian): (Orbit<T>, Option<glam::DMat3>) = if self.de == DeMethod::Jacobian {
-            let dual: Orbit<Dual<T>> = self.orbit(
+            let dual: Orbit<Dual<T>> = self.orbit_at(
                 [
                     Dual::variable(T::from_real(p.x), 0),
                     Dual::variable(T::from_real(p.y), 1),
@@ -276,7 +314,7 @@ impl Fractal {
             };
             (plain, Some(jacobian))
         } else {
-            (self.orbit(at(p), self.iterations, true), None)
+            (self.orbit_at(at(p), self.iterations, true), None)
         };
         self.estimate_from_orbit(p, scale, &centre, jacobian)
     }
@@ -295,7 +333,7 @@ impl Fractal {
         let distance = if !centre.escaped {
             0.0
         } else if centre.iterations == 0 {
-            distance_to_ball(p, self.escape_radius::<T>())
+            distance_to_ball(self.world(p), self.escape_radius::<T>())
         } else {
             let r = centre.r.value();
             let d = match self.de {
@@ -319,9 +357,9 @@ impl Fractal {
                     let k = centre.iterations;
                     let sample = |q: DVec3| -> Real {
                         match self.de {
-                            DeMethod::EscapeLength => self.orbit(at(q), k, false).r.value(),
+                            DeMethod::EscapeLength => self.orbit_at(at(q), k, false).r.value(),
                             _ => {
-                                let o: Orbit<T> = self.orbit(at(q), self.iterations, true);
+                                let o: Orbit<T> = self.orbit_at(at(q), self.iterations, true);
                                 potential(o.r.value(), o.iterations, self.power)
                             }
                         }

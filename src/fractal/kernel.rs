@@ -52,7 +52,8 @@ impl Fractal {
         scales: &[Real; N],
         out: &mut [Estimate; N],
     ) {
-        if self.de == DeMethod::Analytic && self.precision == Precision::F64 {
+        if self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
+        {
             if let Some(n) = whole_power(self.power) {
                 self.in_vectors(points, n, out);
                 return self.bound_lanes(points, out);

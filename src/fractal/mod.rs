@@ -107,6 +107,11 @@ pub struct Fractal {
     pub de: DeMethod,
     /// Precision of the estimator's arithmetic.
     pub precision: Precision,
+    /// A deep frame's reference (`deep`): points are then offsets from its
+    /// anchor. Set for rendering a deep frame (`crate::deep`), never read
+    /// from a timeline.
+    #[serde(skip)]
+    pub deep: Option<std::sync::Arc<deep::Reference>>,
 }
 
 impl Default for Fractal {
@@ -119,6 +124,7 @@ impl Default for Fractal {
             julia: None,
             de: DeMethod::Analytic,
             precision: Precision::F64,
+            deep: None,
         }
     }
 }
@@ -180,6 +186,7 @@ impl Estimate {
 /// A point of the kernel's number type.
 pub type Triplex<T> = [T; 3];
 
+pub mod deep;
 mod estimate;
 mod kernel;
 mod orbit;

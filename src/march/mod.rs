@@ -59,13 +59,24 @@ pub struct MarchSettings {
     /// glow, which needs each ray's nearest approach, nor with estimators
     /// other than the analytic one (`Scene::cone_rays`).
     pub cone_rays: u32,
+    /// The bounding sphere's centre in the frame's coordinates: the world
+    /// origin, or in a deep frame (measured from its anchor) minus the anchor.
+    #[serde(skip)]
+    pub centre: DVec3,
 }
 
 impl MarchSettings {
     /// Where `ray` enters and leaves the bounding sphere, if it meets it.
     #[inline]
     pub fn interval(&self, ray: &Ray) -> Option<(Real, Real)> {
-        sphere_interval(ray.origin, ray.dir, self.bounding_radius)
+        self.interval_from(ray.origin, ray.dir)
+    }
+
+    /// Where the ray from `origin` along `dir` enters and leaves the
+    /// bounding sphere, if it meets it.
+    #[inline]
+    pub fn interval_from(&self, origin: DVec3, dir: DVec3) -> Option<(Real, Real)> {
+        sphere_interval(origin - self.centre, dir, self.bounding_radius)
     }
 
     /// The plain step an estimate allows: `fudge` times the estimate, no
@@ -87,6 +98,7 @@ impl Default for MarchSettings {
             bounding_radius: 1.5,
             over_relaxation: 1.2,
             cone_rays: 16,
+            centre: DVec3::ZERO,
         }
     }
 }
@@ -113,8 +125,9 @@ impl Ray {
     /// Width of one pixel's cone at distance `t` along the ray.
     #[inline]
     pub fn footprint(&self, t: Real) -> Real {
-        // A floor keeps the threshold non-zero for a camera sitting on the surface.
-        (self.start_footprint + t * self.pixel_angle).max(1e-15)
+        // A floor keeps the threshold non-zero for a camera sitting on the
+        // surface; the least normal f64, so deep frames keep their pixels.
+        (self.start_footprint + t * self.pixel_angle).max(Real::MIN_POSITIVE)
     }
 }
 

@@ -13,7 +13,8 @@ use rayon::prelude::*;
 
 /// What every band of one frame's rendering shares, worked out once.
 pub(super) struct FrameSetup<'a> {
-    pub(super) scenes: &'a [Scene],
+    /// As they render: a deep frame's measured from its anchor (`deep`).
+    pub(super) scenes: std::borrow::Cow<'a, [Scene]>,
     pub(super) frame_index: u32,
     pub(super) width: u32,
     pub(super) height: u32,
@@ -37,8 +38,11 @@ impl<'a> FrameSetup<'a> {
         samples: std::ops::Range<u32>,
         on_row: &'a (dyn Fn() + Sync),
     ) -> Self {
+        let scenes = match crate::deep::prepare_all(scenes, height) {
+            Some(deep) => std::borrow::Cow::Owned(deep),
+            None => std::borrow::Cow::Borrowed(scenes),
+        };
         FrameSetup {
-            scenes,
             frame_index,
             width,
             height,
@@ -54,6 +58,7 @@ impl<'a> FrameSetup<'a> {
                 .path_tracing
                 .as_ref()
                 .and_then(|pt| pt.sky.environment()),
+            scenes,
             on_row,
         }
     }
@@ -73,7 +78,7 @@ pub(super) const BAND_TASKS: usize = 1;
 /// Adds `frame.samples` of every pixel of the band of image rows from `y0`
 /// (as many as `sums` holds) to `sums`.
 pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> FrameStats {
-    let scenes = frame.scenes;
+    let scenes = &*frame.scenes;
     let w = frame.width as usize;
     let rows = sums.colour.len() / w.max(1);
     let mut stats = FrameStats::default();

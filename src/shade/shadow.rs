@@ -4,7 +4,7 @@
 use super::SurfacePoint;
 use crate::fractal::Fractal;
 use crate::march::MarchSettings;
-use crate::math::{sphere_interval, DVec3, Real};
+use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};
 
 /// Shadows from the light: a march from each lit hit towards the light.
@@ -97,7 +97,7 @@ impl ShadowWalk {
         to_light: DVec3,
         footprint: Real,
     ) -> Result<ShadowWalk, (f32, u64)> {
-        let Some((_, t_exit)) = sphere_interval(from, to_light, settings.bounding_radius) else {
+        let Some((_, t_exit)) = settings.interval_from(from, to_light) else {
             return Err((1.0, 0));
         };
         let walk = ShadowWalk {

@@ -201,14 +201,20 @@ pub(super) const CAMERA: &[Parameter] = &[
         shape: Triple,
         doc: "triple",
         check: |s| within(s.camera.position, MAX_COORDINATE),
-        set: |s, v| s.camera.position = triple(v),
+        set: |s, v| {
+            s.camera.position = triple(v);
+            (s.camera.position_digits, s.camera.offset) = (None, None);
+        },
     },
     Parameter {
         name: "camera.target",
         shape: Triple,
         doc: "triple",
         check: |s| within(s.camera.target, MAX_COORDINATE),
-        set: |s, v| s.camera.target = triple(v),
+        set: |s, v| {
+            s.camera.target = triple(v);
+            s.camera.target_digits = None;
+        },
     },
     Parameter {
         name: "camera.up",
@@ -240,8 +246,10 @@ pub(super) const CAMERA: &[Parameter] = &[
         check: |_| Ok(()),
         set: |s, v| {
             let c = &mut s.camera;
-            let away = crate::math::normalize_or(c.position - c.target, DVec3::Z);
+            let away = crate::math::normalize_or(c.relative_position(), DVec3::Z);
+            c.offset = Some(away * v[0]);
             c.position = c.target + away * v[0];
+            c.position_digits = None;
         },
     },
     Parameter {

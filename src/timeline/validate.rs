@@ -119,17 +119,23 @@ pub(super) fn counted(n: u32, most: u32) -> Checked {
 /// The view direction the camera's position, target and up give.
 fn view(s: &Scene) -> Result<(), Invalid> {
     let c = &s.camera;
-    let view = c.target - c.position;
-    // Below a few ulps of the coordinates the view direction is noise.
-    let scale = c
-        .position
-        .abs()
-        .max_element()
-        .max(c.target.abs().max_element())
-        .max(1.0);
+    let view = -c.relative_position();
+    // Below a few ulps of the coordinates the view direction is noise,
+    // unless the scene knows the position exactly (digits, or placed by
+    // `camera.distance`).
+    let exact = c.offset.is_some() || c.position_digits.is_some() || c.target_digits.is_some();
+    let scale = if exact {
+        Real::MIN_POSITIVE / (8.0 * Real::EPSILON)
+    } else {
+        c.position
+            .abs()
+            .max_element()
+            .max(c.target.abs().max_element())
+            .max(1.0)
+    };
     let coincide = rule(view.length() > 8.0 * Real::EPSILON * scale, || {
         format!(
-            "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale)",
+            "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale; write the target as a string of digits, or place the camera with camera.distance, to go deeper)",
             8.0 * Real::EPSILON * scale
         )
     });

@@ -1,0 +1,204 @@
+//! Orbits of frames deeper than f64 resolves, by perturbation. A deep frame
+//! has an anchor (its target, to as many digits as the timeline gave), and
+//! its points are small f64 offsets from it. One reference orbit is
+//! iterated from the anchor in high precision (`reference`); each point's
+//! orbit is its difference δ from that, iterated in f64 by the perturbed
+//! step (`step`), which keeps δ's relative precision however small δ is.
+//!
+//! Where a point's orbit comes nearer the origin than it is to the
+//! reference's (|Z + δ| < |δ|), or the reference ends (it escaped first),
+//! the point is rebased onto the orbit of the origin: δ becomes the point
+//! itself, from index 0 (Zhuoran's rebasing, from 2-D deep zooms). In
+//! Mandelbrot mode the reference is the orbit of 0 with c = anchor, so it
+//! serves both; in Julia mode the orbit of 0 is a second reference.
+
+use super::orbit::{Orbit, ITERATIONS};
+use super::power::{length_squared, powi, whole_power, whole_power_step};
+use super::{Fractal, OrbitTraps, Triplex};
+use crate::exact::{big_from_f64, Big};
+use crate::math::{DVec3, Number, Real};
+
+mod reference;
+mod step;
+
+/// One reference orbit: its points, and the perturbed step's data at each.
+#[derive(Clone, Debug, PartialEq)]
+struct Track {
+    z: Vec<Triplex<Real>>,
+    /// `None` on the pole axis (and at the origin), where the step falls
+    /// back to the plain power.
+    steps: Vec<Option<step::Point>>,
+}
+
+impl Track {
+    fn new(fractal: &Fractal, n: u32, z: Vec<Triplex<Real>>) -> Track {
+        let steps = z
+            .iter()
+            .map(|&p| step::Point::new(fractal.formula, p, n))
+            .collect();
+        Track { z, steps }
+    }
+}
+
+/// A deep frame's reference: where its points are measured from and the
+/// high-precision orbits their orbits are differences from.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reference {
+    /// The anchor rounded to f64: the world position of the frame's origin,
+    /// for what needs a point's place only roughly (bounding spheres, bounds
+    /// far from the set).
+    pub anchor: DVec3,
+    /// Bits of precision the reference orbits were computed with.
+    pub bits: usize,
+    main: Track,
+    /// Julia mode's orbit of 0; Mandelbrot mode's is `main`.
+    critical: Option<Track>,
+    /// Where a point starts on `main`: 1 in Mandelbrot mode (`main` starts
+    /// at 0, and z₀ = c is its second point), 0 in Julia mode.
+    start: usize,
+    n: u32,
+}
+
+impl Reference {
+    /// The reference for `fractal` at `anchor` (its components in high
+    /// precision, `bits` of them): `None` for a power that is not whole,
+    /// which the perturbed step does not cover.
+    pub fn new(fractal: &Fractal, anchor: [Big; 3], bits: usize) -> Option<Reference> {
+        let n = whole_power(fractal.power)?;
+        let escape = fractal.escape_radius::<Real>();
+        let limit = fractal.iterations;
+        let zero = || [0.0; 3].map(|v| big_from_f64(v, bits));
+        let anchor_f64 = DVec3::from_array(anchor.each_ref().map(|v| v.to_f64().value()));
+        let orbit = |start, c: &[Big; 3], limit| {
+            let points = reference::orbit(fractal.formula, n, start, c, limit, escape, bits);
+            Track::new(fractal, n, points.iter().map(reference::rounded).collect())
+        };
+        let (main, critical, start) = match fractal.julia {
+            None => (orbit(zero(), &anchor, limit + 1), None, 1),
+            Some(k) => {
+                let c = k.to_array().map(|v| big_from_f64(v, bits));
+                let main = orbit(anchor, &c, limit);
+                (main, Some(orbit(zero(), &c, limit)), 0)
+            }
+        };
+        // A point rebased onto the orbit of 0 takes at least one step on it.
+        let origin_track = critical.as_ref().unwrap_or(&main);
+        (origin_track.z.len() >= 2).then_some(Reference {
+            anchor: anchor_f64,
+            bits,
+            main,
+            critical,
+            start,
+            n,
+        })
+    }
+
+    /// The orbit of the point `delta` from the anchor: what
+    /// `Fractal::orbit` gives at anchor + `delta`, computed as a difference.
+    pub(super) fn orbit<T: Number>(
+        &self,
+        fractal: &Fractal,
+        delta: Triplex<T>,
+        limit: u32,
+        stop_at_bailout: bool,
+    ) -> Orbit<T> {
+        self.walk(fractal, delta, limit, stop_at_bailout).orbit
+    }
+
+    /// `orbit`, with where the walk ended on the reference.
+    fn walk<T: Number>(
+        &self,
+        fractal: &Fractal,
+        delta: Triplex<T>,
+        limit: u32,
+        stop_at_bailout: bool,
+    ) -> Walked<T> {
+        let escape = fractal.escape_radius::<T>();
+        let zero = T::from_real(0.0);
+        let mandelbrot = fractal.julia.is_none();
+        let dc = if mandelbrot { delta } else { [zero; 3] };
+        let plus_one = T::from_real(if mandelbrot { 1.0 } else { 0.0 });
+        let nn = T::from_real(self.n as Real);
+        let origin_track = self.critical.as_ref().unwrap_or(&self.main);
+        let (mut track, mut m, mut d) = (&self.main, self.start, delta);
+        let mut z = add(track.z[m], d);
+        let mut r2 = length_squared(z);
+        let mut dr = T::from_real(1.0);
+        let mut traps = OrbitTraps {
+            origin: Real::INFINITY,
+            planes: DVec3::splat(Real::INFINITY),
+        };
+        let (mut i, mut rebased) = (0, 0);
+        while i < limit {
+            if stop_at_bailout && r2.value() > escape * escape {
+                break;
+            }
+            if m + 1 >= track.z.len() || r2.value() < length_squared(d).value() {
+                (track, m, d) = (origin_track, 0, z);
+                rebased += 1;
+            }
+            let zv = DVec3::new(z[0].value(), z[1].value(), z[2].value());
+            traps.origin = traps.origin.min(zv.length_squared());
+            traps.planes = traps.planes.min(zv.abs());
+            let r = r2.sqrt();
+            dr = nn * powi(r, self.n - 1, |a, b| a * b) * dr + plus_one;
+            let difference = match &track.steps[m] {
+                Some(point) => point.power_difference(fractal.formula, d),
+                None => self.plain_difference(fractal, track.z[m], d),
+            };
+            d = [0, 1, 2].map(|k| difference[k] + dc[k]);
+            m += 1;
+            z = add(track.z[m], d);
+            r2 = length_squared(z);
+            i += 1;
+        }
+        ITERATIONS.with(|count| count.set(count.get() + i as u64));
+        Walked {
+            orbit: Orbit::ended(z, r2, r2.sqrt(), dr, traps, i, escape),
+            delta: d,
+            rebased,
+        }
+    }
+
+    /// (Z + δ)ⁿ − Zⁿ where the perturbed step does not apply: at Z = 0 it is
+    /// δⁿ, exact; on the pole axis, the plain difference (f64's precision).
+    fn plain_difference<T: Number>(
+        &self,
+        fractal: &Fractal,
+        z: Triplex<Real>,
+        d: Triplex<T>,
+    ) -> Triplex<T> {
+        let power = |p: Triplex<T>| {
+            let r = length_squared(p).sqrt();
+            whole_power_step(fractal.formula, p, r, self.n).0
+        };
+        if z == [0.0; 3] {
+            return power(d);
+        }
+        let zt = z.map(T::from_real);
+        let (a, b) = (power(add(z, d)), power(zt));
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+}
+
+/// Where a perturbed orbit ended: the orbit, its last difference from the
+/// reference, and how often it was rebased.
+struct Walked<T> {
+    orbit: Orbit<T>,
+    #[cfg_attr(not(test), allow(dead_code))]
+    delta: Triplex<T>,
+    #[cfg_attr(not(test), allow(dead_code))]
+    rebased: u32,
+}
+
+#[inline(always)]
+fn add<T: Number>(z: Triplex<Real>, d: Triplex<T>) -> Triplex<T> {
+    [
+        T::from_real(z[0]) + d[0],
+        T::from_real(z[1]) + d[1],
+        T::from_real(z[2]) + d[2],
+    ]
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,152 @@
+//! The perturbed power step: (Z + δ)ⁿ − Zⁿ for a reference point Z and a
+//! small δ, to δ's own relative precision, where subtracting the two
+//! powers in f64 would keep nothing of δ once it is below 2⁻⁵²·|Z|.
+//!
+//! The whole power is a product of two complex powers (`power.rs`): qⁿ with
+//! q = pole + iρ (or ρ + i·pole for the asin form) and uⁿ with u the unit
+//! equatorial direction. Each difference is taken exactly in δ: ρ′ − ρ as
+//! (ρ′² − ρ²)/(ρ′ + ρ), u′ − u as (δw − u·δρ)/ρ′, a′ⁿ − aⁿ as
+//! (a′ − a)·Σ a′ⁿ⁻¹⁻ʲ·aʲ, and a product's as δa·b′ + a·δb.
+
+use super::super::{Formula, Triplex};
+use crate::math::{Number, Real};
+
+/// A complex number of the kernel's type.
+#[derive(Clone, Copy)]
+pub(super) struct C<T>(pub T, pub T);
+
+impl<T: Number> C<T> {
+    #[inline(always)]
+    fn add(self, o: C<T>) -> C<T> {
+        C(self.0 + o.0, self.1 + o.1)
+    }
+    #[inline(always)]
+    fn mul(self, o: C<T>) -> C<T> {
+        C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
+    }
+    #[inline(always)]
+    fn constant(c: [Real; 2]) -> C<T> {
+        C(T::from_real(c[0]), T::from_real(c[1]))
+    }
+}
+
+/// What the step needs of one reference point, all from its f64 value.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Point {
+    /// The pole coordinate and the equatorial pair (`split`).
+    pub pole: Real,
+    pub equator: [Real; 2],
+    /// Distance from the pole axis.
+    pub rho: Real,
+    /// qʲ and uʲ for j = 0..=n (index j).
+    pub q_powers: Vec<[Real; 2]>,
+    pub u_powers: Vec<[Real; 2]>,
+}
+
+/// The pole coordinate and the equatorial pair whose angle is the azimuth.
+#[inline(always)]
+pub(super) fn split<T: Copy>(formula: Formula, z: Triplex<T>) -> (T, [T; 2]) {
+    let [x, y, zz] = z;
+    match formula {
+        Formula::Quilez => (y, [zz, x]),
+        Formula::WhiteNylander | Formula::Asin => (zz, [x, y]),
+    }
+}
+
+/// The point whose pole coordinate and equatorial pair are given.
+#[inline(always)]
+fn join<T: Copy>(formula: Formula, pole: T, [e1, e2]: [T; 2]) -> Triplex<T> {
+    match formula {
+        Formula::Quilez => [e2, pole, e1],
+        Formula::WhiteNylander | Formula::Asin => [e1, e2, pole],
+    }
+}
+
+/// q from the pole coordinate and ρ: the complex number whose argument is
+/// the polar angle in the formula's convention.
+#[inline(always)]
+fn q_of<T: Copy>(formula: Formula, pole: T, rho: T) -> C<T> {
+    match formula {
+        Formula::Asin => C(rho, pole),
+        Formula::Quilez | Formula::WhiteNylander => C(pole, rho),
+    }
+}
+
+impl Point {
+    /// The step's data for reference point `z` and power `n`; `None` on the
+    /// pole axis (and at the origin), where u is undefined.
+    pub fn new(formula: Formula, z: Triplex<Real>, n: u32) -> Option<Point> {
+        let (pole, equator) = split(formula, z);
+        let rho = equator[0].hypot(equator[1]);
+        if !(rho > 0.0 && rho.is_finite()) {
+            return None;
+        }
+        let powers = |a: [Real; 2]| {
+            let mut out = vec![[1.0, 0.0]];
+            for _ in 0..n {
+                let p = out[out.len() - 1];
+                out.push([p[0] * a[0] - p[1] * a[1], p[0] * a[1] + p[1] * a[0]]);
+            }
+            out
+        };
+        let q = q_of(formula, pole, rho);
+        Some(Point {
+            pole,
+            equator,
+            rho,
+            q_powers: powers([q.0, q.1]),
+            u_powers: powers([equator[0] / rho, equator[1] / rho]),
+        })
+    }
+
+    /// (Z + δ)ⁿ − Zⁿ for this reference point Z.
+    #[inline]
+    pub fn power_difference<T: Number>(&self, formula: Formula, delta: Triplex<T>) -> Triplex<T> {
+        let n = self.q_powers.len() - 1;
+        let (d_pole, [d1, d2]) = split(formula, delta);
+        let [e1, e2] = self.equator.map(T::from_real);
+        let rho = T::from_real(self.rho);
+        // The pixel's distance from the pole axis, and its difference.
+        let (w1, w2) = (e1 + d1, e2 + d2);
+        let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
+        let two = T::from_real(2.0);
+        let d_rho = (two * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
+        // qⁿ's difference.
+        let d_q = q_of(formula, d_pole, d_rho);
+        let q_pixel = C::constant(self.q_powers[1]).add(d_q);
+        let d_qn = d_q.mul(geometric_sum(q_pixel, &self.q_powers[..n]));
+        // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
+        let u = C::<T>::constant(self.u_powers[1]);
+        let d_u = if rho_pixel.value() > 0.0 {
+            C(
+                (d1 - u.0 * d_rho) / rho_pixel,
+                (d2 - u.1 * d_rho) / rho_pixel,
+            )
+        } else {
+            C(T::from_real(0.0), T::from_real(0.0))
+        };
+        let d_un = d_u.mul(geometric_sum(u.add(d_u), &self.u_powers[..n]));
+        let [qc, qs] = self.q_powers[n].map(T::from_real);
+        let un = C::<T>::constant(self.u_powers[n]);
+        let un_pixel = un.add(d_un);
+        // (radial part) × (azimuthal part), differenced as δa·b′ + a·δb.
+        let times_u = |a: T, d_a: T| [d_a * un_pixel.0 + a * d_un.0, d_a * un_pixel.1 + a * d_un.1];
+        match formula {
+            // [rs·sp, rc, rs·cp] and [rs·cp, rs·sp, rc]: pole rc, equator rs·u.
+            Formula::Quilez | Formula::WhiteNylander => join(formula, d_qn.0, times_u(qs, d_qn.1)),
+            // [rc·cp, rc·sp, rs]: pole rs, equator rc·u.
+            Formula::Asin => join(formula, d_qn.1, times_u(qc, d_qn.0)),
+        }
+    }
+}
+
+/// Σ a′ⁿ⁻¹⁻ʲ·aʲ over j = 0..n given aʲ (`powers`, n of them), by Horner's
+/// rule in a′: (a′ⁿ − aⁿ)/(a′ − a) without the division.
+#[inline(always)]
+fn geometric_sum<T: Number>(a_pixel: C<T>, powers: &[[Real; 2]]) -> C<T> {
+    let mut sum = C::constant(powers[0]);
+    for &p in &powers[1..] {
+        sum = sum.mul(a_pixel).add(C::constant(p));
+    }
+    sum
+}

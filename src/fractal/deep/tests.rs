@@ -1,0 +1,215 @@
+use super::*;
+use crate::fractal::Formula;
+use std::sync::Arc;
+
+const FORMULAS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+
+fn fractals() -> Vec<Fractal> {
+    let mut all = Vec::new();
+    for formula in FORMULAS {
+        for julia in [None, Some(DVec3::new(0.35, -0.4, 0.2))] {
+            all.push(Fractal {
+                formula,
+                julia,
+                iterations: 24,
+                ..Fractal::default()
+            });
+        }
+    }
+    all
+}
+
+/// A point within 1e-15 of the set's surface along `dir` (bisection of
+/// membership from outside the set towards the origin).
+fn surface_point(fractal: &Fractal, dir: DVec3) -> DVec3 {
+    let dir = dir.normalize();
+    let (mut inside, mut outside) = (0.0, 2.0);
+    if !fractal.contains(DVec3::ZERO) {
+        // A Julia set without the origin: look from the other side.
+        inside = 2.0;
+        while inside > 0.0 && !fractal.contains(dir * inside) {
+            inside -= 0.01;
+        }
+        outside = inside + 0.01;
+    }
+    for _ in 0..60 {
+        let mid = 0.5 * (inside + outside);
+        if fractal.contains(dir * mid) {
+            inside = mid;
+        } else {
+            outside = mid;
+        }
+    }
+    dir * outside
+}
+
+fn big(v: DVec3, bits: usize) -> [Big; 3] {
+    v.to_array().map(|c| big_from_f64(c, bits))
+}
+
+/// The orbit of anchor + `delta` computed directly in high precision.
+fn direct(
+    fractal: &Fractal,
+    anchor: DVec3,
+    delta: DVec3,
+    limit: u32,
+    bits: usize,
+) -> Vec<[Big; 3]> {
+    let a = big(anchor, bits);
+    let d = big(delta, bits);
+    let p: [Big; 3] = [0, 1, 2].map(|i| &a[i] + &d[i]);
+    let n = whole_power(fractal.power).unwrap();
+    let escape = fractal.escape_radius::<Real>();
+    match fractal.julia {
+        None => {
+            let mut points = reference::orbit(
+                fractal.formula,
+                n,
+                big(DVec3::ZERO, bits),
+                &p,
+                limit + 1,
+                escape,
+                bits,
+            );
+            points.remove(0);
+            points
+        }
+        Some(k) => reference::orbit(fractal.formula, n, p, &big(k, bits), limit, escape, bits),
+    }
+}
+
+fn directions(count: usize) -> Vec<DVec3> {
+    crate::math::shell_points(count, 1.0..1.0001, 7)
+        .into_iter()
+        .map(DVec3::normalize)
+        .collect()
+}
+
+#[test]
+fn perturbed_differences_keep_their_precision_thirty_decades_down() {
+    let bits = 256;
+    let mut compared = 0;
+    for fractal in fractals() {
+        for dir in directions(3) {
+            let anchor = surface_point(&fractal, dir + DVec3::new(0.1, 0.2, 0.0));
+            let reference = Reference::new(&fractal, big(anchor, bits), bits).unwrap();
+            let delta = dir * 1e-30;
+            let exact = direct(&fractal, anchor, delta, fractal.iterations, bits);
+            let main: Vec<[Big; 3]> = match fractal.julia {
+                None => {
+                    let mut z = reference::orbit(
+                        fractal.formula,
+                        8,
+                        big(DVec3::ZERO, bits),
+                        &big(anchor, bits),
+                        fractal.iterations + 1,
+                        fractal.escape_radius::<Real>(),
+                        bits,
+                    );
+                    z.remove(0);
+                    z
+                }
+                Some(k) => reference::orbit(
+                    fractal.formula,
+                    8,
+                    big(anchor, bits),
+                    &big(k, bits),
+                    fractal.iterations,
+                    fractal.escape_radius::<Real>(),
+                    bits,
+                ),
+            };
+            for k in 1..exact.len().min(main.len()) as u32 {
+                let walked = reference.walk(&fractal, delta.to_array(), k, false);
+                if walked.rebased > 0 {
+                    break;
+                }
+                let want = [0, 1, 2].map(|i| {
+                    (&exact[k as usize][i] - &main[k as usize][i])
+                        .to_f64()
+                        .value()
+                });
+                let size = DVec3::from_array(want).length();
+                let error = (DVec3::from_array(walked.delta) - DVec3::from_array(want)).length();
+                assert!(
+                    error <= 1e-9 * size,
+                    "{:?} julia {:?} step {k}: δ {:?} vs {want:?}",
+                    fractal.formula,
+                    fractal.julia,
+                    walked.delta
+                );
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared > 100, "only {compared} steps compared");
+}
+
+#[test]
+fn rebased_orbits_follow_the_direct_orbit() {
+    let bits = 192;
+    let (mut rebased, mut compared) = (0, 0);
+    for fractal in fractals() {
+        let anchor = surface_point(&fractal, DVec3::new(0.5, 0.6, 0.4));
+        let reference = Reference::new(&fractal, big(anchor, bits), bits).unwrap();
+        for (i, dir) in directions(40).into_iter().enumerate() {
+            let delta = dir * 10f64.powi(-2 - (i % 8) as i32);
+            let limit = 8;
+            let walked = reference.walk(&fractal, delta.to_array(), limit, true);
+            let exact = direct(&fractal, anchor, delta, limit, bits);
+            let z = reference::rounded(&exact[exact.len() - 1]);
+            let escape = fractal.escape_radius::<Real>();
+            let r2 = DVec3::from_array(z).length_squared();
+            if (r2 / (escape * escape) - 1.0).abs() < 1e-6 {
+                continue; // on the bailout: either count is right
+            }
+            let orbit = walked.orbit;
+            assert_eq!(
+                orbit.iterations as usize,
+                exact.len() - 1,
+                "{:?} {delta}",
+                fractal.formula
+            );
+            let error = (DVec3::from_array(orbit.z) - DVec3::from_array(z)).length();
+            assert!(
+                error <= 1e-7 * DVec3::from_array(z).length().max(1e-3),
+                "{:?} {delta}: {:?} vs {z:?}",
+                fractal.formula,
+                orbit.z
+            );
+            rebased += (walked.rebased > 0) as u32;
+            compared += 1;
+        }
+    }
+    assert!(compared > 200, "{compared}");
+    assert!(rebased > 20, "only {rebased} orbits were rebased");
+}
+
+#[test]
+fn deep_estimates_match_plain_ones_where_f64_is_exact() {
+    for mut fractal in fractals() {
+        // An anchor of 20 bits and offsets of 40: every sum is exact in f64.
+        let anchor =
+            (surface_point(&fractal, DVec3::new(0.3, 0.8, 0.5)) * 1048576.0).round() / 1048576.0;
+        let plain = fractal.clone();
+        fractal.deep = Some(Arc::new(
+            Reference::new(&fractal, big(anchor, 128), 128).unwrap(),
+        ));
+        for (i, dir) in directions(12).into_iter().enumerate() {
+            let delta =
+                (dir * 2f64.powi(-8 - i as i32) * 1099511627776.0).round() / 1099511627776.0;
+            let deep = fractal.estimate(delta, 1e-9);
+            let want = plain.estimate(anchor + delta, 1e-9);
+            assert_eq!(deep.escaped, want.escaped, "{delta}");
+            assert_eq!(deep.iterations, want.iterations, "{delta}");
+            assert!(
+                (deep.distance - want.distance).abs() <= 1e-9 * want.distance,
+                "{:?}: {} vs {}",
+                fractal.formula,
+                deep.distance,
+                want.distance
+            );
+            assert_eq!(fractal.contains(delta), plain.contains(anchor + delta));
+        }
+    }
+}
