@@ -204,8 +204,14 @@ pub struct PickArgs {
     #[arg(long, default_value_t = 0)]
     pub frame: u32,
     /// Pixel column and row, from the top-left corner.
-    #[arg(long, value_name = "X,Y")]
-    pub pixel: String,
+    #[arg(long, value_name = "X,Y", required_unless_present = "refine")]
+    pub pixel: Option<String>,
+    /// Re-centre the target on the surface under the centre of the view,
+    /// zooming in steps of a thousand from a thousandth of the target's
+    /// size down to this frame's camera distance; prints the new
+    /// `target:` line with all the digits that depth needs.
+    #[arg(long, conflicts_with = "pixel")]
+    pub refine: bool,
     /// Image size the pixel refers to [default: the timeline's].
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,

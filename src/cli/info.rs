@@ -55,6 +55,7 @@ pub fn info(path: &Path) -> anyhow::Result<()> {
         base.quality.fudge,
         base.quality.max_steps
     );
+    print_deep(&t)?;
     print_tracks(&t)?;
     print_plan(base)?;
     print_cost(&t, base)
@@ -214,6 +215,35 @@ fn print_cost(t: &Timeline, base: &Scene) -> anyhow::Result<()> {
             "warning:  {} (of the thumbnail)",
             out_of_steps_warning(&[0], t)
         );
+    }
+    Ok(())
+}
+
+/// Which frames are deep (`crate::deep`) at the timeline's size, the
+/// precision their reference orbits take, and the iterations that resolve
+/// the deepest; nothing where every frame is within f64's reach.
+fn print_deep(t: &Timeline) -> anyhow::Result<()> {
+    let deep: Vec<u32> = (0..t.frame_count)
+        .filter(|&f| crate::deep::needed(&t.scene_at(f), t.height))
+        .collect();
+    let (Some(&first), Some(&last)) = (deep.first(), deep.last()) else {
+        return Ok(());
+    };
+    let scene = t.scene_at(last);
+    let bits = crate::deep::bits(&scene, t.height);
+    out!(
+        "deep:     {} frame(s) ({first}..={last}) are finer than f64 resolves at {}x{}: rendered by perturbation, the deepest from a {bits}-bit reference orbit",
+        deep.len(),
+        t.width,
+        t.height
+    );
+    out!(
+        "          frame {last} has {} iterations; about {} resolve its pixels (10 + 4 per decade of the target's size over a pixel)",
+        scene.fractal.iterations,
+        crate::deep::iterations_for(&scene, t.height)
+    );
+    if crate::fractal::whole_power(scene.fractal.power).is_none() {
+        out!("          power {} is not whole: perturbation needs a whole power, so these frames render in f64 and lose their detail", scene.fractal.power);
     }
     Ok(())
 }

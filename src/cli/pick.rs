@@ -14,13 +14,16 @@ pub fn pick(args: PickArgs) -> anyhow::Result<()> {
         None => (t.width, t.height),
     };
     check_frame(&t, args.frame)?;
+    let Some(pixel) = &args.pixel else {
+        return refine(&t, &args, [width, height]);
+    };
     let bad = || {
         Error::usage(
             "--pixel",
-            format!("expected X,Y inside {width}x{height}, got {:?}", args.pixel),
+            format!("expected X,Y inside {width}x{height}, got {pixel:?}"),
         )
     };
-    let (x, y) = args.pixel.split_once(',').ok_or_else(bad)?;
+    let (x, y) = pixel.split_once(',').ok_or_else(bad)?;
     let (x, y): (u32, u32) = (
         x.trim().parse().map_err(|_| bad())?,
         y.trim().parse().map_err(|_| bad())?,
@@ -41,23 +44,61 @@ pub fn pick(args: PickArgs) -> anyhow::Result<()> {
         .zip(report.normal.zip(report.pixel_footprint));
     match hit {
         Some(((point, distance), (n, footprint))) => {
-            out!(
-                "hit:       ({:.12}, {:.12}, {:.12})",
-                point[0],
-                point[1],
-                point[2]
-            );
+            match report.point_digits.as_ref().filter(|_| report.deep) {
+                Some(d) => out!("hit:       ({}, {}, {})", d[0], d[1], d[2]),
+                None => out!(
+                    "hit:       ({:.12}, {:.12}, {:.12})",
+                    point[0],
+                    point[1],
+                    point[2]
+                ),
+            }
             out!("distance:  {distance:.6e} along the ray from the camera");
             out!("normal:    ({:.4}, {:.4}, {:.4})", n[0], n[1], n[2]);
             out!("footprint: {footprint:.3e} (one pixel's width there)");
-            out!(
-                "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
-                point[0],
-                point[1],
-                point[2]
-            );
+            match report.point_digits.as_ref().filter(|_| report.deep) {
+                Some(d) => out!("As a zoom target:  target: {}", as_ron(d)),
+                None => out!(
+                    "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
+                    point[0],
+                    point[1],
+                    point[2]
+                ),
+            }
         }
         None => out!("miss: the ray leaves the bounding sphere without meeting the fractal"),
     }
+    Ok(())
+}
+
+/// A target as the timeline writes one with digits: `("…", "…", "…")`.
+fn as_ron(d: &[String; 3]) -> String {
+    format!("(\"{}\", \"{}\", \"{}\")", d[0], d[1], d[2])
+}
+
+/// `pick --refine`: re-centres the frame's target and prints it.
+fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
+    let scene = t.scene_at(args.frame);
+    let refined = crate::render::pick::refine(&scene, size).map_err(|distance| {
+        anyhow::anyhow!(
+            "the centre ray missed the fractal with the camera {distance:.3e} from the target: pick a target on the surface first (pick --pixel)"
+        )
+    })?;
+    if args.json {
+        out!("{}", serde_json::to_string(&refined)?);
+        return Ok(());
+    }
+    for step in &refined.steps {
+        out!(
+            "camera {:.3e} away: surface {:+.3e} beyond the target",
+            step.camera_distance,
+            step.beyond_target
+        );
+    }
+    out!(
+        "Re-centred for frame {}:  target: {}",
+        args.frame,
+        as_ron(&refined.target)
+    );
     Ok(())
 }

@@ -181,12 +181,19 @@ fn frames_inside(timeline: &Timeline, frames: &[u32]) -> (Vec<usize>, usize) {
                 run.iter().map(move |&f| {
                     let s = timeline.scene_at(f);
                     let same = |(l, _): &&(crate::scene::Scene, bool)| {
-                        l.camera.position == s.camera.position && l.fractal == s.fractal
+                        l.camera.position == s.camera.position
+                            && l.camera.offset == s.camera.offset
+                            && l.fractal == s.fractal
                     };
                     if let Some((_, was)) = last.as_ref().filter(same) {
                         return *was;
                     }
-                    let is = s.fractal.contains(s.camera.position);
+                    // A deep frame's camera is placed from its target more
+                    // finely than f64 holds its position.
+                    let is = match crate::deep::prepare(&s, timeline.height) {
+                        Some(d) => d.fractal.contains(d.camera.position),
+                        None => s.fractal.contains(s.camera.position),
+                    };
                     last = Some((s, is));
                     is
                 })

@@ -15,6 +15,11 @@ pub struct Pick {
     pub ray_direction: [f64; 3],
     pub hit: bool,
     pub point: Option<[f64; 3]>,
+    /// The hit as decimal digits, as many as place it to a thousandth of a
+    /// pixel (more than f64 holds in a deep frame).
+    pub point_digits: Option<[String; 3]>,
+    /// Whether the frame is deep (`crate::deep`).
+    pub deep: bool,
     pub distance: Option<f64>,
     pub normal: Option<[f64; 3]>,
     /// Width of the pixel's cone at the hit, or at the far side of the
@@ -37,27 +42,38 @@ pub struct PickFractal {
 /// `width`×`height` image of `scene`, frame `frame` of its film. The pixel
 /// must be inside the image.
 pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
-    let camera = scene.camera.frame();
+    let deep = crate::deep::prepare(scene, height);
+    let marched = deep.as_ref().unwrap_or(scene);
+    let camera = marched.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
-    let result = march(&ray, &scene.fractal, &scene.quality);
+    let fractal = &marched.fractal;
+    let result = march(&ray, fractal, &marched.quality);
     let hit = result
         .hit
-        .map(|h| (h, normal(&ray, &h, &scene.fractal, &scene.quality).0));
+        .map(|h| (h, normal(&ray, &h, fractal, &marched.quality).0));
     let arr = |v: crate::math::DVec3| [v.x, v.y, v.z];
+    let footprint = hit
+        .map(|(h, _)| h.t)
+        .or_else(|| marched.quality.interval(&ray).map(|(_, far)| far))
+        .map(|t| ray.footprint(t));
+    let digits = hit.zip(footprint).map(|((h, _), f)| {
+        let size = fractal.world(h.point).abs().max_element();
+        let significant = crate::deep::digits_for(size, f);
+        crate::deep::world_digits(scene, deep.is_some(), h.point, significant)
+    });
     Pick {
         frame,
         pixel: [x, y],
         size: [width, height],
-        ray_origin: arr(ray.origin),
+        ray_origin: arr(fractal.world(ray.origin)),
         ray_direction: arr(ray.dir),
         hit: hit.is_some(),
-        point: hit.map(|(h, _)| arr(h.point)),
+        point: hit.map(|(h, _)| arr(fractal.world(h.point))),
+        point_digits: digits,
+        deep: deep.is_some(),
         distance: hit.map(|(h, _)| h.t),
         normal: hit.map(|(_, n)| arr(n)),
-        pixel_footprint: hit
-            .map(|(h, _)| h.t)
-            .or_else(|| scene.quality.interval(&ray).map(|(_, far)| far))
-            .map(|t| ray.footprint(t)),
+        pixel_footprint: footprint,
         fractal: PickFractal {
             formula: scene.fractal.formula.name(),
             power: scene.fractal.power,
@@ -66,4 +82,98 @@ pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 
             julia: scene.fractal.julia.map(arr),
         },
     }
+}
+
+/// One step of `refine`: the camera's distance from the target, and how
+/// far beyond the target the centre ray met the surface.
+#[derive(Serialize)]
+pub struct RefineStep {
+    pub camera_distance: f64,
+    pub beyond_target: f64,
+}
+
+/// A target re-centred on the surface (`refine`), and the steps taken.
+#[derive(Serialize)]
+pub struct Refined {
+    pub target: [String; 3],
+    pub steps: Vec<RefineStep>,
+}
+
+/// How much closer each step of `refine` goes: the last hit is within
+/// half a pixel of the surface, so a thousandth keeps it well in view.
+const REFINE_STEP: f64 = 1e-3;
+
+/// Re-centres `scene`'s target on the surface: from a thousandth of the
+/// target's size away, then a thousandth closer each step down to the
+/// scene's own camera distance, the camera looks along its own direction at
+/// the target and the target moves to where the centre ray meets the
+/// surface. Each hit is within a pixel of the surface at that depth, so the
+/// last places the target as finely as the scene's pixels. `Err` names the
+/// distance where the centre ray missed.
+pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, f64> {
+    let relative = scene.camera.relative_position();
+    let (last, away) = (relative.length(), relative.normalize());
+    let size = scene.camera.target.abs().max_element();
+    let mut distance = (REFINE_STEP * size).max(last);
+    let mut s = scene.clone();
+    let mut steps = Vec::new();
+    loop {
+        let c = &mut s.camera;
+        c.offset = Some(away * distance);
+        c.position = c.target + away * distance;
+        c.position_digits = None;
+        let deep = crate::deep::prepare(&s, height);
+        let marched = deep.as_ref().unwrap_or(&s);
+        let ray =
+            marched
+                .camera
+                .frame()
+                .ray(width as f64 * 0.5, height as f64 * 0.5, width, height);
+        let hit = march(&ray, &marched.fractal, &marched.quality)
+            .hit
+            .ok_or(distance)?;
+        let footprint = ray.footprint(hit.t);
+        let t = hit.t + onto_the_set(&ray, hit.t, marched);
+        let point = ray.at(t);
+        let significant = crate::deep::digits_for(size, footprint);
+        let digits = crate::deep::world_digits(&s, deep.is_some(), point, significant);
+        s.camera.target = marched.fractal.world(point);
+        s.camera.target_digits = Some(std::sync::Arc::new(digits));
+        steps.push(RefineStep {
+            camera_distance: distance,
+            beyond_target: t - distance,
+        });
+        if distance <= last {
+            break;
+        }
+        distance = (distance * REFINE_STEP).max(last);
+    }
+    let target = s
+        .camera
+        .target_digits
+        .as_deref()
+        .cloned()
+        .unwrap_or_default();
+    Ok(Refined { target, steps })
+}
+
+/// How far past `t` along `ray` the set begins, found by membership: the
+/// estimate stops a ray short of the surface, often by many pixels where it
+/// understates the distance, and a target that short would leave the next,
+/// closer camera far from the surface. 0 where no crossing is found.
+fn onto_the_set(ray: &crate::march::Ray, t: f64, scene: &Scene) -> f64 {
+    let from = crate::march::Ray {
+        origin: ray.at(t),
+        start_footprint: ray.footprint(t),
+        ..*ray
+    };
+    let (crossing, _) = crate::march::march_by_membership(
+        &from,
+        &scene.fractal,
+        &scene.quality,
+        0.25,
+        0.0,
+        1 << 14,
+    );
+    crossing.unwrap_or(0.0)
 }

@@ -6,6 +6,7 @@ mod accuracy;
 mod bench;
 mod cli;
 mod compositing;
+mod deep;
 mod deep_oracle;
 mod farm;
 mod formats;

@@ -25,18 +25,38 @@ mod step;
 #[derive(Clone, Debug, PartialEq)]
 struct Track {
     z: Vec<Triplex<Real>>,
+    /// |Z|² − E² at each point (`reference::excess`).
+    excess: Vec<Real>,
     /// `None` on the pole axis (and at the origin), where the step falls
     /// back to the plain power.
     steps: Vec<Option<step::Point>>,
 }
 
 impl Track {
-    fn new(fractal: &Fractal, n: u32, z: Vec<Triplex<Real>>) -> Track {
+    fn new(fractal: &Fractal, n: u32, points: &[[Big; 3]], bits: usize) -> Track {
+        let escape = fractal.escape_radius::<Real>();
+        let z: Vec<_> = points.iter().map(reference::rounded).collect();
         let steps = z
             .iter()
             .map(|&p| step::Point::new(fractal.formula, p, n))
             .collect();
-        Track { z, steps }
+        let excess = points
+            .iter()
+            .map(|p| reference::excess(p, escape, bits))
+            .collect();
+        Track { z, excess, steps }
+    }
+
+    /// Whether Z + `d` at index `m` is past the escape radius E, tested as
+    /// (|Z|² − E²) + (2Z + δ)·δ > 0.
+    #[inline(always)]
+    fn outside<T: Number>(&self, m: usize, d: Triplex<T>) -> bool {
+        let z = self.z[m];
+        let mut sum = T::from_real(self.excess[m]);
+        for k in 0..3 {
+            sum = sum + (T::from_real(2.0 * z[k]) + d[k]) * d[k];
+        }
+        sum.value() > 0.0
     }
 }
 
@@ -71,7 +91,7 @@ impl Reference {
         let anchor_f64 = DVec3::from_array(anchor.each_ref().map(|v| v.to_f64().value()));
         let orbit = |start, c: &[Big; 3], limit| {
             let points = reference::orbit(fractal.formula, n, start, c, limit, escape, bits);
-            Track::new(fractal, n, points.iter().map(reference::rounded).collect())
+            Track::new(fractal, n, &points, bits)
         };
         let (main, critical, start) = match fractal.julia {
             None => (orbit(zero(), &anchor, limit + 1), None, 1),
@@ -114,6 +134,8 @@ impl Reference {
         stop_at_bailout: bool,
     ) -> Walked<T> {
         let escape = fractal.escape_radius::<T>();
+        // The tracks' excesses are over f64's escape radius; f32's may be lower.
+        let exact = escape == fractal.escape_radius::<Real>();
         let zero = T::from_real(0.0);
         let mandelbrot = fractal.julia.is_none();
         let dc = if mandelbrot { delta } else { [zero; 3] };
@@ -129,8 +151,15 @@ impl Reference {
             planes: DVec3::splat(Real::INFINITY),
         };
         let (mut i, mut rebased) = (0, 0);
+        let outside = |track: &Track, m: usize, d: Triplex<T>, r2: T| {
+            if exact {
+                track.outside(m, d)
+            } else {
+                r2.value() > escape * escape
+            }
+        };
         while i < limit {
-            if stop_at_bailout && r2.value() > escape * escape {
+            if stop_at_bailout && outside(track, m, d, r2) {
                 break;
             }
             if m + 1 >= track.z.len() || r2.value() < length_squared(d).value() {
@@ -153,8 +182,10 @@ impl Reference {
             i += 1;
         }
         ITERATIONS.with(|count| count.set(count.get() + i as u64));
+        let mut orbit = Orbit::ended(z, r2, r2.sqrt(), dr, traps, i, escape);
+        orbit.escaped = outside(track, m, d, r2);
         Walked {
-            orbit: Orbit::ended(z, r2, r2.sqrt(), dr, traps, i, escape),
+            orbit,
             delta: d,
             rebased,
         }

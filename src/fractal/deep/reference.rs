@@ -64,15 +64,30 @@ pub(super) fn orbit(
     bits: usize,
 ) -> Vec<[Big; 3]> {
     let mut points = vec![start];
+    // One point past the escape radius, so that a point whose orbit is just
+    // inside it when the reference's is just outside has a next one.
+    let mut past = 0;
     for _ in 0..limit {
         let z = &points[points.len() - 1];
         if rounded(z).iter().map(|v| v * v).sum::<Real>() > escape * escape {
-            break;
+            past += 1;
+            if past == 2 {
+                break;
+            }
         }
         let w = power(formula, z, n, bits);
         points.push([0, 1, 2].map(|i| &w[i] + &c[i]));
     }
     points
+}
+
+/// |z|² − `escape`², computed in high precision and then rounded: a point
+/// of the orbit Z + δ is past the escape radius where this plus 2Z·δ + δ²
+/// is positive, a test f64 takes exactly where |Z + δ|² itself cannot.
+pub(super) fn excess(z: &[Big; 3], escape: Real, bits: usize) -> Real {
+    let e = big_from_f64(escape, bits);
+    let sum = &z[0] * &z[0] + &z[1] * &z[1] + &z[2] * &z[2] - &e * &e;
+    sum.to_f64().value()
 }
 
 /// A high-precision point rounded to f64.

@@ -1,0 +1,252 @@
+//! Deep frames (past f64): against the high-precision oracle, pixel by
+//! pixel, across threads, and from the command line.
+
+use crate::deep_oracle::{self, OracleFractal};
+use crate::util::{stdout, Dir};
+use mandelreel::fractal::Formula;
+use mandelreel::march::{march, MarchSettings};
+use mandelreel::math::DVec3;
+use mandelreel::scene::Scene;
+
+/// A point on the 60-iteration power-8 bulb's surface, to 36 digits
+/// (`pick --refine` at 1e-30).
+const TARGET: [&str; 3] = [
+    "0.503022307080229373071939037055122258",
+    "0.443273582773394260215122339228275534",
+    "0.397548797954846079557511169564137767",
+];
+
+/// Where the camera looks from, far off: its direction from the target.
+const FROM: DVec3 = DVec3::new(2.4548, 3.5662, 1.9590);
+
+fn digits() -> [String; 3] {
+    TARGET.map(String::from)
+}
+
+/// The scene of a camera `distance` from `TARGET`, looking at it.
+fn scene(distance: f64) -> Scene {
+    let text = format!(
+        "(camera: (position: (2.4548, 3.5662, 1.9590), target: (\"{}\", \"{}\", \"{}\"), fov_degrees: 40), fractal: (iterations: 60), quality: (over_relaxation: 1.0, max_steps: 1000))",
+        TARGET[0], TARGET[1], TARGET[2]
+    );
+    let mut s: Scene = ron::from_str(&text).unwrap();
+    let away = (FROM - s.camera.target).normalize();
+    s.camera.offset = Some(away * distance);
+    s.camera.position = s.camera.target + away * distance;
+    s
+}
+
+fn oracle() -> OracleFractal {
+    OracleFractal {
+        formula: Formula::Quilez,
+        power: 8,
+        iterations: 60,
+        bailout: 4.0,
+        julia: None,
+        bits: 192,
+    }
+}
+
+const SIZE: [u32; 2] = [1920, 1080];
+
+/// The analytic estimate overstates the distance many times where an orbit
+/// escapes at the iteration limit, as it does just off a surface refined at
+/// that limit: a march steps into the set and bisects back, which a plain
+/// sphere tracer cannot. So the hit is checked against the oracle's
+/// estimate and membership instead: outside at the hit, and either under
+/// the hit threshold there or inside a pixel further, and outside at 64
+/// points on the way from the camera.
+#[test]
+fn deep_hits_agree_with_high_precision_membership() {
+    let outside = |offset: DVec3| deep_oracle::estimate(&oracle(), &digits(), offset.to_array()).2;
+    for distance in [1e-20, 1e-30] {
+        let s = scene(distance);
+        let deep = mandelreel::deep::prepare(&s, SIZE[1]).expect("a deep frame");
+        let camera = deep.camera.frame();
+        for (x, y) in [(960, 540), (700, 300), (1300, 800)] {
+            let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, SIZE[0], SIZE[1]);
+            let hit = march(&ray, &deep.fractal, &deep.quality)
+                .hit
+                .expect("the surface is in view");
+            let footprint = ray.footprint(hit.t);
+            let at = |t: f64| ray.at(t);
+            let place = format!("{distance:e}, pixel ({x}, {y}), hit at {:e}", hit.t);
+            let (estimate, _, escaped) =
+                deep_oracle::estimate(&oracle(), &digits(), at(hit.t).to_array());
+            assert!(escaped, "{place}: inside");
+            // Stopped by the estimate (under half a footprint), or by
+            // bisecting a crossing that is within a footprint.
+            let stopped = estimate < 0.5 * footprint * (1.0 + 1e-9);
+            assert!(
+                stopped || !outside(at(hit.t + footprint)),
+                "{place}: estimate {estimate:e}, outside a pixel on"
+            );
+            for k in 0..64 {
+                assert!(
+                    outside(at(hit.t * k as f64 / 64.0)),
+                    "{place}: inside at {k}/64"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn every_pixel_has_its_own_hit_thirty_decades_down() {
+    let deep = mandelreel::deep::prepare(&scene(1e-30), SIZE[1]).unwrap();
+    let camera = deep.camera.frame();
+    let settings = MarchSettings {
+        cone_rays: 1,
+        ..deep.quality.clone()
+    };
+    let mut hits = Vec::new();
+    for y in 536..544 {
+        for x in 956..964 {
+            let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, SIZE[0], SIZE[1]);
+            let hit = march(&ray, &deep.fractal, &settings).hit.unwrap();
+            hits.push((x as f64, y as f64, hit.t, hit.point, ray.footprint(hit.t)));
+        }
+    }
+    for (i, a) in hits.iter().enumerate() {
+        for b in &hits[i + 1..] {
+            assert_ne!(a.3, b.3, "two pixels share a hit point");
+        }
+    }
+    // No terraces: depth follows a plane (least squares) to a fraction of
+    // a footprint, where f64 would step by many.
+    let rms = plane_residual(&hits.iter().map(|h| (h.0, h.1, h.2)).collect::<Vec<_>>());
+    let footprint = hits[0].4;
+    assert!(
+        rms < 0.3 * footprint,
+        "rms {rms:e} against a footprint of {footprint:e}"
+    );
+}
+
+/// The rms distance of `z` from the least-squares plane z = a + b·x + c·y.
+fn plane_residual(points: &[(f64, f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let mean = |f: &dyn Fn(&(f64, f64, f64)) -> f64| points.iter().map(f).sum::<f64>() / n;
+    let (mx, my, mz) = (mean(&|p| p.0), mean(&|p| p.1), mean(&|p| p.2));
+    let (mut sxx, mut sxy, mut syy, mut sxz, mut syz) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for &(x, y, z) in points {
+        let (x, y, z) = (x - mx, y - my, z - mz);
+        (sxx, sxy, syy, sxz, syz) = (
+            sxx + x * x,
+            sxy + x * y,
+            syy + y * y,
+            sxz + x * z,
+            syz + y * z,
+        );
+    }
+    let det = sxx * syy - sxy * sxy;
+    let b = (sxz * syy - syz * sxy) / det;
+    let c = (syz * sxx - sxz * sxy) / det;
+    let sum: f64 = points
+        .iter()
+        .map(|&(x, y, z)| (z - mz - b * (x - mx) - c * (y - my)).powi(2))
+        .sum();
+    (sum / n).sqrt()
+}
+
+/// A timeline zooming onto `TARGET` from 1e-12 to 1e-24 over `frames`.
+fn deep_timeline(frames: u32) -> String {
+    format!(
+        "(fps: 1, frames: {frames}, size: (48, 27), scene: (camera: (position: (2.4548, 3.5662, 1.9590), target: (\"{}\", \"{}\", \"{}\"), fov_degrees: 40), fractal: (iterations: 60)), tracks: {{ \"camera.distance\": (interpolation: Linear, keys: [(time: 0, value: 1e-12), (time: {}, value: 1e-24)]) }})",
+        TARGET[0],
+        TARGET[1],
+        TARGET[2],
+        frames - 1
+    )
+}
+
+#[test]
+fn deep_frames_are_the_same_on_any_thread_count_and_after_a_resume() {
+    let dir = Dir::new();
+    dir.write("deep.ron", &deep_timeline(2));
+    dir.ok(&[
+        "render",
+        "deep.ron",
+        "--out",
+        "one",
+        "--threads",
+        "1",
+        "--quiet",
+    ]);
+    dir.ok(&[
+        "render",
+        "deep.ron",
+        "--out",
+        "two",
+        "--threads",
+        "2",
+        "--quiet",
+    ]);
+    let read = |folder: &str, frame: u32| {
+        std::fs::read(
+            dir.path()
+                .join(folder)
+                .join(format!("frame_{frame:05}.png")),
+        )
+        .unwrap()
+    };
+    for frame in 0..2 {
+        assert_eq!(read("one", frame), read("two", frame), "frame {frame}");
+    }
+    std::fs::remove_file(dir.path().join("two/frame_00001.png")).unwrap();
+    dir.ok(&["render", "deep.ron", "--out", "two", "--quiet"]);
+    assert_eq!(read("one", 1), read("two", 1));
+    // And the frames are not blank: a deep frame shows the surface.
+    let image = image::load_from_memory(&read("one", 1)).unwrap().to_rgb8();
+    let distinct: std::collections::HashSet<_> = image.pixels().map(|p| p.0).collect();
+    assert!(distinct.len() > 3, "{} colours", distinct.len());
+}
+
+#[test]
+fn info_names_the_deep_frames_and_pick_refine_recentres_the_target() {
+    let dir = Dir::new();
+    dir.write("deep.ron", &deep_timeline(3));
+    let info = stdout(&dir.ok(&["info", "deep.ron"]));
+    assert!(info.contains("deep:     3 frame(s) (0..=2)"), "{info}");
+    // From a target off the surface, refine finds one on it.
+    let off = deep_timeline(3).replace(TARGET[0], "0.5030223070");
+    dir.write("off.ron", &off);
+    let out = stdout(&dir.ok(&["pick", "off.ron", "--frame", "2", "--refine"]));
+    let line = out.lines().last().unwrap();
+    let target = line.split("target: ").nth(1).expect(line);
+    let refined = deep_timeline(3).replace(
+        &format!("(\"{}\", \"{}\", \"{}\")", TARGET[0], TARGET[1], TARGET[2]),
+        target,
+    );
+    assert!(target.len() > 3 * 28, "too few digits: {target}");
+    dir.write("refined.ron", &refined);
+    let pick = stdout(&dir.ok(&[
+        "pick",
+        "refined.ron",
+        "--frame",
+        "2",
+        "--pixel",
+        "24,13",
+        "--json",
+    ]));
+    let report: serde_json::Value = serde_json::from_str(&pick).unwrap();
+    assert_eq!(report["deep"], true);
+    // The camera is 1e-24 from the refined target, and the surface is there.
+    let distance = report["distance"].as_f64().unwrap();
+    assert!((distance - 1e-24).abs() < 0.05e-24, "{distance:e}");
+}
+
+#[test]
+fn digits_that_are_not_a_number_are_refused_at_their_line() {
+    let dir = Dir::new();
+    let bad = deep_timeline(2).replace(TARGET[1], "0.44x3");
+    dir.write("bad.ron", &bad);
+    let out = dir.run(&["info", "bad.ron"]);
+    assert_eq!(out.status.code(), Some(3));
+    let said = crate::util::stderr(&out);
+    assert!(
+        said.contains("bad.ron:1:")
+            && said.contains("scene.camera.target[1]")
+            && said.contains("\"0.44x3\" is not a decimal number"),
+        "{said}"
+    );
+}
