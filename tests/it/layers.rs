@@ -13,6 +13,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("job", &["job"]),
     ("files", &["output"]),
     ("film", &["timeline", "render"]),
+    ("deep frames", &["deep"]),
     ("scene", &["scene"]),
     ("shading", &["shade"]),
     ("camera", &["camera"]),
@@ -20,6 +21,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("fractal", &["fractal"]),
     ("light", &["color", "environment"]),
     ("errors", &["error"]),
+    ("digits", &["exact"]),
     ("leaves", &["math", "spans", "input", "interrupt", "host"]),
 ];
 
