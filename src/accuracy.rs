@@ -195,10 +195,13 @@ pub fn reference_depths(
     height: u32,
     step_fraction: Real,
 ) -> (Vec<Option<Real>>, u64) {
+    // A deep frame is marched as it renders, measured from its target.
+    let deep = crate::deep::prepare(scene, height);
+    let scene = deep.as_ref().unwrap_or(scene);
     let camera = scene.camera.frame();
     // Never step finer than a millionth of the camera–target distance: bounds the
     // work for rays that start right on the surface in deep zooms.
-    let min_step = 1e-6 * (scene.camera.position - scene.camera.target).length();
+    let min_step = 1e-6 * scene.camera.relative_position().length();
     let rows: Vec<(Vec<Option<Real>>, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {

@@ -17,6 +17,10 @@ use std::sync::Arc;
 /// normals (differences of estimates half a pixel apart) keep 4 digits.
 pub const DEEP_BELOW: Real = 1.0 / (1u64 << 36) as Real;
 
+/// The closest a camera may come to its target: a frame's offsets are f64,
+/// and lengths square them, which leaves f64's range below about 1e-154.
+pub const DEEPEST: Real = 1e-150;
+
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;
 
@@ -47,7 +51,8 @@ pub fn needed(scene: &Scene, height: u32) -> bool {
 /// digits down to a pixel, and 64 bits more for the orbit's own rounding.
 pub fn bits(scene: &Scene, height: u32) -> usize {
     let below = -resolution(scene, height).log2();
-    (64 + below.max(0.0).ceil() as usize + 32).max(MIN_BITS)
+    // A resolution of 0 (validation keeps frames from it) would ask for ∞.
+    (64 + below.clamp(0.0, 2048.0).ceil() as usize + 32).max(MIN_BITS)
 }
 
 /// The scene that frame renders as, where it is deep: measured from its
@@ -55,27 +60,58 @@ pub fn bits(scene: &Scene, height: u32) -> usize {
 /// and for powers that are not whole, which perturbation does not cover
 /// (they render in f64, and `info` says so).
 pub fn prepare(scene: &Scene, height: u32) -> Option<Scene> {
+    prepare_sharing(scene, height, &mut Vec::new())
+}
+
+/// `prepare`, taking the reference from `built` where a scene there has
+/// the same target, fractal and precision (a motion-blurred frame's
+/// instants), and adding the one it builds.
+fn prepare_sharing(
+    scene: &Scene,
+    height: u32,
+    built: &mut Vec<(Scene, usize, Arc<Reference>)>,
+) -> Option<Scene> {
     if !needed(scene, height) {
         return None;
     }
     let bits = bits(scene, height);
     let c = &scene.camera;
-    let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
-    let reference = Reference::new(&scene.fractal, anchor, bits)?;
+    let same = |(s, b, _): &&(Scene, usize, Arc<Reference>)| {
+        *b == bits
+            && s.fractal == scene.fractal
+            && s.camera.target == c.target
+            && s.camera.target_digits == c.target_digits
+    };
+    let reference = match built.iter().find(same) {
+        Some((_, _, r)) => r.clone(),
+        None => {
+            let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
+            let r = Arc::new(Reference::new(&scene.fractal, anchor, bits)?);
+            built.push((scene.clone(), bits, r.clone()));
+            r
+        }
+    };
     let mut deep = scene.clone();
     deep.quality.centre = -reference.anchor;
     deep.camera.position = c.relative_position();
-    deep.camera.target = crate::math::DVec3::ZERO;
+    deep.camera.target = DVec3::ZERO;
     (deep.camera.position_digits, deep.camera.target_digits) = (None, None);
     deep.camera.offset = None;
-    deep.fractal.deep = Some(Arc::new(reference));
+    deep.fractal.deep = Some(reference);
+    // f32's range ends near 1e-38, and the offsets are what carry the depth.
+    deep.fractal.precision = crate::fractal::Precision::F64;
     Some(deep)
 }
 
 /// `scenes` (a frame's instants) as they render at `height` rows: `None`
-/// where none is deep, so the caller keeps its own.
+/// where none is deep, so the caller keeps its own. Instants that share a
+/// target and fractal share one reference orbit.
 pub fn prepare_all(scenes: &[Scene], height: u32) -> Option<Vec<Scene>> {
-    let prepared: Vec<Option<Scene>> = scenes.iter().map(|s| prepare(s, height)).collect();
+    let mut built = Vec::new();
+    let prepared: Vec<Option<Scene>> = scenes
+        .iter()
+        .map(|s| prepare_sharing(s, height, &mut built))
+        .collect();
     if prepared.iter().all(Option::is_none) {
         return None;
     }

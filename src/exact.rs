@@ -188,8 +188,9 @@ impl Coordinates {
         let digits = any_digits.then(|| {
             Arc::new(parts.each_ref().map(|c| match c {
                 Component::Digits(d, _) => d.clone(),
-                // A number's exact binary value, written in full.
-                Component::Number(v) => decimal(&big_from_f64(*v, 64), 40),
+                // A number as written (its shortest decimal form): 0.1
+                // means a tenth, as the strings beside it mean what they say.
+                Component::Number(v) => format!("{v:?}"),
             }))
         });
         Coordinates {

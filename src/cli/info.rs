@@ -243,7 +243,7 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
         crate::deep::iterations_for(&scene, t.height)
     );
     if crate::fractal::whole_power(scene.fractal.power).is_none() {
-        out!("          power {} is not whole: perturbation needs a whole power, so these frames render in f64 and lose their detail", scene.fractal.power);
+        out!("          power {} is not a whole number from 2 to 64: perturbation needs one, so these frames render in f64 and lose their detail", scene.fractal.power);
     }
     Ok(())
 }

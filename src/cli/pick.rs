@@ -79,9 +79,9 @@ fn as_ron(d: &[String; 3]) -> String {
 /// `pick --refine`: re-centres the frame's target and prints it.
 fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
     let scene = t.scene_at(args.frame);
-    let refined = crate::render::pick::refine(&scene, size).map_err(|distance| {
+    let refined = crate::render::pick::refine(&scene, size).map_err(|problem| {
         anyhow::anyhow!(
-            "the centre ray missed the fractal with the camera {distance:.3e} from the target: pick a target on the surface first (pick --pixel)"
+            "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
         )
     })?;
     if args.json {

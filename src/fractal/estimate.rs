@@ -286,6 +286,19 @@ impl Fractal {
         estimate
     }
 
+    /// What `estimate_in::<f64>(p, scale, true)` makes of `p`'s orbit,
+    /// given the orbit: for kernels that iterate orbits side by side.
+    pub(super) fn estimate_finished(&self, p: DVec3, scale: Real, orbit: &Orbit<f64>) -> Estimate {
+        let mut estimate = self.estimate_from_orbit::<f64>(p, scale, orbit, None);
+        if estimate.escaped {
+            let (distance, orbits) =
+                self.bounded::<f64>(p, scale, estimate.distance, estimate.iterations, true);
+            estimate.distance = distance;
+            estimate.orbits += orbits;
+        }
+        estimate
+    }
+
     /// The estimator's formula at `p`, without `bounded`'s bounds.
     pub(super) fn estimate_raw<T: Number>(&self, p: DVec3, scale: Real) -> Estimate {
         let at = |q: DVec3| [T::from_real(q.x), T::from_real(q.y), T::from_real(q.z)];
@@ -352,7 +365,14 @@ impl Fractal {
                 DeMethod::Potential | DeMethod::SinhPotential | DeMethod::EscapeLength => {
                     // Tetrahedral finite differences; the step is a fraction of the
                     // pixel footprint but never below the precision's noise floor.
-                    let floor = T::EPSILON.sqrt() * p.length().max(1e-3);
+                    // A deep frame's points are offsets from its anchor, as
+                    // fine as its pixels: no floor of a thousandth there.
+                    let size = if self.deep.is_some() {
+                        p.length()
+                    } else {
+                        p.length().max(1e-3)
+                    };
+                    let floor = T::EPSILON.sqrt() * size;
                     let h = (0.25 * scale).max(floor);
                     let k = centre.iterations;
                     let sample = |q: DVec3| -> Real {

@@ -52,6 +52,11 @@ impl Fractal {
         scales: &[Real; N],
         out: &mut [Estimate; N],
     ) {
+        if let (Some(reference), DeMethod::Analytic, Precision::F64) =
+            (&self.deep, self.de, self.precision)
+        {
+            return reference.estimates_into(self, points, scales, out);
+        }
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
         {
             if let Some(n) = whole_power(self.power) {
@@ -142,7 +147,7 @@ pub(super) const REGISTER: usize = VECTOR / 2;
 pub(super) struct Stored([f64; REGISTER]);
 
 impl Stored {
-    const ZERO: Stored = Stored([0.0; REGISTER]);
+    pub(super) const ZERO: Stored = Stored([0.0; REGISTER]);
 }
 
 impl std::ops::Deref for Stored {

@@ -108,9 +108,9 @@ const REFINE_STEP: f64 = 1e-3;
 /// scene's own camera distance, the camera looks along its own direction at
 /// the target and the target moves to where the centre ray meets the
 /// surface. Each hit is within a pixel of the surface at that depth, so the
-/// last places the target as finely as the scene's pixels. `Err` names the
-/// distance where the centre ray missed.
-pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, f64> {
+/// last places the target as finely as the scene's pixels. `Err` says at
+/// which distance the centre ray missed, or the camera was inside the set.
+pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, String> {
     let relative = scene.camera.relative_position();
     let (last, away) = (relative.length(), relative.normalize());
     let size = scene.camera.target.abs().max_element();
@@ -131,7 +131,14 @@ pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, f64> 
                 .ray(width as f64 * 0.5, height as f64 * 0.5, width, height);
         let hit = march(&ray, &marched.fractal, &marched.quality)
             .hit
-            .ok_or(distance)?;
+            .ok_or_else(|| {
+                format!("the centre ray missed the fractal with the camera {distance:.3e} from the target")
+            })?;
+        if hit.t <= 0.0 {
+            return Err(format!(
+                "the camera, {distance:.3e} from the target, is inside the fractal"
+            ));
+        }
         let footprint = ray.footprint(hit.t);
         let t = hit.t + onto_the_set(&ray, hit.t, marched);
         let point = ray.at(t);

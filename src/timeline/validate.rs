@@ -124,21 +124,28 @@ fn view(s: &Scene) -> Result<(), Invalid> {
     // unless the scene knows the position exactly (digits, or placed by
     // `camera.distance`).
     let exact = c.offset.is_some() || c.position_digits.is_some() || c.target_digits.is_some();
-    let scale = if exact {
-        Real::MIN_POSITIVE / (8.0 * Real::EPSILON)
+    let coincide = if exact {
+        // Offsets are f64: past this their squares leave its range.
+        rule(view.abs().max_element() > crate::deep::DEEPEST, || {
+            format!(
+                "the camera is closer to its target than {:.0e}, the deepest a frame can be",
+                crate::deep::DEEPEST
+            )
+        })
     } else {
-        c.position
+        let scale = c
+            .position
             .abs()
             .max_element()
             .max(c.target.abs().max_element())
-            .max(1.0)
+            .max(1.0);
+        rule(view.length() > 8.0 * Real::EPSILON * scale, || {
+            format!(
+                "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale; write the target as a string of digits, or place the camera with camera.distance, to go deeper)",
+                8.0 * Real::EPSILON * scale
+            )
+        })
     };
-    let coincide = rule(view.length() > 8.0 * Real::EPSILON * scale, || {
-        format!(
-            "the camera position and target coincide (closer than {:.1e}, the limit of f64 at this scale; write the target as a string of digits, or place the camera with camera.distance, to go deeper)",
-            8.0 * Real::EPSILON * scale
-        )
-    });
     at("camera.target", coincide)?;
     let parallel = rule(view.normalize().cross(c.up).length() > 1e-9, || {
         format!(

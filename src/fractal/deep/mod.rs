@@ -14,10 +14,12 @@
 
 use super::orbit::{Orbit, ITERATIONS};
 use super::power::{length_squared, powi, whole_power, whole_power_step};
-use super::{Fractal, OrbitTraps, Triplex};
+use super::{Formula, Fractal, OrbitTraps, Triplex};
 use crate::exact::{big_from_f64, Big};
 use crate::math::{DVec3, Number, Real};
+use step::Delta;
 
+mod lanes;
 mod reference;
 mod step;
 
@@ -89,6 +91,7 @@ impl Reference {
         let limit = fractal.iterations;
         let zero = || [0.0; 3].map(|v| big_from_f64(v, bits));
         let anchor_f64 = DVec3::from_array(anchor.each_ref().map(|v| v.to_f64().value()));
+        let anchor = off_the_axis(fractal.formula, anchor, bits);
         let orbit = |start, c: &[Big; 3], limit| {
             let points = reference::orbit(fractal.formula, n, start, c, limit, escape, bits);
             Track::new(fractal, n, &points, bits)
@@ -133,61 +136,102 @@ impl Reference {
         limit: u32,
         stop_at_bailout: bool,
     ) -> Walked<T> {
+        let dc = self.dc(fractal, delta);
+        self.run(fractal, self.start(delta), dc, limit, stop_at_bailout)
+    }
+
+    /// The c offset of the point `delta`: itself in Mandelbrot mode, 0 in Julia mode.
+    #[inline(always)]
+    fn dc<T: Delta>(&self, fractal: &Fractal, delta: Triplex<T>) -> Triplex<T> {
+        match fractal.julia {
+            None => delta,
+            Some(_) => [delta[0].constant(0.0); 3],
+        }
+    }
+
+    /// The orbit of the point `delta` before its first iteration.
+    #[inline(always)]
+    fn start<T: Delta>(&self, delta: Triplex<T>) -> State<T> {
+        let z = add(self.main.z[self.start], delta);
+        State {
+            on_origin: false,
+            m: self.start,
+            d: delta,
+            z,
+            r2: length_squared(z),
+            dr: delta[0].constant(1.0),
+            traps: OrbitTraps {
+                origin: Real::INFINITY,
+                planes: DVec3::splat(Real::INFINITY),
+            },
+            i: 0,
+            rebased: 0,
+        }
+    }
+
+    fn track(&self, on_origin: bool) -> &Track {
+        match on_origin {
+            true => self.critical.as_ref().unwrap_or(&self.main),
+            false => &self.main,
+        }
+    }
+
+    /// Iterates `state` on to `limit` (stopping at the bailout where asked):
+    /// the loop every perturbed orbit ends in, the vector kernel's lanes
+    /// included wherever they need more than the common step.
+    fn run<T: Number>(
+        &self,
+        fractal: &Fractal,
+        mut s: State<T>,
+        dc: Triplex<T>,
+        limit: u32,
+        stop_at_bailout: bool,
+    ) -> Walked<T> {
         let escape = fractal.escape_radius::<T>();
         // The tracks' excesses are over f64's escape radius; f32's may be lower.
         let exact = escape == fractal.escape_radius::<Real>();
-        let zero = T::from_real(0.0);
-        let mandelbrot = fractal.julia.is_none();
-        let dc = if mandelbrot { delta } else { [zero; 3] };
-        let plus_one = T::from_real(if mandelbrot { 1.0 } else { 0.0 });
+        let plus_one = T::from_real(if fractal.julia.is_none() { 1.0 } else { 0.0 });
         let nn = T::from_real(self.n as Real);
-        let origin_track = self.critical.as_ref().unwrap_or(&self.main);
-        let (mut track, mut m, mut d) = (&self.main, self.start, delta);
-        let mut z = add(track.z[m], d);
-        let mut r2 = length_squared(z);
-        let mut dr = T::from_real(1.0);
-        let mut traps = OrbitTraps {
-            origin: Real::INFINITY,
-            planes: DVec3::splat(Real::INFINITY),
-        };
-        let (mut i, mut rebased) = (0, 0);
-        let outside = |track: &Track, m: usize, d: Triplex<T>, r2: T| {
+        let outside = |s: &State<T>| {
             if exact {
-                track.outside(m, d)
+                self.track(s.on_origin).outside(s.m, s.d)
             } else {
-                r2.value() > escape * escape
+                s.r2.value() > escape * escape
             }
         };
-        while i < limit {
-            if stop_at_bailout && outside(track, m, d, r2) {
+        while s.i < limit {
+            if stop_at_bailout && outside(&s) {
                 break;
             }
-            if m + 1 >= track.z.len() || r2.value() < length_squared(d).value() {
-                (track, m, d) = (origin_track, 0, z);
-                rebased += 1;
+            if s.m + 1 >= self.track(s.on_origin).z.len()
+                || s.r2.value() < length_squared(s.d).value()
+            {
+                (s.on_origin, s.m, s.d) = (true, 0, s.z);
+                s.rebased += 1;
             }
-            let zv = DVec3::new(z[0].value(), z[1].value(), z[2].value());
-            traps.origin = traps.origin.min(zv.length_squared());
-            traps.planes = traps.planes.min(zv.abs());
-            let r = r2.sqrt();
-            dr = nn * powi(r, self.n - 1, |a, b| a * b) * dr + plus_one;
-            let difference = match &track.steps[m] {
-                Some(point) => point.power_difference(fractal.formula, d),
-                None => self.plain_difference(fractal, track.z[m], d),
+            let zv = DVec3::new(s.z[0].value(), s.z[1].value(), s.z[2].value());
+            s.traps.origin = s.traps.origin.min(zv.length_squared());
+            s.traps.planes = s.traps.planes.min(zv.abs());
+            let r = s.r2.sqrt();
+            s.dr = nn * powi(r, self.n - 1, |a, b| a * b) * s.dr + plus_one;
+            let track = self.track(s.on_origin);
+            let difference = match &track.steps[s.m] {
+                Some(point) => point.power_difference(fractal.formula, s.d),
+                None => self.plain_difference(fractal, track.z[s.m], s.d),
             };
-            d = [0, 1, 2].map(|k| difference[k] + dc[k]);
-            m += 1;
-            z = add(track.z[m], d);
-            r2 = length_squared(z);
-            i += 1;
+            s.d = [0, 1, 2].map(|k| difference[k] + dc[k]);
+            s.m += 1;
+            s.z = add(track.z[s.m], s.d);
+            s.r2 = length_squared(s.z);
+            s.i += 1;
         }
-        ITERATIONS.with(|count| count.set(count.get() + i as u64));
-        let mut orbit = Orbit::ended(z, r2, r2.sqrt(), dr, traps, i, escape);
-        orbit.escaped = outside(track, m, d, r2);
+        ITERATIONS.with(|count| count.set(count.get() + s.i as u64));
+        let mut orbit = Orbit::ended(s.z, s.r2, s.r2.sqrt(), s.dr, s.traps, s.i, escape);
+        orbit.escaped = outside(&s);
         Walked {
             orbit,
-            delta: d,
-            rebased,
+            delta: s.d,
+            rebased: s.rebased,
         }
     }
 
@@ -212,6 +256,45 @@ impl Reference {
     }
 }
 
+/// `anchor`, or where it lies on the pole axis a point 2⁻⁽ᵇⁱᵗˢ⁻³²⁾ of its
+/// size off it: a reference on the axis keeps its whole orbit there, where
+/// the perturbed step has no azimuth to differ from and falls back to the
+/// plain difference, losing δ. The shift is 2⁻⁶⁴ of a pixel or less
+/// (`crate::deep::bits` keeps 96 bits past the pixel), so points keep their
+/// offsets from the target.
+fn off_the_axis(formula: Formula, mut anchor: [Big; 3], bits: usize) -> [Big; 3] {
+    let equator = match formula {
+        Formula::Quilez => [2, 0],
+        Formula::WhiteNylander | Formula::Asin => [0, 1],
+    };
+    let zero = big_from_f64(0.0, bits);
+    if equator.iter().all(|&k| anchor[k] == zero) {
+        let size = anchor
+            .iter()
+            .map(|v| v.to_f64().value().abs())
+            .fold(0.0, Real::max);
+        let shift = bits as isize - 32;
+        anchor[equator[0]] = big_from_f64(size.max(Real::MIN_POSITIVE), bits) >> shift;
+    }
+    anchor
+}
+
+/// A perturbed orbit being iterated: on which track (the main reference or
+/// the orbit of the origin), where on it, the difference from it, the
+/// point itself and what `OrbitState` keeps.
+#[derive(Clone, Copy)]
+struct State<T> {
+    on_origin: bool,
+    m: usize,
+    d: Triplex<T>,
+    z: Triplex<T>,
+    r2: T,
+    dr: T,
+    traps: OrbitTraps,
+    i: u32,
+    rebased: u32,
+}
+
 /// Where a perturbed orbit ended: the orbit, its last difference from the
 /// reference, and how often it was rebased.
 struct Walked<T> {
@@ -223,11 +306,11 @@ struct Walked<T> {
 }
 
 #[inline(always)]
-fn add<T: Number>(z: Triplex<Real>, d: Triplex<T>) -> Triplex<T> {
+fn add<T: Delta>(z: Triplex<Real>, d: Triplex<T>) -> Triplex<T> {
     [
-        T::from_real(z[0]) + d[0],
-        T::from_real(z[1]) + d[1],
-        T::from_real(z[2]) + d[2],
+        d[0].constant(z[0]) + d[0],
+        d[1].constant(z[1]) + d[1],
+        d[2].constant(z[2]) + d[2],
     ]
 }
 

@@ -9,13 +9,51 @@
 //! (a′ − a)·Σ a′ⁿ⁻¹⁻ʲ·aʲ, and a product's as δa·b′ + a·δb.
 
 use super::super::{Formula, Triplex};
-use crate::math::{Number, Real};
+use crate::math::{Arith, Number, Real, Vector};
+
+/// What the perturbed step computes with: one number of the kernel's types
+/// (f64, f32, dual numbers) or a `Vector` of f64 lanes, alike operation
+/// for operation, so one lane of a vector gets one f64's bits.
+pub(crate) trait Delta: Arith {
+    /// `v` (in every lane).
+    fn constant(self, v: Real) -> Self;
+    /// Lane by lane: `then` where `self` > 0, else `otherwise`.
+    fn positive_or(self, then: Self, otherwise: Self) -> Self;
+}
+
+impl<T: Number> Delta for T {
+    #[inline(always)]
+    fn constant(self, v: Real) -> Self {
+        T::from_real(v)
+    }
+    #[inline(always)]
+    fn positive_or(self, then: Self, otherwise: Self) -> Self {
+        if self.value() > 0.0 {
+            then
+        } else {
+            otherwise
+        }
+    }
+}
+
+impl<S: pulp::Simd> Delta for Vector<S> {
+    #[inline(always)]
+    fn constant(self, v: Real) -> Self {
+        Vector::splat(self.0, v)
+    }
+    #[inline(always)]
+    fn positive_or(self, then: Self, otherwise: Self) -> Self {
+        let simd = self.0;
+        let mask = simd.greater_than_f64s(self.1, simd.splat_f64s(0.0));
+        Vector(simd, simd.select_f64s(mask, then.1, otherwise.1))
+    }
+}
 
 /// A complex number of the kernel's type.
 #[derive(Clone, Copy)]
 pub(super) struct C<T>(pub T, pub T);
 
-impl<T: Number> C<T> {
+impl<T: Delta> C<T> {
     #[inline(always)]
     fn add(self, o: C<T>) -> C<T> {
         C(self.0 + o.0, self.1 + o.1)
@@ -25,8 +63,8 @@ impl<T: Number> C<T> {
         C(self.0 * o.0 - self.1 * o.1, self.0 * o.1 + self.1 * o.0)
     }
     #[inline(always)]
-    fn constant(c: [Real; 2]) -> C<T> {
-        C(T::from_real(c[0]), T::from_real(c[1]))
+    fn constant(like: T, c: [Real; 2]) -> C<T> {
+        C(like.constant(c[0]), like.constant(c[1]))
     }
 }
 
@@ -100,34 +138,32 @@ impl Point {
     }
 
     /// (Z + δ)ⁿ − Zⁿ for this reference point Z.
-    #[inline]
-    pub fn power_difference<T: Number>(&self, formula: Formula, delta: Triplex<T>) -> Triplex<T> {
+    #[inline(always)]
+    pub fn power_difference<T: Delta>(&self, formula: Formula, delta: Triplex<T>) -> Triplex<T> {
         let n = self.q_powers.len() - 1;
+        let like = delta[0];
+        let k = |v: Real| like.constant(v);
         let (d_pole, [d1, d2]) = split(formula, delta);
-        let [e1, e2] = self.equator.map(T::from_real);
-        let rho = T::from_real(self.rho);
+        let [e1, e2] = self.equator.map(k);
+        let rho = k(self.rho);
         // The pixel's distance from the pole axis, and its difference.
         let (w1, w2) = (e1 + d1, e2 + d2);
         let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
-        let two = T::from_real(2.0);
-        let d_rho = (two * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
+        let d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
         // qⁿ's difference.
         let d_q = q_of(formula, d_pole, d_rho);
-        let q_pixel = C::constant(self.q_powers[1]).add(d_q);
+        let q_pixel = C::constant(like, self.q_powers[1]).add(d_q);
         let d_qn = d_q.mul(geometric_sum(q_pixel, &self.q_powers[..n]));
         // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
-        let u = C::<T>::constant(self.u_powers[1]);
-        let d_u = if rho_pixel.value() > 0.0 {
-            C(
-                (d1 - u.0 * d_rho) / rho_pixel,
-                (d2 - u.1 * d_rho) / rho_pixel,
-            )
-        } else {
-            C(T::from_real(0.0), T::from_real(0.0))
-        };
+        let u = C::constant(like, self.u_powers[1]);
+        let zero = k(0.0);
+        let d_u = C(
+            rho_pixel.positive_or((d1 - u.0 * d_rho) / rho_pixel, zero),
+            rho_pixel.positive_or((d2 - u.1 * d_rho) / rho_pixel, zero),
+        );
         let d_un = d_u.mul(geometric_sum(u.add(d_u), &self.u_powers[..n]));
-        let [qc, qs] = self.q_powers[n].map(T::from_real);
-        let un = C::<T>::constant(self.u_powers[n]);
+        let [qc, qs] = self.q_powers[n].map(k);
+        let un = C::constant(like, self.u_powers[n]);
         let un_pixel = un.add(d_un);
         // (radial part) × (azimuthal part), differenced as δa·b′ + a·δb.
         let times_u = |a: T, d_a: T| [d_a * un_pixel.0 + a * d_un.0, d_a * un_pixel.1 + a * d_un.1];
@@ -143,10 +179,11 @@ impl Point {
 /// Σ a′ⁿ⁻¹⁻ʲ·aʲ over j = 0..n given aʲ (`powers`, n of them), by Horner's
 /// rule in a′: (a′ⁿ − aⁿ)/(a′ − a) without the division.
 #[inline(always)]
-fn geometric_sum<T: Number>(a_pixel: C<T>, powers: &[[Real; 2]]) -> C<T> {
-    let mut sum = C::constant(powers[0]);
+fn geometric_sum<T: Delta>(a_pixel: C<T>, powers: &[[Real; 2]]) -> C<T> {
+    let like = a_pixel.0;
+    let mut sum = C::constant(like, powers[0]);
     for &p in &powers[1..] {
-        sum = sum.mul(a_pixel).add(C::constant(p));
+        sum = sum.mul(a_pixel).add(C::constant(like, p));
     }
     sum
 }

@@ -85,64 +85,99 @@ fn directions(count: usize) -> Vec<DVec3> {
         .collect()
 }
 
+/// Compares δ after each step, at 1e-30 from `anchor` along `dir`, with
+/// the difference of the two high-precision orbits (to `tolerance` of δ),
+/// while no rebase has happened; the steps compared.
+fn compare_differences(
+    fractal: &Fractal,
+    anchor: DVec3,
+    dir: DVec3,
+    tolerance: Real,
+    steps: u32,
+) -> u32 {
+    let bits = 256;
+    let reference = Reference::new(fractal, big(anchor, bits), bits).unwrap();
+    let delta = dir * 1e-30;
+    let exact = direct(fractal, anchor, delta, fractal.iterations, bits);
+    let escape = fractal.escape_radius::<Real>();
+    let main: Vec<[Big; 3]> = match fractal.julia {
+        None => {
+            let zero = big(DVec3::ZERO, bits);
+            let mut z = reference::orbit(
+                fractal.formula,
+                8,
+                zero,
+                &big(anchor, bits),
+                fractal.iterations + 1,
+                escape,
+                bits,
+            );
+            z.remove(0);
+            z
+        }
+        Some(k) => reference::orbit(
+            fractal.formula,
+            8,
+            big(anchor, bits),
+            &big(k, bits),
+            fractal.iterations,
+            escape,
+            bits,
+        ),
+    };
+    let mut compared = 0;
+    for k in 1..(exact.len().min(main.len()) as u32).min(steps + 1) {
+        let walked = reference.walk(fractal, delta.to_array(), k, false);
+        if walked.rebased > 0 {
+            break;
+        }
+        let want = [0, 1, 2].map(|i| {
+            (&exact[k as usize][i] - &main[k as usize][i])
+                .to_f64()
+                .value()
+        });
+        let size = DVec3::from_array(want).length();
+        let error = (DVec3::from_array(walked.delta) - DVec3::from_array(want)).length();
+        assert!(
+            error <= tolerance * size,
+            "{:?} julia {:?} step {k}: δ {:?} vs {want:?}",
+            fractal.formula,
+            fractal.julia,
+            walked.delta
+        );
+        compared += 1;
+    }
+    compared
+}
+
 #[test]
 fn perturbed_differences_keep_their_precision_thirty_decades_down() {
-    let bits = 256;
     let mut compared = 0;
     for fractal in fractals() {
         for dir in directions(3) {
             let anchor = surface_point(&fractal, dir + DVec3::new(0.1, 0.2, 0.0));
-            let reference = Reference::new(&fractal, big(anchor, bits), bits).unwrap();
-            let delta = dir * 1e-30;
-            let exact = direct(&fractal, anchor, delta, fractal.iterations, bits);
-            let main: Vec<[Big; 3]> = match fractal.julia {
-                None => {
-                    let mut z = reference::orbit(
-                        fractal.formula,
-                        8,
-                        big(DVec3::ZERO, bits),
-                        &big(anchor, bits),
-                        fractal.iterations + 1,
-                        fractal.escape_radius::<Real>(),
-                        bits,
-                    );
-                    z.remove(0);
-                    z
-                }
-                Some(k) => reference::orbit(
-                    fractal.formula,
-                    8,
-                    big(anchor, bits),
-                    &big(k, bits),
-                    fractal.iterations,
-                    fractal.escape_radius::<Real>(),
-                    bits,
-                ),
-            };
-            for k in 1..exact.len().min(main.len()) as u32 {
-                let walked = reference.walk(&fractal, delta.to_array(), k, false);
-                if walked.rebased > 0 {
-                    break;
-                }
-                let want = [0, 1, 2].map(|i| {
-                    (&exact[k as usize][i] - &main[k as usize][i])
-                        .to_f64()
-                        .value()
-                });
-                let size = DVec3::from_array(want).length();
-                let error = (DVec3::from_array(walked.delta) - DVec3::from_array(want)).length();
-                assert!(
-                    error <= 1e-9 * size,
-                    "{:?} julia {:?} step {k}: δ {:?} vs {want:?}",
-                    fractal.formula,
-                    fractal.julia,
-                    walked.delta
-                );
-                compared += 1;
-            }
+            compared += compare_differences(&fractal, anchor, dir, 1e-9, 1000);
         }
     }
     assert!(compared > 100, "only {compared} steps compared");
+}
+
+#[test]
+fn an_anchor_on_the_pole_axis_keeps_its_precision() {
+    let mut compared = 0;
+    for fractal in fractals().into_iter().filter(|f| f.julia.is_none()) {
+        let pole = match fractal.formula {
+            Formula::Quilez => DVec3::Y,
+            _ => DVec3::Z,
+        };
+        let anchor = surface_point(&fractal, pole);
+        // Near the axis the azimuth multiplies by 8 a step while the
+        // distance from the axis barely grows, so δ's own rounding grows
+        // ~20 times a step there, as any f64 orbit's would: 10 steps.
+        let dir = DVec3::new(0.3, 0.5, -0.8).normalize();
+        compared += compare_differences(&fractal, anchor, dir, 1e-6, 10);
+    }
+    assert_eq!(compared, 30, "steps compared");
 }
 
 #[test]
@@ -216,4 +251,40 @@ fn deep_estimates_match_plain_ones_where_f64_is_exact() {
             assert_eq!(fractal.contains(delta), plain.contains(anchor + delta));
         }
     }
+}
+
+#[test]
+fn lanes_are_bit_identical_to_the_scalar_orbit() {
+    let bits = 160;
+    let mut compared = 0;
+    for mut fractal in fractals() {
+        let anchor = surface_point(&fractal, DVec3::new(0.4, 0.7, 0.5));
+        fractal.deep = Some(Arc::new(
+            Reference::new(&fractal, big(anchor, bits), bits).unwrap(),
+        ));
+        // Offsets from far below a pixel to ones that rebase and escape.
+        let dirs = directions(48);
+        let points: [DVec3; 48] =
+            std::array::from_fn(|i| dirs[i] * 10f64.powi(-(i as i32 % 12) * 3));
+        let scales = [1e-12; 48];
+        for chunk in [&points[..16], &points[16..32], &points[32..]] {
+            let lanes = fractal
+                .estimate_lanes::<16>(chunk.try_into().unwrap(), scales[..16].try_into().unwrap());
+            for (p, lane) in chunk.iter().zip(lanes) {
+                let one = fractal.estimate(*p, 1e-12);
+                assert_eq!(
+                    lane, one,
+                    "{:?} julia {:?} at {p}",
+                    fractal.formula, fractal.julia
+                );
+                compared += 1;
+            }
+        }
+        // A partial register too.
+        let five = fractal.estimate_lanes::<5>(points[..5].try_into().unwrap(), [1e-12; 5]);
+        for (p, lane) in points.iter().zip(five) {
+            assert_eq!(lane, fractal.estimate(*p, 1e-12));
+        }
+    }
+    assert_eq!(compared, 6 * 48);
 }
