@@ -6,7 +6,7 @@
 //! Both do the same operations in the same order, so a lane's orbit is
 //! bit-identical to the scalar one.
 
-use super::super::kernel::{Stored, REGISTER};
+use super::super::kernel::{Stored, REGISTER, VECTOR};
 use super::super::orbit::Orbit;
 use super::super::power::{length_squared, powi};
 use super::super::{Fractal, OrbitTraps};
@@ -28,57 +28,127 @@ impl pulp::WithSimd for Lanes<'_> {
     #[inline(always)]
     fn with_simd<S: pulp::Simd>(self, simd: S) {
         let lanes = S::F64_LANES;
-        for (points, out) in self.points.chunks(lanes).zip(self.out.chunks_mut(lanes)) {
-            register(simd, self.reference, self.fractal, points, out);
+        let (reference, fractal) = (self.reference, self.fractal);
+        // Two registers at a time: their chains of dependent operations are
+        // independent, so the processor overlaps them.
+        for (points, out) in self
+            .points
+            .chunks(2 * lanes)
+            .zip(self.out.chunks_mut(2 * lanes))
+        {
+            let split = points.len().min(lanes);
+            let (first, second) = out.split_at_mut(split);
+            let mut a = Register::start(simd, reference, fractal, &points[..split]);
+            let mut b = Register::start(simd, reference, fractal, &points[split..]);
+            loop {
+                let run_a = a.check(reference, fractal, first);
+                let run_b = b.check(reference, fractal, second);
+                if !(run_a || run_b) {
+                    break;
+                }
+                if run_a {
+                    a.step(reference, fractal);
+                }
+                if run_b {
+                    b.step(reference, fractal);
+                }
+            }
         }
     }
 }
 
-/// One register's worth of `points` (at most `S::F64_LANES`) into `out`.
-#[inline(always)]
-fn register<S: pulp::Simd>(
+/// One register of perturbed orbits on the main reference, and which of
+/// its lanes are still in it.
+struct Register<S: pulp::Simd> {
     simd: S,
-    reference: &Reference,
-    fractal: &Fractal,
-    points: &[DVec3],
-    out: &mut [Orbit<f64>],
-) {
-    let load = |axis: usize| {
-        let mut a = Stored::ZERO;
-        for (k, p) in points.iter().enumerate() {
-            a[k] = p[axis];
-        }
-        Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
-    };
-    let store = |v: Vector<S>| {
+    s: State<Vector<S>>,
+    dc: [Vector<S>; 3],
+    origin: Vector<S>,
+    planes: [Vector<S>; 3],
+    live: [bool; REGISTER],
+    count: usize,
+}
+
+impl<S: pulp::Simd> Register<S> {
+    #[inline(always)]
+    fn splat(&self, v: Real) -> Vector<S> {
+        Vector::splat(self.simd, v)
+    }
+
+    #[inline(always)]
+    fn store(v: Vector<S>) -> Stored {
         let mut a = Stored::ZERO;
         S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
         a
-    };
-    let delta = [load(0), load(1), load(2)];
-    let dc = reference.dc(fractal, delta);
-    let dcs = dc.map(store);
-    let mut s = reference.start(delta);
-    let splat = |v: Real| Vector::splat(simd, v);
-    let (mut origin, mut planes) = (splat(Real::INFINITY), [splat(Real::INFINITY); 3]);
-    let plus_one = splat(if fractal.julia.is_none() { 1.0 } else { 0.0 });
-    let nn = splat(reference.n as Real);
-    let mut live = [false; REGISTER];
-    live[..points.len()].fill(true);
-    let limit = fractal.iterations;
-    let track = &reference.main;
-    loop {
-        // Lanes that need more than the common step leave for the scalar loop.
-        let (d, z, r2, dr) = (s.d.map(store), s.z.map(store), store(s.r2), store(s.dr));
-        let (o, p) = (store(origin), planes.map(store));
+    }
+
+    /// The orbits of `points` (at most a register of them) before iterating.
+    #[inline(always)]
+    fn start(simd: S, reference: &Reference, fractal: &Fractal, points: &[DVec3]) -> Self {
+        let load = |axis: usize| {
+            let mut a = Stored::ZERO;
+            for (k, p) in points.iter().enumerate() {
+                a[k] = p[axis];
+            }
+            Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
+        };
+        let delta = [load(0), load(1), load(2)];
+        let infinity = Vector::splat(simd, Real::INFINITY);
+        let mut live = [false; REGISTER];
+        live[..points.len()].fill(true);
+        Register {
+            simd,
+            s: reference.start(delta),
+            dc: reference.dc(fractal, delta),
+            origin: infinity,
+            planes: [infinity; 3],
+            live,
+            count: points.len(),
+        }
+    }
+
+    /// Sends the lanes that need more than the common step to the scalar
+    /// loop, which writes their orbits to `out`; whether any lane is left.
+    #[inline(always)]
+    fn check(&mut self, reference: &Reference, fractal: &Fractal, out: &mut [Orbit<f64>]) -> bool {
+        if self.count == 0 {
+            return false;
+        }
+        let (simd, s, track) = (self.simd, &self.s, &reference.main);
+        let limit = fractal.iterations;
         let common = s.i < limit && track.steps[s.m].is_some() && s.m + 1 < track.z.len();
-        for k in 0..points.len() {
-            if !live[k] {
+        // `Track::outside` and `Reference::run`'s rebase test, in the register.
+        let leaving = !common || {
+            let z = track.z[s.m];
+            let mut sum = self.splat(track.excess[s.m]);
+            for k in 0..3 {
+                sum = sum + (self.splat(2.0 * z[k]) + s.d[k]) * s.d[k];
+            }
+            let outside = simd.greater_than_f64s(sum.1, self.splat(0.0).1);
+            let rebase = simd.less_than_f64s(s.r2.1, length_squared(s.d).1);
+            let either = simd.or_m64s(outside, rebase);
+            let flags = Self::store(Vector(
+                simd,
+                simd.select_f64s(either, self.splat(1.0).1, self.splat(0.0).1),
+            ));
+            (0..REGISTER).any(|k| self.live[k] && flags[k] > 0.0)
+        };
+        if !leaving {
+            return true;
+        }
+        let store = Self::store;
+        let (d, z, r2, dr) = (s.d.map(store), s.z.map(store), store(s.r2), store(s.dr));
+        let (o, p, dc) = (
+            store(self.origin),
+            self.planes.map(store),
+            self.dc.map(store),
+        );
+        for k in 0..REGISTER {
+            if !self.live[k] {
                 continue;
             }
             let dk = [d[0][k], d[1][k], d[2][k]];
-            let leaves = !common || track.outside(s.m, dk) || r2[k] < length_squared(dk);
-            if leaves {
+            if !common || track.outside(s.m, dk) || r2[k] < length_squared(dk) {
                 let lane = State {
                     d: dk,
                     z: [z[0][k], z[1][k], z[2][k]],
@@ -90,30 +160,38 @@ fn register<S: pulp::Simd>(
                     },
                     ..s.place()
                 };
-                let dck = [dcs[0][k], dcs[1][k], dcs[2][k]];
+                let dck = [dc[0][k], dc[1][k], dc[2][k]];
                 out[k] = reference.run(fractal, lane, dck, limit, true).orbit;
-                live[k] = false;
+                self.live[k] = false;
+                self.count -= 1;
             }
         }
-        if !live.iter().any(|&l| l) {
-            return;
-        }
-        // `Reference::run`'s step, operation for operation.
+        self.count > 0
+    }
+
+    /// `Reference::run`'s step, operation for operation, on every lane.
+    #[inline(always)]
+    fn step(&mut self, reference: &Reference, fractal: &Fractal) {
+        let simd = self.simd;
         let lesser = |a: Vector<S>, b: Vector<S>| {
             Vector(
                 simd,
                 simd.select_f64s(simd.less_than_f64s(a.1, b.1), a.1, b.1),
             )
         };
-        origin = lesser(s.r2, origin);
-        for (plane, zk) in planes.iter_mut().zip(s.z) {
+        let s = &mut self.s;
+        self.origin = lesser(s.r2, self.origin);
+        for (plane, zk) in self.planes.iter_mut().zip(s.z) {
             *plane = lesser(*plane, Vector(simd, simd.abs_f64s(zk.1)));
         }
+        let plus_one = Vector::splat(simd, if fractal.julia.is_none() { 1.0 } else { 0.0 });
+        let nn = Vector::splat(simd, reference.n as Real);
         let r = s.r2.sqrt();
         s.dr = nn * powi(r, reference.n - 1, |a, b| a * b) * s.dr + plus_one;
-        let point = track.steps[s.m].as_ref().expect("checked above");
+        let track = &reference.main;
+        let point = track.steps[s.m].as_ref().expect("checked before the step");
         let difference = point.power_difference(fractal.formula, s.d);
-        s.d = [0, 1, 2].map(|a| difference[a] + dc[a]);
+        s.d = [0, 1, 2].map(|a| difference[a] + self.dc[a]);
         s.m += 1;
         s.z = add(track.z[s.m], s.d);
         s.r2 = length_squared(s.z);
@@ -166,11 +244,11 @@ impl Reference {
         };
         let arch = pulp::Arch::new();
         for ((points, scales), out) in points
-            .chunks(REGISTER)
-            .zip(scales.chunks(REGISTER))
-            .zip(out.chunks_mut(REGISTER))
+            .chunks(VECTOR)
+            .zip(scales.chunks(VECTOR))
+            .zip(out.chunks_mut(VECTOR))
         {
-            let mut orbits = [blank; REGISTER];
+            let mut orbits = [blank; VECTOR];
             arch.dispatch(Lanes {
                 reference: self,
                 fractal,

@@ -16,6 +16,15 @@ fn fractals() -> Vec<Fractal> {
             });
         }
     }
+    // Powers that are not 8: Horner's rule (3) and the product form (4).
+    for (power, formula) in [(3.0, Formula::Quilez), (4.0, Formula::Asin)] {
+        all.push(Fractal {
+            formula,
+            power,
+            iterations: 24,
+            ..Fractal::default()
+        });
+    }
     all
 }
 
@@ -100,12 +109,13 @@ fn compare_differences(
     let delta = dir * 1e-30;
     let exact = direct(fractal, anchor, delta, fractal.iterations, bits);
     let escape = fractal.escape_radius::<Real>();
+    let n = whole_power(fractal.power).unwrap();
     let main: Vec<[Big; 3]> = match fractal.julia {
         None => {
             let zero = big(DVec3::ZERO, bits);
             let mut z = reference::orbit(
                 fractal.formula,
-                8,
+                n,
                 zero,
                 &big(anchor, bits),
                 fractal.iterations + 1,
@@ -117,7 +127,7 @@ fn compare_differences(
         }
         Some(k) => reference::orbit(
             fractal.formula,
-            8,
+            n,
             big(anchor, bits),
             &big(k, bits),
             fractal.iterations,
@@ -177,7 +187,7 @@ fn an_anchor_on_the_pole_axis_keeps_its_precision() {
         let dir = DVec3::new(0.3, 0.5, -0.8).normalize();
         compared += compare_differences(&fractal, anchor, dir, 1e-6, 10);
     }
-    assert_eq!(compared, 30, "steps compared");
+    assert!(compared >= 40, "only {compared} steps compared");
 }
 
 #[test]
@@ -286,5 +296,5 @@ fn lanes_are_bit_identical_to_the_scalar_orbit() {
             assert_eq!(lane, fractal.estimate(*p, 1e-12));
         }
     }
-    assert_eq!(compared, 6 * 48);
+    assert_eq!(compared, 8 * 48);
 }
