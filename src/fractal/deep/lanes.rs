@@ -121,8 +121,8 @@ impl<S: pulp::Simd> Register<S> {
         let leaving = !common || {
             let z = track.z[s.m];
             let mut sum = self.splat(track.excess[s.m]);
-            for k in 0..3 {
-                sum = sum + (self.splat(2.0 * z[k]) + s.d[k]) * s.d[k];
+            for (zk, dk) in z.iter().zip(s.d) {
+                sum = sum + (self.splat(2.0 * zk) + dk) * dk;
             }
             let outside = simd.greater_than_f64s(sum.1, self.splat(0.0).1);
             let rebase = simd.less_than_f64s(s.r2.1, length_squared(s.d).1);
