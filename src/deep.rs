@@ -13,9 +13,11 @@ use crate::scene::Scene;
 use std::sync::Arc;
 
 /// A frame is deep where a pixel at its target is narrower than this share
-/// of the target's coordinates: 2¹⁶ times f64's resolution there, so that
-/// normals (differences of estimates half a pixel apart) keep 4 digits.
-pub const DEEP_BELOW: Real = 1.0 / (1u64 << 36) as Real;
+/// of the target's coordinates: 2²⁶ times f64's resolution there. Orbits
+/// near a repelling fixed point amplify f64's rounding far more than their
+/// pixels' offsets: on `deep_zoom.ron`'s tip f64 frames turn to noise from
+/// 2⁻³⁰, so this keeps a margin of 16 over the worst case seen.
+pub const DEEP_BELOW: Real = 1.0 / (1u64 << 26) as Real;
 
 /// The closest a camera may come to its target: a frame's offsets are f64,
 /// and lengths square them, which leaves f64's range below about 1e-154.
@@ -145,12 +147,21 @@ pub fn digits_for(size: Real, footprint: Real) -> usize {
     (decades.max(0.0).ceil() as usize + 4).max(12)
 }
 
-/// Iterations that resolve detail down to a pixel at the target: about 4
-/// per decade of the target's size over the pixel, and 10 more. The
-/// running derivative of orbits on the surface grows about 10^0.27 times
-/// an iteration (measured on `timelines/deep_zoom.ron`'s target), and the
-/// finest detail an iteration count draws is about 1/derivative.
-pub fn iterations_for(scene: &Scene, height: u32) -> u32 {
-    let decades = (1.0 / resolution(scene, height)).log10().max(0.0);
-    10 + (4.0 * decades).ceil() as u32
+/// Iterations that resolve detail down to a pixel at the target: those
+/// after which the running derivative of the target's own orbit (computed
+/// from its high-precision reference, up to `MOST_ITERATIONS`) passes one
+/// over the pixel's width, since the finest detail an iteration count draws
+/// is about 1/dr. `None` where the orbit escapes first (the target is off
+/// the surface at this depth) or the power is not whole.
+pub fn iterations_for(scene: &Scene, height: u32) -> Option<u32> {
+    let mut probe = scene.fractal.clone();
+    probe.iterations = MOST_ITERATIONS;
+    let bits = bits(scene, height);
+    let c = &scene.camera;
+    let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
+    let reference = Reference::new(&probe, anchor, bits)?;
+    reference.derivative_passes(&probe, 1.0 / footprint(scene, height))
 }
+
+/// How far `iterations_for` looks.
+const MOST_ITERATIONS: u32 = 2000;

@@ -237,11 +237,15 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
         t.width,
         t.height
     );
-    out!(
-        "          frame {last} has {} iterations; about {} resolve its pixels (10 + 4 per decade of the target's size over a pixel)",
-        scene.fractal.iterations,
-        crate::deep::iterations_for(&scene, t.height)
-    );
+    match crate::deep::iterations_for(&scene, t.height) {
+        Some(n) => out!(
+            "          frame {last} has {} iterations; {n} resolve its pixels (where the target's own orbit's derivative passes one over a pixel)",
+            scene.fractal.iterations
+        ),
+        None => out!(
+            "          frame {last}: the target's orbit escapes before its derivative resolves a pixel; put the target on the surface (pick --refine)"
+        ),
+    }
     if crate::fractal::whole_power(scene.fractal.power).is_none() {
         out!("          power {} is not a whole number from 2 to 64: perturbation needs one, so these frames render in f64 and lose their detail", scene.fractal.power);
     }

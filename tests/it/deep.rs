@@ -52,43 +52,74 @@ const SIZE: [u32; 2] = [1920, 1080];
 /// The analytic estimate overstates the distance many times where an orbit
 /// escapes at the iteration limit, as it does just off a surface refined at
 /// that limit: a march steps into the set and bisects back, which a plain
-/// sphere tracer cannot. So the hit is checked against the oracle's
+/// sphere tracer cannot. So each hit is checked against the oracle's
 /// estimate and membership instead: outside at the hit, and either under
-/// the hit threshold there or inside a pixel further, and outside at 64
-/// points on the way from the camera.
-#[test]
-fn deep_hits_agree_with_high_precision_membership() {
-    let outside = |offset: DVec3| deep_oracle::estimate(&oracle(), &digits(), offset.to_array()).2;
-    for distance in [1e-20, 1e-30] {
-        let s = scene(distance);
-        let deep = mandelreel::deep::prepare(&s, SIZE[1]).expect("a deep frame");
-        let camera = deep.camera.frame();
-        for (x, y) in [(960, 540), (700, 300), (1300, 800)] {
-            let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, SIZE[0], SIZE[1]);
-            let hit = march(&ray, &deep.fractal, &deep.quality)
-                .hit
-                .expect("the surface is in view");
-            let footprint = ray.footprint(hit.t);
-            let at = |t: f64| ray.at(t);
-            let place = format!("{distance:e}, pixel ({x}, {y}), hit at {:e}", hit.t);
-            let (estimate, _, escaped) =
-                deep_oracle::estimate(&oracle(), &digits(), at(hit.t).to_array());
-            assert!(escaped, "{place}: inside");
-            // Stopped by the estimate (under half a footprint), or by
-            // bisecting a crossing that is within a footprint.
-            let stopped = estimate < 0.5 * footprint * (1.0 + 1e-9);
-            assert!(
-                stopped || !outside(at(hit.t + footprint)),
-                "{place}: estimate {estimate:e}, outside a pixel on"
-            );
-            for k in 0..64 {
-                assert!(
-                    outside(at(hit.t * k as f64 / 64.0)),
-                    "{place}: inside at {k}/64"
-                );
-            }
+/// the hit threshold there or inside a pixel further, and outside at
+/// `samples` points on the way from the camera.
+fn check_against_the_oracle(
+    s: &Scene,
+    oracle: &OracleFractal,
+    base: &[String; 3],
+    pixels: [(u32, u32); 3],
+    samples: u32,
+) {
+    let outside = |offset: DVec3| deep_oracle::estimate(oracle, base, offset.to_array()).2;
+    let distance = s.camera.relative_position().length();
+    let deep = mandelreel::deep::prepare(s, SIZE[1]).expect("a deep frame");
+    let camera = deep.camera.frame();
+    for (x, y) in pixels {
+        let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, SIZE[0], SIZE[1]);
+        let marched = march(&ray, &deep.fractal, &deep.quality);
+        assert!(!marched.out_of_steps, "pixel ({x}, {y}) ran out of steps");
+        let hit = marched.hit.expect("the surface is in view");
+        let footprint = ray.footprint(hit.t);
+        let at = |t: f64| ray.at(t);
+        let place = format!("{distance:e}, pixel ({x}, {y}), hit at {:e}", hit.t);
+        let (estimate, _, escaped) = deep_oracle::estimate(oracle, base, at(hit.t).to_array());
+        assert!(escaped, "{place}: inside");
+        // Stopped by the estimate (under half a footprint), or by
+        // bisecting a crossing that is within a footprint.
+        let stopped = estimate < 0.5 * footprint * (1.0 + 1e-9);
+        assert!(
+            stopped || !outside(at(hit.t + footprint)),
+            "{place}: estimate {estimate:e}, outside a pixel on"
+        );
+        for k in 0..samples {
+            let t = hit.t * k as f64 / samples as f64;
+            assert!(outside(at(t)), "{place}: inside at {k}/{samples}");
         }
     }
+}
+
+#[test]
+fn deep_hits_agree_with_high_precision_membership() {
+    for distance in [1e-20, 1e-30] {
+        let pixels = [(960, 540), (700, 300), (1300, 800)];
+        check_against_the_oracle(&scene(distance), &oracle(), &digits(), pixels, 64);
+    }
+}
+
+/// The bottom tip of the power-8 bulb (`deep_zoom.ron`'s target), c = −b
+/// with b⁷ = 2, to 120 digits.
+const TIP: &str = "-1.10408951367381233764950538762334472132532660078012416551453246414210632288038098071659828988630200514689715906557993125397";
+
+#[test]
+fn a_few_pixels_a_hundred_decades_down() {
+    let text = format!(
+        "(camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{TIP}\", \"0\"), fov_degrees: 40), fractal: (iterations: 100), quality: (over_relaxation: 1.0, max_steps: 1000))"
+    );
+    let mut s: Scene = ron::from_str(&text).unwrap();
+    let away = (DVec3::new(1.5, -1.3, 1.2) - s.camera.target).normalize();
+    s.camera.offset = Some(away * 1e-100);
+    let oracle = OracleFractal {
+        iterations: 100,
+        bits: 480,
+        ..oracle()
+    };
+    let tip = ["0", TIP, "0"].map(String::from);
+    // On the tip and the crown above it (rays below it pass the tip by,
+    // a fixed share of their distance a step, and run out of steps).
+    check_against_the_oracle(&s, &oracle, &tip, [(960, 540), (900, 420), (1040, 470)], 16);
 }
 
 #[test]

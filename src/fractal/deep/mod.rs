@@ -140,6 +140,25 @@ impl Reference {
         self.run(fractal, self.start(delta), dc, limit, stop_at_bailout)
     }
 
+    /// Iterations after which the running derivative of the anchor's own
+    /// orbit exceeds `value`; `None` if it escapes or ends first.
+    pub fn derivative_passes(&self, fractal: &Fractal, value: Real) -> Option<u32> {
+        let plus_one = if fractal.julia.is_none() { 1.0 } else { 0.0 };
+        let escape2 = fractal.escape_radius::<Real>().powi(2);
+        let mut dr: Real = 1.0;
+        for (i, z) in self.main.z[self.start..].iter().enumerate() {
+            let r2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2];
+            if dr > value {
+                return Some(i as u32);
+            }
+            if r2 > escape2 {
+                return None;
+            }
+            dr = self.n as Real * r2.sqrt().powi(self.n as i32 - 1) * dr + plus_one;
+        }
+        None
+    }
+
     /// The c offset of the point `delta`: itself in Mandelbrot mode, 0 in Julia mode.
     #[inline(always)]
     fn dc<T: Delta>(&self, fractal: &Fractal, delta: Triplex<T>) -> Triplex<T> {
