@@ -7,6 +7,7 @@
 //! render as they always have.
 
 use crate::exact::{big_from_f64, big_point, decimal};
+pub use crate::fractal::deep::Derivative;
 use crate::fractal::deep::Reference;
 use crate::math::{DVec3, Real};
 use crate::scene::Scene;
@@ -22,6 +23,21 @@ pub const DEEP_BELOW: Real = 1.0 / (1u64 << 26) as Real;
 /// The closest a camera may come to its target: a frame's offsets are f64,
 /// and lengths square them, which leaves f64's range below about 1e-154.
 pub const DEEPEST: Real = 1e-150;
+
+/// Steps a deep frame's rays get for each decade of its depth, over
+/// `quality.max_steps`: a ray passing just by a structure steps a fixed
+/// share of its distance from it, so crossing from a pixel's scale to the
+/// bulb's takes steps in proportion to the decades between (`deep_zoom.ron`
+/// needed about 1000 in all at 1e-30, and 4000 at 1e-100).
+const STEPS_PER_DECADE: Real = 40.0;
+
+/// `quality.max_steps` for a deep frame: the scene's own, and
+/// `STEPS_PER_DECADE` for every decade of the target's size over a pixel.
+pub fn max_steps(scene: &Scene, height: u32) -> u32 {
+    let decades = (1.0 / resolution(scene, height)).log10().clamp(0.0, 400.0);
+    let more = (STEPS_PER_DECADE * decades).ceil() as u32;
+    scene.quality.max_steps.saturating_add(more)
+}
 
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;
@@ -95,6 +111,7 @@ fn prepare_sharing(
     };
     let mut deep = scene.clone();
     deep.quality.centre = -reference.anchor;
+    deep.quality.max_steps = max_steps(scene, height);
     deep.camera.position = c.relative_position();
     deep.camera.target = DVec3::ZERO;
     (deep.camera.position_digits, deep.camera.target_digits) = (None, None);
@@ -151,16 +168,16 @@ pub fn digits_for(size: Real, footprint: Real) -> usize {
 /// after which the running derivative of the target's own orbit (computed
 /// from its high-precision reference, up to `MOST_ITERATIONS`) passes one
 /// over the pixel's width, since the finest detail an iteration count draws
-/// is about 1/dr. `None` where the orbit escapes first (the target is off
-/// the surface at this depth) or the power is not whole.
-pub fn iterations_for(scene: &Scene, height: u32) -> Option<u32> {
+/// is about 1/dr; or what the target's orbit does instead. `None` for a
+/// power that is not whole.
+pub fn iterations_for(scene: &Scene, height: u32) -> Option<Derivative> {
     let mut probe = scene.fractal.clone();
     probe.iterations = MOST_ITERATIONS;
     let bits = bits(scene, height);
     let c = &scene.camera;
     let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
     let reference = Reference::new(&probe, anchor, bits)?;
-    reference.derivative_passes(&probe, 1.0 / footprint(scene, height))
+    Some(reference.derivative_passes(&probe, 1.0 / footprint(scene, height)))
 }
 
 /// How far `iterations_for` looks.

@@ -232,19 +232,25 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
     let scene = t.scene_at(last);
     let bits = crate::deep::bits(&scene, t.height);
     out!(
-        "deep:     {} frame(s) ({first}..={last}) are finer than f64 resolves at {}x{}: rendered by perturbation, the deepest from a {bits}-bit reference orbit",
+        "deep:     {} frame(s) ({first}..={last}) are finer than f64 resolves at {}x{}: rendered by perturbation, the deepest from a {bits}-bit reference orbit with up to {} march steps (40 more per decade)",
         deep.len(),
         t.width,
-        t.height
+        t.height,
+        crate::deep::max_steps(&scene, t.height)
     );
+    use crate::deep::Derivative;
+    let has = scene.fractal.iterations;
     match crate::deep::iterations_for(&scene, t.height) {
-        Some(n) => out!(
-            "          frame {last} has {} iterations; {n} resolve its pixels (where the target's own orbit's derivative passes one over a pixel)",
-            scene.fractal.iterations
+        Some(Derivative::Passes(n)) => out!(
+            "          frame {last} has {has} iterations; {n} resolve its pixels (where the target's own orbit's derivative passes one over a pixel)"
         ),
-        None => out!(
-            "          frame {last}: the target's orbit escapes before its derivative resolves a pixel; put the target on the surface (pick --refine)"
+        Some(Derivative::Escapes(n)) => out!(
+            "          frame {last}: the target's orbit escapes after {n} iterations, before it resolves a pixel: the target is off the surface at this depth (pick --refine)"
         ),
+        Some(Derivative::Stays) => out!(
+            "          frame {last}: the target is inside the set (its orbit stays bounded): put it on the surface (pick --refine)"
+        ),
+        None => {}
     }
     if crate::fractal::whole_power(scene.fractal.power).is_none() {
         out!("          power {} is not a whole number from 2 to 64: perturbation needs one, so these frames render in f64 and lose their detail", scene.fractal.power);

@@ -281,3 +281,22 @@ fn digits_that_are_not_a_number_are_refused_at_their_line() {
         "{said}"
     );
 }
+
+/// Rays passing the tip step a fixed share of their distance from it, so
+/// crossing 60 decades takes far more than the 300 steps a scene gets: a
+/// deep frame's rays get 40 more a decade, and none runs out.
+#[test]
+fn deep_frames_take_the_steps_their_depth_needs() {
+    let dir = Dir::new();
+    dir.write(
+        "tip.ron",
+        &format!(
+            "(fps: 1, frames: 1, size: (64, 36), scene: (camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{TIP}\", \"0\"), fov_degrees: 40), fractal: (iterations: 80)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-60)]) }})"
+        ),
+    );
+    let out = dir.ok(&["render", "tip.ron", "--quiet", "--stats"]);
+    let said = crate::util::stderr(&out);
+    assert!(said.contains("(0 out of steps)"), "{said}");
+    let info = stdout(&dir.ok(&["info", "tip.ron"]));
+    assert!(info.contains("with up to 2770 march steps"), "{info}");
+}

@@ -140,23 +140,23 @@ impl Reference {
         self.run(fractal, self.start(delta), dc, limit, stop_at_bailout)
     }
 
-    /// Iterations after which the running derivative of the anchor's own
-    /// orbit exceeds `value`; `None` if it escapes or ends first.
-    pub fn derivative_passes(&self, fractal: &Fractal, value: Real) -> Option<u32> {
+    /// Where the running derivative of the anchor's own orbit exceeds
+    /// `value`, or why it does not.
+    pub fn derivative_passes(&self, fractal: &Fractal, value: Real) -> Derivative {
         let plus_one = if fractal.julia.is_none() { 1.0 } else { 0.0 };
         let escape2 = fractal.escape_radius::<Real>().powi(2);
         let mut dr: Real = 1.0;
         for (i, z) in self.main.z[self.start..].iter().enumerate() {
             let r2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2];
             if dr > value {
-                return Some(i as u32);
+                return Derivative::Passes(i as u32);
             }
             if r2 > escape2 {
-                return None;
+                return Derivative::Escapes(i as u32);
             }
             dr = self.n as Real * r2.sqrt().powi(self.n as i32 - 1) * dr + plus_one;
         }
-        None
+        Derivative::Stays
     }
 
     /// The c offset of the point `delta`: itself in Mandelbrot mode, 0 in Julia mode.
@@ -273,6 +273,17 @@ impl Reference {
         let (a, b) = (power(add(z, d)), power(zt));
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
     }
+}
+
+/// What the anchor's orbit does (`Reference::derivative_passes`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Derivative {
+    /// Its derivative passes the value after this many iterations.
+    Passes(u32),
+    /// It escapes after this many, before its derivative does.
+    Escapes(u32),
+    /// Neither within the reference's iterations: a point inside the set.
+    Stays,
 }
 
 /// `anchor`, or where it lies on the pole axis a point 2⁻⁽ᵇⁱᵗˢ⁻³²⁾ of its
