@@ -92,7 +92,7 @@ impl Precision {
 
 /// Parameters of the fractal for one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(from = "form::FractalForm", into = "form::FractalForm")]
 pub struct Fractal {
     pub formula: Formula,
     /// The exponent n of the triplex power (any real; 8 is the classic bulb).
@@ -103,6 +103,9 @@ pub struct Fractal {
     pub bailout: Real,
     /// `None` for the Mandelbrot mode (z₀ = c = p), `Some(k)` for the Julia set of constant k.
     pub julia: Option<DVec3>,
+    /// The Julia constant's digits where the timeline wrote them as strings:
+    /// a deep frame's reference orbits take the constant from them.
+    pub julia_digits: Option<crate::exact::Digits>,
     /// Distance estimator.
     pub de: DeMethod,
     /// Precision of the estimator's arithmetic.
@@ -110,7 +113,6 @@ pub struct Fractal {
     /// A deep frame's reference (`deep`): points are then offsets from its
     /// anchor. Set for rendering a deep frame (`crate::deep`), never read
     /// from a timeline.
-    #[serde(skip)]
     pub deep: Option<std::sync::Arc<deep::Reference>>,
 }
 
@@ -124,6 +126,7 @@ impl Default for Fractal {
             julia: None,
             de: DeMethod::Analytic,
             precision: Precision::F64,
+            julia_digits: None,
             deep: None,
         }
     }
@@ -188,6 +191,7 @@ pub type Triplex<T> = [T; 3];
 
 pub mod deep;
 mod estimate;
+mod form;
 mod kernel;
 mod orbit;
 mod power;

@@ -323,7 +323,10 @@ pub(super) const FRACTAL: &[Parameter] = &[
         shape: Triple,
         doc: "triple: the Julia-c morph (switches to Julia mode)",
         check: |s| s.fractal.julia.map_or(Ok(()), |k| within(k, MAX_JULIA)),
-        set: |s, v| s.fractal.julia = Some(triple(v)),
+        set: |s, v| {
+            s.fractal.julia = Some(triple(v));
+            s.fractal.julia_digits = None;
+        },
     },
 ];
 

@@ -99,7 +99,7 @@ impl Reference {
         let (main, critical, start) = match fractal.julia {
             None => (orbit(zero(), &anchor, limit + 1), None, 1),
             Some(k) => {
-                let c = k.to_array().map(|v| big_from_f64(v, bits));
+                let c = crate::exact::big_point(k, fractal.julia_digits.as_ref(), bits);
                 let main = orbit(anchor, &c, limit);
                 (main, Some(orbit(zero(), &c, limit)), 0)
             }
