@@ -176,6 +176,9 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
             s.samples_per_pixel = n
         });
     }
+    add("perturbation", "off: f64 alone".into(), &|s| {
+        s.fractal.perturbation = false
+    });
     for precision in [Precision::F64, Precision::F32] {
         for de in DeMethod::ALL {
             add("de", format!("{} {}", de.name(), precision.name()), &|s| {
@@ -407,7 +410,12 @@ pub fn measure(
     height: u32,
     progress: &dyn Fn(usize, usize, &Variant),
 ) -> Report {
-    let all = variants(scene);
+    // Perturbation is a knob only where the frame is deep.
+    let deep = crate::deep::needed(scene, height);
+    let all: Vec<Variant> = variants(scene)
+        .into_iter()
+        .filter(|v| deep || v.knob != "perturbation")
+        .collect();
     let reference = &all[0].scene;
     progress(0, all.len(), &all[0]);
     let started = Instant::now();

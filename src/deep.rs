@@ -89,7 +89,7 @@ fn prepare_sharing(
     height: u32,
     built: &mut Vec<(Scene, usize, Arc<Reference>)>,
 ) -> Option<Scene> {
-    if !needed(scene, height) {
+    if !needed(scene, height) || !scene.fractal.perturbation {
         return None;
     }
     let bits = bits(scene, height);

@@ -42,6 +42,7 @@ impl From<FractalForm> for Fractal {
             de: form.de,
             precision: form.precision,
             deep: None,
+            perturbation: true,
         }
     }
 }

@@ -114,6 +114,9 @@ pub struct Fractal {
     /// anchor. Set for rendering a deep frame (`crate::deep`), never read
     /// from a timeline.
     pub deep: Option<std::sync::Arc<deep::Reference>>,
+    /// Whether a deep frame is rendered by perturbation: false only for the
+    /// accuracy report's row that shows what f64 alone gets there.
+    pub perturbation: bool,
 }
 
 impl Default for Fractal {
@@ -128,6 +131,7 @@ impl Default for Fractal {
             precision: Precision::F64,
             julia_digits: None,
             deep: None,
+            perturbation: true,
         }
     }
 }

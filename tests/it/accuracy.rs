@@ -44,6 +44,8 @@ fn accuracy_writes_csv_table_and_chart() {
         assert!(rows.iter().any(|r| r[0] == knob), "no {knob} rows");
     }
     assert_eq!(rows.iter().filter(|r| r[0] == "de").count(), 9);
+    // Perturbation is a knob of deep frames only (tests/it/deep.rs).
+    assert!(!rows.iter().any(|r| r[0] == "perturbation"));
     // Zero error for the reference against itself.
     for c in [
         "depth_error_mean_px",

@@ -300,3 +300,25 @@ fn deep_frames_take_the_steps_their_depth_needs() {
     let info = stdout(&dir.ok(&["info", "tip.ron"]));
     assert!(info.contains("with up to 2770 march steps"), "{info}");
 }
+
+/// `accuracy` on a deep frame has a row for f64 alone: on the tip at 1e-9
+/// (2⁻³⁴ of its size a pixel, where f64's rounding is amplified into
+/// noise) it is further from the reference than the frame as rendered.
+#[test]
+fn accuracy_shows_what_f64_alone_gets_in_a_deep_frame() {
+    let dir = Dir::new();
+    dir.write(
+        "tip.ron",
+        &format!(
+            "(fps: 1, frames: 1, size: (12, 7), scene: (camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{TIP}\", \"0\"), fov_degrees: 40), fractal: (iterations: 40)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-9)]) }})"
+        ),
+    );
+    dir.ok(&["accuracy", "tip.ron", "--quiet"]);
+    let csv = std::fs::read_to_string(dir.path().join("out/tip/accuracy.csv")).unwrap();
+    let rmse = |knob: &str| -> f64 {
+        let line = csv.lines().find(|l| l.starts_with(knob)).expect(knob);
+        line.split(',').nth(8).unwrap().parse().unwrap()
+    };
+    let (scene, alone) = (rmse("scene,"), rmse("perturbation,off: f64 alone"));
+    assert!(alone > scene, "f64 alone {alone} against {scene}");
+}
