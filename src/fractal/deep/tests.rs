@@ -331,3 +331,38 @@ fn a_julia_constant_written_in_digits_is_the_one_iterated() {
     let change = (a.distance - b.distance).abs() / a.distance;
     assert!(change > 1e-8, "{} vs {}", a.distance, b.distance);
 }
+
+mod properties {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+
+        /// Where anchor + δ is exact in f64 (an anchor of 20 bits, offsets
+        /// of 44), the perturbed estimate is the plain one's, in every
+        /// convention and mode, from far below a pixel to offsets that rebase.
+        #[test]
+        fn the_perturbed_estimate_is_the_direct_one(
+            which in 0usize..8,
+            dir in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+            bits_down in 8i32..40,
+            towards in (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0),
+        ) {
+            let plain = fractals()[which].clone();
+            let towards = DVec3::new(towards.0, towards.1, towards.2);
+            prop_assume!(towards.length() > 0.1);
+            let grid = |v: DVec3, bits: i32| (v * 2f64.powi(bits)).round() / 2f64.powi(bits);
+            let anchor = grid(surface_point(&plain, towards), 20);
+            let dir = DVec3::new(dir.0, dir.1, dir.2);
+            prop_assume!(dir.length() > 0.1);
+            let delta = grid(dir.normalize() * 2f64.powi(-bits_down), 44);
+            let mut deep = plain.clone();
+            deep.deep = Some(Arc::new(Reference::new(&plain, big(anchor, 128), 128).unwrap()));
+            let (a, b) = (deep.estimate(delta, 1e-12), plain.estimate(anchor + delta, 1e-12));
+            prop_assert_eq!(a.escaped, b.escaped);
+            prop_assert_eq!(a.iterations, b.iterations);
+            prop_assert!((a.distance - b.distance).abs() <= 1e-8 * b.distance, "{} vs {}", a.distance, b.distance);
+        }
+    }
+}
