@@ -411,7 +411,8 @@ pub fn measure(
     progress: &dyn Fn(usize, usize, &Variant),
 ) -> Report {
     // Perturbation is a knob only where the frame is deep.
-    let deep = crate::deep::needed(scene, height);
+    let deep = crate::deep::needed(scene, height)
+        && crate::fractal::whole_power(scene.fractal.power).is_some();
     let all: Vec<Variant> = variants(scene)
         .into_iter()
         .filter(|v| deep || v.knob != "perturbation")

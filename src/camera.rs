@@ -52,7 +52,7 @@ impl Default for Camera {
 /// The camera as a timeline writes it: position and target may be numbers
 /// or strings of digits.
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(rename = "Camera", deny_unknown_fields, default)]
 struct CameraForm {
     position: Coordinates,
     target: Coordinates,

@@ -39,6 +39,23 @@ pub fn max_steps(scene: &Scene, height: u32) -> u32 {
     scene.quality.max_steps.saturating_add(more)
 }
 
+/// The march steps the frame of `scene` at `height` rows takes: `max_steps`
+/// where it renders deep (needed, and a whole power), else the scene's own.
+pub fn steps_of(scene: &Scene, height: u32) -> u32 {
+    let perturbed = needed(scene, height)
+        && scene.fractal.perturbation
+        && crate::fractal::whole_power(scene.fractal.power).is_some();
+    if perturbed {
+        max_steps(scene, height)
+    } else {
+        scene.quality.max_steps
+    }
+}
+
+/// The hash a deep frame's file adds to its scene's: what rendering it by
+/// perturbation means changes with it, as `RENDERER_REVISION` does for all.
+pub const DEEP_REVISION: u32 = 1;
+
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;
 

@@ -200,7 +200,7 @@ fn print_cost(t: &Timeline, base: &Scene) -> anyhow::Result<()> {
         None => out!(
             "cost:     not measured: one sample of frame 0 could compute {} orbits of {} \
              iterations (every march to quality.max_steps); render it with --frames 0 --stats",
-            worst_orbits_per_sample(base),
+            worst_orbits_per_sample(&crate::job::probe::deep_steps(base, t.height)),
             base.fractal.iterations
         ),
     }
@@ -229,17 +229,26 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
     let (Some(&first), Some(&last)) = (deep.first(), deep.last()) else {
         return Ok(());
     };
-    let scene = t.scene_at(last);
-    let bits = crate::deep::bits(&scene, t.height);
+    // The deepest: the finest pixel against the target's size.
+    let resolution = |f: &u32| crate::deep::resolution(&t.scene_at(*f), t.height);
+    let deepest = *deep
+        .iter()
+        .min_by(|a, b| resolution(a).total_cmp(&resolution(b)))
+        .unwrap_or(&last);
+    let scene = t.scene_at(deepest);
+    let frames = format!("{} frame(s) ({first}..={last})", deep.len());
+    let size = format!("{}x{}", t.width, t.height);
+    if crate::fractal::whole_power(scene.fractal.power).is_none() {
+        out!("deep:     {frames} are finer than f64 resolves at {size}, but power {} is not a whole number from 2 to 64: perturbation needs one, so they render in f64 and lose their detail", scene.fractal.power);
+        return Ok(());
+    }
     out!(
-        "deep:     {} frame(s) ({first}..={last}) are finer than f64 resolves at {}x{}: rendered by perturbation, the deepest from a {bits}-bit reference orbit with up to {} march steps (40 more per decade)",
-        deep.len(),
-        t.width,
-        t.height,
+        "deep:     {frames} are finer than f64 resolves at {size}: rendered by perturbation, the deepest (frame {deepest}) from a {}-bit reference orbit with up to {} march steps (40 more per decade)",
+        crate::deep::bits(&scene, t.height),
         crate::deep::max_steps(&scene, t.height)
     );
     use crate::deep::Derivative;
-    let has = scene.fractal.iterations;
+    let (has, last) = (scene.fractal.iterations, deepest);
     match crate::deep::iterations_for(&scene, t.height) {
         Some(Derivative::Passes(n)) => out!(
             "          frame {last} has {has} iterations; {n} resolve its pixels (where the target's own orbit's derivative passes one over a pixel)"
@@ -251,9 +260,6 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
             "          frame {last}: the target is inside the set (its orbit stays bounded): put it on the surface (pick --refine)"
         ),
         None => {}
-    }
-    if crate::fractal::whole_power(scene.fractal.power).is_none() {
-        out!("          power {} is not a whole number from 2 to 64: perturbation needs one, so these frames render in f64 and lose their detail", scene.fractal.power);
     }
     Ok(())
 }

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 /// `Fractal`'s serde form, field for field in the same order, so a scene's
 /// JSON (and its hash) is what it was where no digits are written.
 #[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields, default)]
+#[serde(rename = "Fractal", deny_unknown_fields, default)]
 pub(super) struct FractalForm {
     formula: Formula,
     power: Real,

@@ -228,12 +228,18 @@ pub fn out_of_steps_matters(stats: &FrameStats) -> bool {
 /// What to say of `frames`, in each of which 1% or more of the camera rays
 /// ran out of `quality.max_steps`.
 pub fn out_of_steps_warning(frames: &[u32], timeline: &Timeline) -> String {
-    let quality = &timeline.scene_at(frames[0]).quality;
+    let scene = timeline.scene_at(frames[0]);
+    let quality = &scene.quality;
+    let steps = crate::deep::steps_of(&scene, timeline.height);
+    let deeper = if steps > quality.max_steps {
+        " with 40 more a decade of a deep frame's depth"
+    } else {
+        ""
+    };
     format!(
-        "in frame(s) {}, 1% or more of the camera rays ran out of quality.max_steps ({}) and \
+        "in frame(s) {}, 1% or more of the camera rays ran out of quality.max_steps ({steps}{deeper}) and \
          count as hits where they stopped (a false surface in the background): raise max_steps{}",
         ranges(frames),
-        quality.max_steps,
         if quality.fudge < 0.5 {
             format!(", or quality.fudge ({}): a step of a fudge of the estimate needs about 1/fudge times the steps", quality.fudge)
         } else {

@@ -54,7 +54,11 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         width: u32,
         height: u32,
         scenes: &'a [Scene],
+        /// Only in a deep frame's, so that other frames keep their hashes.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        deep: Option<u32>,
     }
+    let deep = scenes.iter().any(|s| crate::deep::needed(s, height));
     let inputs = Inputs {
         renderer: env!("CARGO_PKG_VERSION"),
         revision: crate::RENDERER_REVISION,
@@ -62,6 +66,7 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         width,
         height,
         scenes,
+        deep: deep.then_some(crate::deep::DEEP_REVISION),
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);
