@@ -322,3 +322,28 @@ fn accuracy_shows_what_f64_alone_gets_in_a_deep_frame() {
     let (scene, alone) = (rmse("scene,"), rmse("perturbation,off: f64 alone"));
     assert!(alone > scene, "f64 alone {alone} against {scene}");
 }
+
+/// A deep frame whose rays run out of steps is warned of with the steps it
+/// took, the scene's and those its depth added, not the scene's alone.
+#[test]
+fn the_out_of_steps_warning_names_a_deep_frames_steps() {
+    let dir = Dir::new();
+    dir.write(
+        "tip.ron",
+        &format!(
+            "(fps: 1, frames: 1, size: (48, 27), scene: (camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{TIP}\", \"0\"), fov_degrees: 40), fractal: (iterations: 40), quality: (max_steps: 1, fudge: 0.05)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-9)]) }})"
+        ),
+    );
+    let out = dir.ok(&["render", "tip.ron", "--quiet"]);
+    let said = crate::util::stderr(&out);
+    let steps = stdout(&dir.ok(&["info", "tip.ron"]))
+        .split("with up to ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .expect("info names the steps")
+        .to_string();
+    assert!(
+        said.contains(&format!("quality.max_steps ({steps} with 40 more a decade")),
+        "{said}"
+    );
+}
