@@ -30,7 +30,6 @@ pub struct Orbit<T> {
     pub escaped: bool,
 }
 
-#[cfg(test)]
 impl Orbit<f64> {
     /// A placeholder: where the kernel skips a register of padding, its
     /// lanes keep this (zero iterations, zero orbits).

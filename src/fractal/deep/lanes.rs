@@ -6,7 +6,7 @@
 //! Both do the same operations in the same order, so a lane's orbit is
 //! bit-identical to the scalar one.
 
-use super::super::kernel::{Stored, REGISTER, VECTOR};
+use super::super::kernel::{Register as Kernel, Stored, REGISTER, VECTOR};
 use super::super::orbit::Orbit;
 use super::super::power::{length_squared, powi};
 use super::super::{Fractal, OrbitTraps};
@@ -67,6 +67,10 @@ struct Register<S: pulp::Simd> {
     planes: [Vector<S>; 3],
     live: [bool; REGISTER],
     count: usize,
+    /// 1 in Mandelbrot mode, 0 in Julia mode; and the power: the
+    /// derivative's constants, splatted once.
+    plus_one: Vector<S>,
+    power: Vector<S>,
 }
 
 impl<S: pulp::Simd> Register<S> {
@@ -77,9 +81,7 @@ impl<S: pulp::Simd> Register<S> {
 
     #[inline(always)]
     fn store(v: Vector<S>) -> Stored {
-        let mut a = Stored::ZERO;
-        S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
-        a
+        Kernel::<S>::store(v)
     }
 
     /// The orbits of `points` (at most a register of them) before iterating.
@@ -90,7 +92,7 @@ impl<S: pulp::Simd> Register<S> {
             for (k, p) in points.iter().enumerate() {
                 a[k] = p[axis];
             }
-            Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
+            Kernel::load(simd, &a)
         };
         let delta = [load(0), load(1), load(2)];
         let infinity = Vector::splat(simd, Real::INFINITY);
@@ -104,6 +106,8 @@ impl<S: pulp::Simd> Register<S> {
             planes: [infinity; 3],
             live,
             count: points.len(),
+            plus_one: Vector::splat(simd, if fractal.julia.is_none() { 1.0 } else { 0.0 }),
+            power: Vector::splat(simd, reference.n as Real),
         }
     }
 
@@ -184,10 +188,8 @@ impl<S: pulp::Simd> Register<S> {
         for (plane, zk) in self.planes.iter_mut().zip(s.z) {
             *plane = lesser(*plane, Vector(simd, simd.abs_f64s(zk.1)));
         }
-        let plus_one = Vector::splat(simd, if fractal.julia.is_none() { 1.0 } else { 0.0 });
-        let nn = Vector::splat(simd, reference.n as Real);
         let r = s.r2.sqrt();
-        s.dr = nn * powi(r, reference.n - 1, |a, b| a * b) * s.dr + plus_one;
+        s.dr = self.power * powi(r, reference.n - 1, |a, b| a * b) * s.dr + self.plus_one;
         let track = &reference.main;
         let point = track.steps[s.m].as_ref().expect("checked before the step");
         let difference = point.power_difference(fractal.formula, s.d);
@@ -231,24 +233,13 @@ impl Reference {
         scales: &[Real],
         out: &mut [crate::fractal::Estimate],
     ) {
-        let blank = Orbit {
-            z: [0.0; 3],
-            r: 0.0,
-            dr: 0.0,
-            traps: OrbitTraps {
-                origin: 0.0,
-                planes: DVec3::ZERO,
-            },
-            iterations: 0,
-            escaped: false,
-        };
         let arch = pulp::Arch::new();
         for ((points, scales), out) in points
             .chunks(VECTOR)
             .zip(scales.chunks(VECTOR))
             .zip(out.chunks_mut(VECTOR))
         {
-            let mut orbits = [blank; VECTOR];
+            let mut orbits = [Orbit::IDLE; VECTOR];
             arch.dispatch(Lanes {
                 reference: self,
                 fractal,
