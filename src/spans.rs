@@ -1,11 +1,13 @@
 //! Where a value stands in a RON document, as RON's own parser reads it:
-//! the line and column of the value at a field path, and the field path of
-//! the value at a line and column. Each level is read as `RawValue`s, slices
+//! the line and column of the value at a field path, the field path of the
+//! value at a line and column, and the bytes of a value and of a block's
+//! children (which `timeline::edit` rewrites). Each level is read as `RawValue`s, slices
 //! of the document's text, so comments and same-named fields elsewhere
 //! never match.
 
 use ron::value::RawValue;
 use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
+use std::ops::Range;
 
 /// One step of a field path: `.name`, `[3]` or `["camera.position"]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -148,6 +150,88 @@ pub fn path_at(text: &str, line: usize, column: usize) -> Option<(String, Place)
     }
 }
 
+/// A struct, map, tuple or list as written: its inside, from past the
+/// opening bracket to the closing one, and each child's value.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Block {
+    pub inside: Range<usize>,
+    pub children: Vec<(Step, Range<usize>)>,
+}
+
+/// The bytes of the value at `steps`, without the blanks and comments
+/// around it; `None` where the document does not give it or is not RON.
+pub fn range_at(text: &str, steps: &[Step]) -> Option<Range<usize>> {
+    let raw = raw_at(text, steps)?;
+    let start = start_of(text, raw);
+    Some(start..value_end(text, start)?)
+}
+
+/// The block at `steps` (inside `Some(…)` where it is written so), or
+/// `None` where that value is not a block or not given.
+pub fn block_at(text: &str, steps: &[Step]) -> Option<Block> {
+    let raw = raw_at(text, steps)?;
+    let node = Node::read(raw)?;
+    let mut range = range_at(text, steps)?;
+    if let Some(inner) = inside_some(text, range.clone()) {
+        range = inner;
+    }
+    // A struct's name may stand before its bracket: `Camera(…)`.
+    let open = range.start + text[range.clone()].find(['(', '{', '['])?;
+    let named = |c: char| c.is_alphanumeric() || c == '_' || is_blank(c);
+    let inside = open + 1..range.end - 1;
+    let empty = skip_blank(text, inside.start) >= inside.end;
+    // An enum's variant `Filmic(…)` reads as a leaf: it is no block.
+    if !text[range.start..open].chars().all(named) || (node.children.is_empty() && !empty) {
+        return None;
+    }
+    let children = node
+        .children
+        .into_iter()
+        .map(|(step, raw)| {
+            let start = start_of(text, raw);
+            Some((step, start..value_end(text, start)?))
+        })
+        .collect::<Option<_>>()?;
+    Some(Block { inside, children })
+}
+
+/// The value inside `Some(…)` where `range` is written so.
+pub fn inside_some(text: &str, range: Range<usize>) -> Option<Range<usize>> {
+    let rest = text[range.clone()].strip_prefix("Some")?;
+    let open = range.end - rest.len() + rest.find('(')?;
+    let start = skip_blank(text, open + 1);
+    Some(start..value_end(text, start)?)
+}
+
+/// The raw slice of the value at `steps`.
+fn raw_at<'a>(text: &'a str, steps: &[Step]) -> Option<&'a str> {
+    let mut raw = text;
+    for step in steps {
+        let node = Node::read(raw)?;
+        raw = node.children.into_iter().find(|(s, _)| same(s, step))?.1;
+    }
+    Some(raw)
+}
+
+/// Whether two steps name the same child: a struct's field and a map's
+/// string key are both names.
+fn same(a: &Step, b: &Step) -> bool {
+    match (a, b) {
+        (Step::Index(a), Step::Index(b)) => a == b,
+        (Step::Field(a) | Step::Key(a), Step::Field(b) | Step::Key(b)) => a == b,
+        _ => false,
+    }
+}
+
+/// Where the value starting at `start` ends, as RON reads it.
+fn value_end(text: &str, start: usize) -> Option<usize> {
+    let options =
+        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let mut de = ron::Deserializer::from_str_with_options(&text[start..], &options).ok()?;
+    serde::de::IgnoredAny::deserialize(&mut de).ok()?;
+    Some(text.len() - de.remainder().len())
+}
+
 /// White space as RON skips it (Unicode's pattern white space).
 fn is_blank(c: char) -> bool {
     c.is_whitespace() || matches!(c, '\u{200e}' | '\u{200f}')
@@ -165,12 +249,7 @@ fn deepest(text: &str, wanted: &[Step]) -> Option<(usize, usize)> {
             // Text that is not RON has no places; a leaf has no fields.
             return (depth > 0).then(|| (depth, start_of(text, raw)));
         };
-        let matches = |s: &Step| match (s, step) {
-            (Step::Index(a), Step::Index(b)) => a == b,
-            (Step::Field(a) | Step::Key(a), Step::Field(b) | Step::Key(b)) => a == b,
-            _ => false,
-        };
-        match node.children.into_iter().find(|(s, _)| matches(s)) {
+        match node.children.into_iter().find(|(s, _)| same(s, step)) {
             Some((_, child)) => raw = child,
             None => return Some((depth, start_of(text, raw))),
         }
@@ -185,7 +264,7 @@ fn start_of(text: &str, raw: &str) -> usize {
 }
 
 /// `at` moved past white space and comments.
-fn skip_blank(text: &str, mut at: usize) -> usize {
+pub fn skip_blank(text: &str, mut at: usize) -> usize {
     loop {
         let rest = &text[at..];
         let trimmed = rest.trim_start_matches(is_blank);
@@ -489,6 +568,26 @@ mod tests {
         // A place inside a key's string is not read as a comment.
         let inside = path_at(doc, 1, 35).map(|(path, _)| path);
         assert_eq!(inside.as_deref(), Some("tracks"));
+    }
+
+    #[test]
+    fn ranges_hold_the_value_alone_and_blocks_their_children() {
+        let path = |p: &str| steps(p);
+        let text = |p: &str| range_at(DOC, &path(p)).map(|r| &DOC[r]);
+        assert_eq!(text("fps"), Some("24"));
+        assert_eq!(text("scene.camera.up"), Some("Some((0, 0, 1))"));
+        assert_eq!(text("scene.camera.up[1]"), Some("0"));
+        assert_eq!(text("scene.camera.focus"), None);
+        let up = block_at(DOC, &path("scene.camera.up")).unwrap();
+        assert_eq!(&DOC[up.inside.clone()], "0, 0, 1");
+        assert_eq!(up.children.len(), 3);
+        let tracks = block_at(DOC, &path("tracks")).unwrap();
+        let (key, value) = &tracks.children[0];
+        assert_eq!(key, &Step::Key("camera.fov_degrees".into()));
+        assert!(DOC[value.clone()].starts_with("(keys: [") && DOC[value.clone()].ends_with("])"));
+        assert_eq!(block_at(DOC, &path("fps")), None);
+        let empty = block_at("(a: (), b: Some(Named( /* c */ )))", &path("b")).unwrap();
+        assert_eq!((empty.inside, empty.children), (22..31, vec![]));
     }
 
     #[test]

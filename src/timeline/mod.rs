@@ -8,6 +8,7 @@
 //! spline code; `camera.distance` is interpolated in log space so a zoom
 //! keeps a constant apparent speed over many decades of scale.
 
+pub mod edit;
 mod limits;
 mod messages;
 pub mod parameters;

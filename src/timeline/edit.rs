@@ -1,0 +1,379 @@
+//! Edits of a timeline's RON text that keep everything else as written: a
+//! scene value set, a track's key set, moved or deleted. Each edit finds
+//! its place with RON's own parser (`spans`) and changes only the bytes it
+//! must, so the author's comments, field order and layout survive a save.
+
+use super::parameters::{self, Parameter, Shape};
+use super::{KeyValue, ZOOM_TRACK};
+use crate::math::Real;
+use crate::spans::{self, Block, Step};
+use std::ops::Range;
+
+/// One change a user makes to a timeline.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Edit {
+    /// `scene.<parameter>`: replaced where written, else inserted with any
+    /// block missing around it.
+    SetScene { parameter: String, value: KeyValue },
+    /// The key of `track` at `time`: its value replaced, else a key added
+    /// in time order (and the track, and `tracks`, where absent).
+    SetKey {
+        track: String,
+        time: Real,
+        value: KeyValue,
+    },
+    /// Removes key `index`; removing the last key removes the track.
+    DeleteKey { track: String, index: usize },
+    /// Gives key `index` a new time, moving it to keep the keys in order.
+    MoveKey {
+        track: String,
+        index: usize,
+        time: Real,
+    },
+}
+
+/// Key times closer than this are the same key's.
+const SAME_TIME: Real = 1e-9;
+
+/// Scene fields held as whole numbers: RON refuses `8.5` (or `8.0`) there.
+const WHOLE_NUMBERS: [&str; 2] = ["fractal.iterations", "quality.max_steps"];
+
+/// `text` with `edit` made, or what stops it.
+pub fn apply(text: &str, edit: &Edit) -> Result<String, String> {
+    spans::block_at(text, &[]).ok_or("the text is not a timeline in RON: `( … )`")?;
+    match edit {
+        Edit::SetScene { parameter, value } => set_scene(text, parameter, value),
+        Edit::SetKey { track, time, value } => set_key(text, track, *time, value),
+        Edit::DeleteKey { track, index } => delete_key(text, track, *index),
+        Edit::MoveKey { track, index, time } => move_key(text, track, *index, *time),
+    }
+}
+
+fn set_scene(text: &str, name: &str, value: &KeyValue) -> Result<String, String> {
+    let parameter = parameter(name)?;
+    if parameter.name == ZOOM_TRACK {
+        return Err(format!(
+            "{ZOOM_TRACK} is no scene field: only a track sets it"
+        ));
+    }
+    let written = written(value, parameter)?;
+    if let (true, KeyValue::Number(v)) = (WHOLE_NUMBERS.contains(&name), value) {
+        if v.fract() != 0.0 || !(0.0..=u32::MAX as Real).contains(v) {
+            return Err(format!("scene.{name} is a whole number, got {v}"));
+        }
+    }
+    let mut path = vec![Step::Field("scene".into())];
+    path.extend(name.split('.').map(|field| Step::Field(field.into())));
+    set_field(text, &path, &written)
+}
+
+/// The field at `path` set to `value`: replaced where written (inside its
+/// `Some(…)`), else inserted in the deepest block given, nested in the
+/// blocks missing.
+fn set_field(text: &str, path: &[Step], value: &str) -> Result<String, String> {
+    if let Some(range) = spans::range_at(text, path) {
+        let range = spans::inside_some(text, range.clone()).unwrap_or(range);
+        return Ok(spliced(text, range, value));
+    }
+    let given = (0..path.len())
+        .rev()
+        .find(|&n| spans::range_at(text, &path[..n]).is_some())
+        .unwrap_or(0);
+    let block = spans::block_at(text, &path[..given]).ok_or_else(|| {
+        let path = spans::path_of(&path[..given]);
+        format!("{path} is written as a value, not a block of fields")
+    })?;
+    let mut entry = value.to_string();
+    for (i, step) in path[given..].iter().enumerate().rev() {
+        let Step::Field(name) = step else {
+            return Err(format!("cannot write {}", spans::path_of(path)));
+        };
+        let last = i + given + 1 == path.len();
+        entry = if last {
+            format!("{name}: {entry}")
+        } else {
+            format!("{name}: ({entry})")
+        };
+    }
+    Ok(insert(text, &block, block.children.len(), &entry))
+}
+
+fn set_key(text: &str, track: &str, time: Real, value: &KeyValue) -> Result<String, String> {
+    let value = written(value, parameter(track)?)?;
+    let time_text = key_time_text(time)?;
+    let Some(keys) = keys(text, track)? else {
+        let key = format!("(time: {time_text}, value: {value})");
+        return add_track(text, track, &key);
+    };
+    if let Some(i) = keys.times.iter().position(|t| (t - time).abs() < SAME_TIME) {
+        let range = key_part(text, keys.range(i), "value")?;
+        return Ok(spliced(text, range, &value));
+    }
+    let index = keys.times.iter().filter(|&&t| t < time).count();
+    // Written like the key before it (or after, for a new first key).
+    let key = match keys.block.children.len() {
+        0 => format!("(time: {time_text}, value: {value})"),
+        _ => {
+            let like = keys.range(index.saturating_sub(1));
+            with_parts(text, like, &[("time", &time_text), ("value", &value)])?
+        }
+    };
+    Ok(insert(text, &keys.block, index, &key))
+}
+
+fn delete_key(text: &str, track: &str, index: usize) -> Result<String, String> {
+    let keys = existing_keys(text, track, index)?;
+    if keys.block.children.len() > 1 {
+        return Ok(remove(text, &keys.block, index));
+    }
+    let tracks = spans::block_at(text, &tracks_path()).ok_or("tracks is not a map")?;
+    let entry = tracks
+        .children
+        .iter()
+        .position(|(step, _)| matches!(step, Step::Key(k) | Step::Field(k) if k == track))
+        .ok_or_else(|| format!("there is no track \"{track}\""))?;
+    Ok(remove(text, &tracks, entry))
+}
+
+fn move_key(text: &str, track: &str, index: usize, time: Real) -> Result<String, String> {
+    let keys = existing_keys(text, track, index)?;
+    let time_text = key_time_text(time)?;
+    let others = || keys.times.iter().enumerate().filter(|&(i, _)| i != index);
+    if others().any(|(_, t)| (t - time).abs() < SAME_TIME) {
+        return Err(format!(
+            "track \"{track}\" has a key at time {time} already"
+        ));
+    }
+    let target = others().filter(|&(_, &t)| t < time).count();
+    if target == index {
+        let range = key_part(text, keys.range(index), "time")?;
+        return Ok(spliced(text, range, &time_text));
+    }
+    let key = with_parts(text, keys.range(index), &[("time", &time_text)])?;
+    let without = remove(text, &keys.block, index);
+    let keys = self::keys(&without, track)?.ok_or("the track went missing")?;
+    Ok(insert(&without, &keys.block, target, &key))
+}
+
+/// A track's keys as written, and their times.
+struct Keys {
+    block: Block,
+    times: Vec<Real>,
+}
+
+impl Keys {
+    fn range(&self, index: usize) -> Range<usize> {
+        self.block.children[index].1.clone()
+    }
+}
+
+fn tracks_path() -> Vec<Step> {
+    vec![Step::Field("tracks".into())]
+}
+
+/// The keys of `track`, or `None` where the timeline has no such track.
+fn keys(text: &str, track: &str) -> Result<Option<Keys>, String> {
+    let mut path = tracks_path();
+    path.extend([Step::Key(track.into()), Step::Field("keys".into())]);
+    let Some(block) = spans::block_at(text, &path) else {
+        return match spans::range_at(text, &path[..2]) {
+            Some(_) => Err(format!("track \"{track}\" has no list of keys")),
+            None => Ok(None),
+        };
+    };
+    let times = (0..block.children.len())
+        .map(|i| {
+            let range = key_part(text, block.children[i].1.clone(), "time")?;
+            ron::from_str(&text[range]).map_err(|e| format!("key {i}'s time: {e}"))
+        })
+        .collect::<Result<_, String>>()?;
+    Ok(Some(Keys { block, times }))
+}
+
+/// The keys of a track that exists and has key `index`.
+fn existing_keys(text: &str, track: &str, index: usize) -> Result<Keys, String> {
+    parameter(track)?;
+    let keys = keys(text, track)?.ok_or_else(|| format!("there is no track \"{track}\""))?;
+    let count = keys.times.len();
+    if index >= count {
+        return Err(format!(
+            "track \"{track}\" has {count} keys, no key {index}"
+        ));
+    }
+    Ok(keys)
+}
+
+/// Where field `name` of the key at `key` is written.
+fn key_part(text: &str, key: Range<usize>, name: &str) -> Result<Range<usize>, String> {
+    let within = spans::range_at(&text[key.clone()], &[Step::Field(name.into())])
+        .ok_or_else(|| format!("a key without a {name}: {}", &text[key.clone()]))?;
+    Ok(within.start + key.start..within.end + key.start)
+}
+
+/// The key at `key` written with some fields' values replaced.
+fn with_parts(text: &str, key: Range<usize>, parts: &[(&str, &str)]) -> Result<String, String> {
+    let mut ranges = parts
+        .iter()
+        .map(|&(name, new)| Ok((key_part(text, key.clone(), name)?, new)))
+        .collect::<Result<Vec<_>, String>>()?;
+    ranges.sort_by_key(|(range, _)| std::cmp::Reverse(range.start));
+    let mut written = text[key.clone()].to_string();
+    for (range, new) in ranges {
+        written.replace_range(range.start - key.start..range.end - key.start, new);
+    }
+    Ok(written)
+}
+
+/// A new track with its one key, at the end of `tracks` (made where absent).
+fn add_track(text: &str, track: &str, key: &str) -> Result<String, String> {
+    let entry = format!("\"{track}\": (keys: [{key}])");
+    match spans::block_at(text, &tracks_path()) {
+        Some(tracks) => Ok(insert(text, &tracks, tracks.children.len(), &entry)),
+        None if spans::range_at(text, &tracks_path()).is_some() => {
+            Err("tracks is not a map".into())
+        }
+        None => set_field(text, &tracks_path(), &format!("{{{entry}}}")),
+    }
+}
+
+fn parameter(name: &str) -> Result<&'static Parameter, String> {
+    parameters::find(name).ok_or_else(|| format!("no parameter is named \"{name}\""))
+}
+
+fn key_time_text(time: Real) -> Result<String, String> {
+    if time < 0.0 {
+        return Err(format!("a key's time must be 0 or later, got {time}"));
+    }
+    number(time)
+}
+
+/// A value as RON text, if it has the parameter's shape.
+fn written(value: &KeyValue, parameter: &Parameter) -> Result<String, String> {
+    match (value, parameter.shape) {
+        (KeyValue::Number(v), Shape::Number) => number(*v),
+        (KeyValue::Triple(x, y, z), Shape::Triple) => Ok(format!(
+            "({}, {}, {})",
+            number(*x)?,
+            number(*y)?,
+            number(*z)?
+        )),
+        (_, shape) => Err(format!(
+            "{} takes {} number(s), got {value:?}",
+            parameter.name,
+            shape.components()
+        )),
+    }
+}
+
+/// The shortest text that reads back as `v`: whole numbers without `.0`,
+/// as integer fields need, and exponents for the very large and small.
+fn number(v: Real) -> Result<String, String> {
+    if !v.is_finite() {
+        return Err(format!("{v} is not a finite number"));
+    }
+    Ok(if v.fract() == 0.0 && v.abs() < 1e15 {
+        format!("{v}")
+    } else {
+        format!("{v:?}")
+    })
+}
+
+/// `entry` made child `index` of `block`: on a line of its own, indented
+/// as its neighbour is, where the neighbour stands on its own line.
+fn insert(text: &str, block: &Block, index: usize, entry: &str) -> String {
+    if index > 0 {
+        return insert_after(text, block, index - 1, entry);
+    }
+    if block.children.is_empty() {
+        let at = block.inside.start;
+        return spliced(text, at..at, entry);
+    }
+    let start = entry_start(text, block, 0);
+    let line = line_start(text, start);
+    if text[line..start].trim().is_empty() {
+        spliced(
+            text,
+            line..line,
+            &format!("{}{entry},\n", &text[line..start]),
+        )
+    } else {
+        spliced(text, start..start, &format!("{entry}, "))
+    }
+}
+
+fn insert_after(text: &str, block: &Block, index: usize, entry: &str) -> String {
+    let end = block.children[index].1.end;
+    let comma = comma_after(text, end);
+    let past = comma.map_or(end, |c| c + 1);
+    let rest_of_line = text[past..]
+        .find('\n')
+        .map(|n| (past + n, text[past..past + n].trim()));
+    match (rest_of_line, comma) {
+        (Some((eol, rest)), _) if rest.is_empty() || rest.starts_with("//") => {
+            let line = line_start(text, entry_start(text, block, index));
+            let indent = &text[line..line + text[line..].len() - text[line..].trim_start().len()];
+            let comma_text = if comma.is_some() { "," } else { "" };
+            let with_line = spliced(
+                text,
+                eol + 1..eol + 1,
+                &format!("{indent}{entry}{comma_text}\n"),
+            );
+            match comma {
+                Some(_) => with_line,
+                None => spliced(&with_line, end..end, ","),
+            }
+        }
+        (_, Some(c)) => spliced(text, c + 1..c + 1, &format!(" {entry},")),
+        (_, None) => spliced(text, end..end, &format!(", {entry}")),
+    }
+}
+
+/// `text` without child `index` of `block`: its whole line where it stands
+/// on its own, else the child and its comma.
+fn remove(text: &str, block: &Block, index: usize) -> String {
+    let start = entry_start(text, block, index);
+    let end = block.children[index].1.end;
+    let comma = comma_after(text, end);
+    let past = comma.map_or(end, |c| c + 1);
+    let eol = text[past..].find('\n').map_or(text.len(), |n| past + n);
+    let line = line_start(text, start);
+    let rest = &text[past..eol];
+    if text[line..start].trim().is_empty() && rest.trim().is_empty() {
+        return spliced(text, line..(eol + 1).min(text.len()), "");
+    }
+    match (comma, index) {
+        (None, 1..) => spliced(text, block.children[index - 1].1.end..end, ""),
+        _ => {
+            let spaces = rest.len() - rest.trim_start().len();
+            spliced(text, start..past + spaces, "")
+        }
+    }
+}
+
+/// Where child `index`'s entry starts: its name or key, or the value itself.
+fn entry_start(text: &str, block: &Block, index: usize) -> usize {
+    let from = match index {
+        0 => block.inside.start,
+        _ => {
+            let end = block.children[index - 1].1.end;
+            comma_after(text, end).map_or(end, |c| c + 1)
+        }
+    };
+    spans::skip_blank(text, from)
+}
+
+fn comma_after(text: &str, end: usize) -> Option<usize> {
+    let at = spans::skip_blank(text, end);
+    text[at..].starts_with(',').then_some(at)
+}
+
+fn line_start(text: &str, at: usize) -> usize {
+    text[..at].rfind('\n').map_or(0, |i| i + 1)
+}
+
+fn spliced(text: &str, range: Range<usize>, new: &str) -> String {
+    format!("{}{new}{}", &text[..range.start], &text[range.end..])
+}
+
+#[cfg(test)]
+mod tests;
