@@ -16,6 +16,7 @@ pub mod deep;
 pub mod environment;
 pub mod error;
 pub mod exact;
+pub mod explore;
 pub mod fractal;
 pub mod host;
 pub mod input;

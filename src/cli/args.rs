@@ -197,6 +197,30 @@ pub struct StatusArgs {
 }
 
 #[derive(Debug, clap::Args)]
+pub struct ExploreArgs {
+    /// The RON timeline to explore and edit; none starts a new one, saved
+    /// under a name you give in the page.
+    pub timeline: Option<PathBuf>,
+    /// The address to listen on. Anything but loopback lets other machines
+    /// reach the page (they still need its token).
+    #[arg(long, default_value = "127.0.0.1", value_name = "ADDRESS")]
+    pub bind: std::net::IpAddr,
+    /// The port to listen on; 0 takes any free one.
+    #[arg(long, default_value = "0", value_name = "PORT")]
+    pub port: u16,
+}
+
+impl From<ExploreArgs> for crate::explore::Options {
+    fn from(args: ExploreArgs) -> Self {
+        crate::explore::Options {
+            timeline: args.timeline,
+            bind: args.bind,
+            port: args.port,
+        }
+    }
+}
+
+#[derive(Debug, clap::Args)]
 pub struct PickArgs {
     /// The RON timeline file.
     pub timeline: PathBuf,

@@ -99,81 +99,11 @@ fn print_tracks(t: &Timeline) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The effects enabled, and which stages run per camera sample with their
-/// cost in distance estimates.
+/// The effects enabled, and the render plan (`job::describe`).
 fn print_plan(base: &Scene) -> anyhow::Result<()> {
-    let effects = &base.effects;
-    let enabled = effects.enabled();
-    out!(
-        "effects:  {}",
-        if enabled.is_empty() {
-            "none enabled (baseline shading: Lambert light + ambient, orbit-trap colour)"
-                .to_string()
-        } else {
-            enabled.join(", ")
-        }
-    );
-    // The render plan: which stages run per camera sample, and their cost in
-    // distance estimates relative to marching (about 20 per ray at this size).
-    let cones = match (base.cone_rays(), base.march_alone_reason()) {
-        (1, Some(why)) => format!("each camera ray alone, {why}"),
-        (1, None) => "each camera ray alone".to_string(),
-        (n, _) => {
-            let (columns, rows) = crate::march::cone_block(n);
-            format!("blocks of {columns}×{rows} camera rays share a cone first")
-        }
-    };
-    out!("plan:     per sample: primary march ({cones}); per hit: normal (4 estimates)");
-    if let Some(sh) = &effects.shadows {
-        out!(
-            "          + shadow march towards the light, up to {} estimates per lit hit ({})",
-            sh.max_steps,
-            if sh.softness > 0.0 {
-                format!("soft, k = {}", sh.softness)
-            } else {
-                "hard".into()
-            }
-        );
+    for line in crate::job::describe::plan_lines(base) {
+        out!("{line}");
     }
-    if let Some(ao) = &effects.ambient_occlusion {
-        out!(
-            "          + ambient occlusion, {} estimates per hit",
-            ao.samples
-        );
-    }
-    if effects.specular.is_some() {
-        out!("          + specular highlight (no estimates)");
-    }
-    if effects.fog.is_some() {
-        out!("          + fog over hit distance (no estimates)");
-    }
-    if effects.glow.is_some() {
-        out!("          + glow from each ray's nearest approach (no estimates; its rays march without cones)");
-    }
-    if let Some(pt) = &effects.path_tracing {
-        out!(
-            "          + path tracing per hit: up to {} bounces (Russian roulette from the third), each with a march and a normal, plus a ray to the {}° sun",
-            pt.max_bounces, pt.sun_angle_degrees
-        );
-    }
-    if let Some(m) = &effects.motion_blur {
-        out!(
-            "          + motion blur: each of the {} samples sees the timeline at its own time over {} of the frame interval",
-            base.samples_per_pixel, m.shutter
-        );
-    }
-    let lens = base.camera.frame();
-    if lens.has_lens() {
-        out!(
-            "          + depth of field: thin lens of radius {}, focused at {:.4} (rays from the lens; needs samples_per_pixel of {} or more)",
-            lens.aperture_radius, lens.focus_distance, crate::scene::LENS_SAMPLES
-        );
-    }
-    out!(
-        "          {} sample(s) per pixel: {}x the per-sample work",
-        base.samples_per_pixel,
-        base.samples_per_pixel
-    );
     Ok(())
 }
 

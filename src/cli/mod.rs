@@ -1,5 +1,5 @@
 //! The command line: clap arguments, one file per subcommand (`render`,
-//! `info`, `pick`, `sheet`, `status`, `accuracy`, `bench`) that turns them
+//! `info`, `pick`, `explore`, `sheet`, `status`, `accuracy`, `bench`) that turns them
 //! into a job's request and prints what comes back, and exit codes.
 
 use crate::error::Error;
@@ -42,7 +42,7 @@ mod sheet;
 mod status;
 
 pub use args::{
-    AccuracyArgs, BenchArgs, PickArgs, RenderArgs, SequenceArgs, SheetArgs, StatusArgs,
+    AccuracyArgs, BenchArgs, ExploreArgs, PickArgs, RenderArgs, SequenceArgs, SheetArgs, StatusArgs,
 };
 
 /// Exit status: success.
@@ -82,6 +82,9 @@ pub enum Command {
     },
     /// Print the world-space point that the ray through one pixel hits.
     Pick(PickArgs),
+    /// Fly around a timeline's fractal in the browser and make its keys there:
+    /// starts a local server and prints the page's address.
+    Explore(ExploreArgs),
     /// Tile rendered PNG frames from a folder into one contact-sheet image.
     Sheet(SheetArgs),
     /// Which frames of a sequence are complete, stale, missing or in progress; exit
@@ -121,6 +124,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::render(args),
         Command::Info { timeline } => info::info(&timeline),
         Command::Pick(args) => pick::pick(args),
+        Command::Explore(args) => crate::explore::serve(args.into()),
         Command::Sheet(args) => sheet::sheet(args),
         Command::Status(args) => status::status(args),
         Command::Accuracy(args) => accuracy::accuracy(args),

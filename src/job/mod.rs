@@ -7,6 +7,7 @@
 
 pub mod checkpoint;
 pub mod claim;
+pub mod describe;
 pub mod frames;
 pub mod memory;
 pub mod plan;

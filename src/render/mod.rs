@@ -123,18 +123,40 @@ pub fn render_samples(
     until: u32,
     on_row: &(dyn Fn() + Sync),
 ) {
+    let finished = render_samples_unless(scenes, frame_index, acc, until, on_row, &|| false);
+    debug_assert!(finished);
+}
+
+/// `render_samples`, given up as soon as `stop` says so (checked before
+/// each band): then it returns false and `acc` holds no usable image.
+pub fn render_samples_unless(
+    scenes: &[Scene],
+    frame_index: u32,
+    acc: &mut Accumulation,
+    until: u32,
+    on_row: &(dyn Fn() + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> bool {
     let samples = acc.samples_done..until;
     let frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
+    let stopped = std::sync::atomic::AtomicBool::new(false);
     // One band of rows per task; rayon spreads bands over threads and each
     // pixel depends only on its own samples and its band, so the result is
     // independent of the split.
     let stats = acc
         .bands_mut()
         .enumerate()
-        .map(|(band, sums)| render_band(&frame, band * BAND_ROWS, sums))
+        .map(|(band, sums)| {
+            if stopped.load(std::sync::atomic::Ordering::Relaxed) || stop() {
+                stopped.store(true, std::sync::atomic::Ordering::Relaxed);
+                return FrameStats::default();
+            }
+            render_band(&frame, band * BAND_ROWS, sums)
+        })
         .reduce(FrameStats::default, |a, b| a + b);
     acc.stats = acc.stats + stats;
     acc.samples_done = until;
+    !stopped.into_inner()
 }
 
 #[cfg(test)]

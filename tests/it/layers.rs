@@ -8,6 +8,7 @@ use std::path::Path;
 /// never one of its own layer or above.
 const LAYERS: &[(&str, &[&str])] = &[
     ("commands", &["cli"]),
+    ("explorer", &["explore"]),
     ("benchmark", &["bench"]),
     ("accuracy", &["accuracy"]),
     ("job", &["job"]),

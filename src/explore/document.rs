@@ -1,0 +1,180 @@
+//! The timeline being explored: its text as edited, what its file held
+//! when last read or written, and the files this session may write (the
+//! one it opened, and new ones the user names in the same folder).
+
+use super::Event;
+use crate::timeline::edit::Edit;
+use crate::timeline::Timeline;
+use std::path::{Path, PathBuf};
+
+/// A new timeline's text, where `explore` starts without one.
+const STARTER: &str = include_str!("starter.ron");
+
+pub struct Document {
+    folder: PathBuf,
+    /// Where Save writes; none until a new timeline is named.
+    path: Option<PathBuf>,
+    pub text: String,
+    /// The file's text when last read or written (none for a new timeline).
+    saved: Option<String>,
+    /// Edited here since then.
+    edited: bool,
+    pub timeline: Timeline,
+}
+
+impl Document {
+    /// The timeline at `path`, read and checked as `render` would; or, with
+    /// none, a new one in the current folder.
+    pub fn open(path: Option<&Path>) -> anyhow::Result<Document> {
+        let Some(path) = path else {
+            let name = Path::new("untitled.ron");
+            return Ok(Document {
+                folder: std::env::current_dir()?,
+                path: None,
+                text: STARTER.to_string(),
+                saved: None,
+                edited: false,
+                timeline: Timeline::parse(STARTER, name)?,
+            });
+        };
+        let text = crate::timeline::read_text(path)?;
+        let timeline = Timeline::parse(&text, path)?;
+        let folder = match path.parent() {
+            Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        Ok(Document {
+            folder,
+            path: Some(path.to_path_buf()),
+            saved: Some(text.clone()),
+            edited: false,
+            text,
+            timeline,
+        })
+    }
+
+    /// The file's name, or `untitled.ron` before it has one.
+    pub fn name(&self) -> String {
+        let path = self.path.as_deref().unwrap_or(Path::new("untitled.ron"));
+        path.file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
+    }
+
+    pub fn path(&self) -> Option<&Path> {
+        self.path.as_deref()
+    }
+
+    /// Edits not yet saved, or a new timeline never saved.
+    pub fn dirty(&self) -> bool {
+        self.edited || self.saved.is_none()
+    }
+
+    /// Applies `edits` in turn; all of them take, or none (the first that
+    /// fails, or a result that is not a valid timeline, is the error, placed
+    /// at its line as the command line places it).
+    pub fn edit(&mut self, edits: &[Edit]) -> Result<(), String> {
+        let mut text = self.text.clone();
+        for edit in edits {
+            text = crate::timeline::edit::apply(&text, edit)?;
+        }
+        self.take(text)?;
+        self.edited = true;
+        Ok(())
+    }
+
+    /// `text` in place of the document's, where it is a valid timeline.
+    fn take(&mut self, text: String) -> Result<(), String> {
+        let shown = self.path.clone().unwrap_or_else(|| self.name().into());
+        let timeline = Timeline::parse(&text, &shown).map_err(|e| format!("{e:#}"))?;
+        (self.text, self.timeline) = (text, timeline);
+        Ok(())
+    }
+
+    /// Writes the text to its file, or to `new_name`: a new file in the
+    /// same folder, which becomes the document's file.
+    pub fn save(&mut self, new_name: Option<&str>) -> Result<PathBuf, String> {
+        let path = match new_name {
+            Some(name) => self.create(name)?,
+            None => self
+                .path
+                .clone()
+                .ok_or("a new timeline needs a file name to be saved under")?,
+        };
+        let text = self.text.clone();
+        crate::output::atomic::write_atomic(&path, |writer, temp| {
+            use std::io::Write as _;
+            writer
+                .write_all(text.as_bytes())
+                .map_err(|e| crate::error::Error::io(temp, e))
+        })
+        .map_err(|e| format!("{e:#}"))?;
+        (self.path, self.saved, self.edited) = (Some(path.clone()), Some(text), false);
+        Ok(path)
+    }
+
+    /// A new file `name` in the document's folder, created empty so that no
+    /// other file is ever written over.
+    fn create(&self, name: &str) -> Result<PathBuf, String> {
+        let plain = !name.is_empty()
+            && name.len() <= 200
+            && !name.starts_with('.')
+            && !name.contains(['/', '\\'])
+            && !name.chars().any(char::is_control);
+        if !plain || !name.ends_with(".ron") {
+            return Err(format!(
+                "{name:?}: a new file's name must be a plain file name ending in .ron, in {}",
+                self.folder.display()
+            ));
+        }
+        let path = self.folder.join(name);
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+            .map_err(|e| match e.kind() {
+                std::io::ErrorKind::AlreadyExists => format!(
+                    "{} already exists: explore writes only its own timeline and new files",
+                    path.display()
+                ),
+                _ => format!("cannot create {}: {e}", path.display()),
+            })?;
+        Ok(path)
+    }
+
+    /// Reads the file again, dropping edits not saved.
+    pub fn reload(&mut self) -> Result<(), String> {
+        let path = self
+            .path
+            .clone()
+            .ok_or("a new timeline has no file to reload")?;
+        let text = crate::timeline::read_text(&path).map_err(|e| format!("{e:#}"))?;
+        self.take(text.clone())?;
+        (self.saved, self.edited) = (Some(text), false);
+        Ok(())
+    }
+
+    /// What to tell the page when the file's text is no longer what this
+    /// session last read or wrote: without edits of its own, the document
+    /// takes the file's text in.
+    pub fn check_disk(&mut self) -> Option<Event> {
+        let path = self.path.clone()?;
+        let text = crate::timeline::read_text(&path).ok()?;
+        if Some(&text) == self.saved.as_ref() {
+            return None;
+        }
+        self.saved = Some(text.clone());
+        if self.edited {
+            return Some(Event::File {
+                dirty: true,
+                error: None,
+            });
+        }
+        // An invalid file is shown as its error, and the last valid text
+        // stays what the page renders until the file is mended.
+        let error = self.take(text).err();
+        Some(Event::File {
+            dirty: false,
+            error,
+        })
+    }
+}

@@ -1,0 +1,102 @@
+//! `explore`: a local web page that shows a timeline's frames as they are
+//! changed, and edits the timeline's text. The server answers only its own
+//! page (`guard`); the document and its edits (`document`), a view's scenes
+//! (`view`), progressive renders (`renderer`), the HTTP routes (`routes`)
+//! and the file watch (`watch`) each have a module.
+
+mod document;
+mod guard;
+mod page;
+mod renderer;
+mod routes;
+mod view;
+mod watch;
+
+use std::net::{IpAddr, SocketAddr};
+use std::path::PathBuf;
+use std::sync::Arc;
+
+pub use document::Document;
+
+/// What `mandelreel explore` was asked for.
+pub struct Options {
+    /// The timeline to open; none starts a new one, saved under a name.
+    pub timeline: Option<PathBuf>,
+    pub bind: IpAddr,
+    /// 0: any free port.
+    pub port: u16,
+}
+
+/// Everything the routes share.
+pub struct State {
+    pub token: String,
+    pub address: SocketAddr,
+    pub document: std::sync::Mutex<Document>,
+    pub renders: renderer::Renders,
+    pub events: tokio::sync::broadcast::Sender<Event>,
+}
+
+/// What the page is told without asking (server-sent events).
+#[derive(Clone, Debug, serde::Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum Event {
+    /// The file changed on disk: taken in (`dirty` false), or kept apart
+    /// from edits not yet saved (`dirty` true).
+    File { dirty: bool, error: Option<String> },
+    /// Rows done of the render in progress.
+    Progress { done: u32, of: u32 },
+}
+
+/// Opens the timeline, listens, prints the page's address, and serves
+/// until Ctrl-C.
+pub fn serve(options: Options) -> anyhow::Result<()> {
+    let document = Document::open(options.timeline.as_deref())?;
+    let runtime = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()?;
+    runtime.block_on(async move {
+        let listener = tokio::net::TcpListener::bind((options.bind, options.port))
+            .await
+            .map_err(|e| {
+                anyhow::anyhow!("cannot listen on {}:{}: {e}", options.bind, options.port)
+            })?;
+        let address = listener.local_addr()?;
+        let state = Arc::new(State {
+            token: guard::new_token()?,
+            address,
+            document: std::sync::Mutex::new(document),
+            renders: renderer::Renders::default(),
+            events: tokio::sync::broadcast::channel(64).0,
+        });
+        announce(&state)?;
+        tokio::spawn(watch::watch(state.clone()));
+        axum::serve(listener, routes::router(state))
+            .with_graceful_shutdown(async {
+                let _ = tokio::signal::ctrl_c().await;
+            })
+            .await?;
+        Ok(())
+    })
+}
+
+/// The address to open, on standard output (a script reads it from there).
+fn announce(state: &State) -> anyhow::Result<()> {
+    use std::io::Write as _;
+    let name = state.document.lock().expect("document").name();
+    let host = match state.address.ip() {
+        ip if ip.is_unspecified() => "127.0.0.1".to_string(),
+        IpAddr::V6(ip) => format!("[{ip}]"),
+        ip => ip.to_string(),
+    };
+    let url = format!(
+        "http://{host}:{}/?token={}",
+        state.address.port(),
+        state.token
+    );
+    let mut out = std::io::stdout();
+    writeln!(out, "Exploring {name}: open {url}")?;
+    writeln!(out, "(Ctrl-C stops the server; edits not saved are lost.)")?;
+    out.flush()?;
+    Ok(())
+}

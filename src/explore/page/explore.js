@@ -1,0 +1,605 @@
+// mandelreel explore: the page. It holds the view (a frame, and values the
+// user changed but has not keyed) and asks the server for renders, picks
+// and edits; the timeline's text lives on the server.
+"use strict";
+
+const TOKEN = document.querySelector('meta[name="token"]').content;
+const $ = (id) => document.getElementById(id);
+
+const page = {
+  state: null,          // the timeline as the server shows it (/api/state)
+  values: {},           // every parameter's value at this frame
+  frame: 0,
+  overrides: {},        // parameter -> numbers, laid over the tracks' values
+  selected: null,       // {track, index} of the selected key
+  serial: 0,            // the latest view asked for; older renders are dropped
+  dragging: false,
+  playing: false,
+  playCache: new Map(), // frame -> blob URL of its playback frame
+  pickCache: null,      // {x, y, serial, hit} for a burst of wheel events
+};
+
+// ---- talking to the server ------------------------------------------------
+
+async function api(path, body) {
+  const init = { headers: { "x-mandelreel-token": TOKEN } };
+  if (body !== undefined) {
+    init.method = "POST";
+    init.headers["content-type"] = "application/json";
+    init.body = JSON.stringify(body);
+  }
+  const response = await fetch(path, init);
+  if (!response.ok) {
+    const error = new Error(await response.text());
+    error.status = response.status;
+    throw error;
+  }
+  return response;
+}
+
+function currentView(withOverrides = true) {
+  const view = { frame: page.frame, overrides: withOverrides ? page.overrides : {} };
+  const size = $("size").value.trim();
+  if (size) view.size = size;
+  const samples = parseInt($("samples").value, 10);
+  if (samples > 0) view.samples = samples;
+  return view;
+}
+
+function say(text) { $("message").textContent = text; }
+
+function alertShown(text) {
+  $("alert").textContent = text || "";
+  $("alert").hidden = !text;
+}
+
+// ---- the timeline ---------------------------------------------------------
+
+async function loadState(state) {
+  page.state = state || await (await api("/api/state")).json();
+  page.playCache.clear();
+  const s = page.state;
+  $("name").textContent = s.name;
+  $("dirty").hidden = !s.dirty;
+  $("frame").max = $("slider").max = s.frames - 1;
+  if (page.frame > s.frames - 1) page.frame = s.frames - 1;
+  $("plan").textContent = s.plan.join("\n");
+  $("command").textContent = s.command;
+  $("text").textContent = s.text;
+  if (page.selected && !trackNamed(page.selected.track)) page.selected = null;
+  buildControls();
+  await showFrame(page.frame);
+}
+
+function trackNamed(name) { return page.state.tracks.find((t) => t.name === name); }
+
+async function showFrame(frame) {
+  page.frame = Math.max(0, Math.min(page.state.frames - 1, frame | 0));
+  $("frame").value = $("slider").value = page.frame;
+  $("time").textContent = `t = ${(page.frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
+  page.values = await (await api(`/api/values?frame=${page.frame}`)).json();
+  drawStrip();
+  fillControls();
+  refresh();
+}
+
+// ---- rendering, progressively ----------------------------------------------
+
+// Renders the view in stages, each shown as it arrives; a newer view
+// makes the server give up this one's stages.
+async function refresh() {
+  const serial = ++page.serial;
+  const view = currentView();
+  showChanges();
+  try {
+    let shown = await stage(view, "quick", null, serial);
+    if (!shown || page.dragging) return;
+    if ((view.samples || page.state.samples) > 1) {
+      const full = await stage(view, "full", shown.generation, serial);
+      if (!full) return;
+    }
+    await stage(view, "final", shown.generation, serial);
+  } catch (error) {
+    if (serial === page.serial) alertShown(error.message);
+  }
+}
+
+async function stage(view, name, generation, serial) {
+  if (serial !== page.serial) return null;
+  let response;
+  try {
+    response = await api("/api/render", { view, stage: name, generation });
+  } catch (error) {
+    if (error.status === 409) return null;  // a newer view took over
+    throw error;
+  }
+  const blob = await response.blob();
+  if (serial !== page.serial || page.playing) return null;
+  const img = $("view");
+  const old = img.src;
+  img.src = URL.createObjectURL(blob);
+  if (old.startsWith("blob:")) URL.revokeObjectURL(old);
+  const size = response.headers.get("x-size");
+  const samples = response.headers.get("x-samples");
+  const seconds = response.headers.get("x-seconds");
+  img.dataset.stage = name;
+  img.dataset.frame = view.frame;
+  img.dataset.size = size;
+  $("overlay").textContent = `frame ${view.frame} · ${name} · ${size} · ${samples} sample(s) · ${seconds} s`;
+  if (name === "final") { $("progress").value = 1; alertShown(""); }
+  return { generation: Number(response.headers.get("x-generation")) };
+}
+
+// While a drag or the wheel moves the view, only quick stages are asked for,
+// one at a time: the newest view when the last one comes back.
+let moving = null;
+function refreshSoon() {
+  if (moving) { moving.again = true; return; }
+  moving = { again: false };
+  const serial = ++page.serial;
+  showChanges();
+  stage(currentView(), "quick", null, serial)
+    .catch((error) => alertShown(error.message))
+    .finally(() => {
+      const again = moving.again;
+      moving = null;
+      if (again) refreshSoon();
+      else if (!page.dragging) refresh();
+    });
+}
+
+// ---- the camera -------------------------------------------------------------
+
+const sub = (a, b) => a.map((v, i) => v - b[i]);
+const add = (a, b) => a.map((v, i) => v + b[i]);
+const scale = (a, k) => a.map((v) => v * k);
+const dot = (a, b) => a.reduce((s, v, i) => s + v * b[i], 0);
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const norm = (a) => scale(a, 1 / Math.hypot(...a));
+
+function value(name) { return page.overrides[name] || page.values[name]; }
+
+function change(name, numbers) {
+  page.overrides[name] = numbers.map((v) => Number(v.toPrecision(15)));
+}
+
+// Rodrigues' rotation of v about unit axis k.
+function rotate(v, k, angle) {
+  const c = Math.cos(angle), s = Math.sin(angle);
+  return add(add(scale(v, c), scale(cross(k, v), s)), scale(k, dot(k, v) * (1 - c)));
+}
+
+function orbit(dx, dy) {
+  const target = value("camera.target");
+  const up = norm(value("camera.up"));
+  let away = sub(value("camera.position"), target);
+  away = rotate(away, up, -dx * 0.008);
+  const right = norm(cross(up, away));
+  const turned = rotate(away, right, -dy * 0.008);
+  // Not over the pole: the view would flip about the up direction.
+  if (Math.abs(dot(norm(turned), up)) < 0.995) away = turned;
+  change("camera.position", add(target, away));
+}
+
+// Moves the camera and target towards `point` by `factor` (< 1 is closer):
+// the point stays where it is in the frame.
+function zoomAbout(point, factor) {
+  change("camera.position", add(point, scale(sub(value("camera.position"), point), factor)));
+  if (point !== value("camera.target")) {
+    change("camera.target", add(point, scale(sub(value("camera.target"), point), factor)));
+  }
+}
+
+function roll(degrees) {
+  change("camera.roll_degrees", [(value("camera.roll_degrees") || [0])[0] + degrees]);
+}
+
+// The view's pixel under a pointer event.
+function pixelAt(event) {
+  const img = $("view");
+  const rect = img.getBoundingClientRect();
+  const [w, h] = viewSize();
+  // The image keeps its aspect inside the element (object-fit: contain).
+  const k = Math.min(rect.width / w, rect.height / h);
+  const x = (event.clientX - rect.left - (rect.width - w * k) / 2) / k;
+  const y = (event.clientY - rect.top - (rect.height - h * k) / 2) / k;
+  if (x < 0 || y < 0 || x >= w || y >= h) return null;
+  return [Math.floor(x), Math.floor(y)];
+}
+
+function viewSize() {
+  const size = $("size").value.trim().split(/[xX]/).map(Number);
+  if (size.length === 2 && size[0] > 0 && size[1] > 0) return size;
+  return [page.state.width, page.state.height];
+}
+
+async function pickAt(pixel) {
+  const response = await api("/api/pick", { view: currentView(), x: pixel[0], y: pixel[1] });
+  const report = await response.json();
+  return report.point || null;
+}
+
+// ---- pointer, wheel and keys -------------------------------------------------
+
+function setUpViewport() {
+  const viewport = $("viewport");
+  let down = null;
+  viewport.addEventListener("pointerdown", (event) => {
+    if (event.button !== 0) return;
+    viewport.setPointerCapture(event.pointerId);
+    down = { x: event.clientX, y: event.clientY, moved: false, event };
+  });
+  viewport.addEventListener("pointermove", (event) => {
+    if (!down) return;
+    const dx = event.clientX - down.x, dy = event.clientY - down.y;
+    if (!down.moved && Math.hypot(dx, dy) < 4) return;
+    down.moved = true;
+    page.dragging = true;
+    viewport.classList.add("dragging");
+    orbit(dx, dy);
+    down.x = event.clientX;
+    down.y = event.clientY;
+    refreshSoon();
+  });
+  viewport.addEventListener("pointerup", async (event) => {
+    const was = down;
+    down = null;
+    viewport.classList.remove("dragging");
+    if (!was) return;
+    if (was.moved) {
+      page.dragging = false;
+      if (!moving) refresh();
+      return;
+    }
+    const pixel = pixelAt(event);
+    if (!pixel) return;
+    try {
+      const hit = await pickAt(pixel);
+      if (!hit) { say("That pixel sees no surface."); return; }
+      change("camera.target", hit);
+      say(`Aimed at (${hit.map((v) => v.toPrecision(8)).join(", ")}).`);
+      refresh();
+    } catch (error) { alertShown(error.message); }
+  });
+  viewport.addEventListener("wheel", async (event) => {
+    event.preventDefault();
+    const factor = Math.exp(Math.max(-1, Math.min(1, event.deltaY * 0.0015)));
+    const pixel = pixelAt(event);
+    let point = value("camera.target");
+    if (pixel) {
+      const cached = page.pickCache;
+      if (cached && cached.x === pixel[0] && cached.y === pixel[1] && performance.now() - cached.at < 400) {
+        point = cached.hit || point;
+      } else {
+        try {
+          const hit = await pickAt(pixel);
+          page.pickCache = { x: pixel[0], y: pixel[1], hit, at: performance.now() };
+          point = hit || point;
+        } catch (error) { alertShown(error.message); return; }
+      }
+      page.pickCache.at = performance.now();
+    }
+    zoomAbout(point, factor);
+    refreshSoon();
+  }, { passive: false });
+}
+
+function setUpKeys() {
+  document.addEventListener("keydown", (event) => {
+    if (event.ctrlKey && event.key === "s") { event.preventDefault(); save(null); return; }
+    const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement.tagName);
+    if (typing || event.ctrlKey || event.metaKey || event.altKey) return;
+    const actions = {
+      ArrowLeft: () => { orbit(-20, 0); refreshSoon(); },
+      ArrowRight: () => { orbit(20, 0); refreshSoon(); },
+      ArrowUp: () => { orbit(0, -20); refreshSoon(); },
+      ArrowDown: () => { orbit(0, 20); refreshSoon(); },
+      w: () => { zoomAbout(value("camera.target"), 0.8); refreshSoon(); },
+      s: () => { zoomAbout(value("camera.target"), 1.25); refreshSoon(); },
+      q: () => { roll(5); refreshSoon(); },
+      e: () => { roll(-5); refreshSoon(); },
+      ",": () => showFrame(page.frame - 1),
+      ".": () => showFrame(page.frame + 1),
+      " ": () => togglePlay(),
+      k: () => keyChanges(),
+      m: () => moveSelected(),
+      Delete: () => deleteSelected(),
+      Escape: () => discard(),
+    };
+    const action = actions[event.key];
+    if (action && !(event.key === " " && document.activeElement.tagName === "BUTTON")) {
+      event.preventDefault();
+      action();
+    }
+  });
+}
+
+// ---- changes and keys ---------------------------------------------------------
+
+function changedNames() { return Object.keys(page.overrides); }
+
+function showChanges() {
+  const names = changedNames();
+  $("changed").textContent = names.length
+    ? "Changed: " + names.map((n) => `${n} = ${format(page.overrides[n])}`).join("; ")
+    : "No changes at this frame.";
+  for (const id of ["key", "set-scene", "discard"]) $(id).disabled = names.length === 0;
+}
+
+function format(numbers) {
+  if (!numbers) return "off";
+  const shown = numbers.map((v) => Number(v.toPrecision(6)));
+  return shown.length === 1 ? String(shown[0]) : `(${shown.join(", ")})`;
+}
+
+// The changes as keys at this frame's time. A zoom track places the camera
+// by its distance, so a moved camera keys that distance too.
+function changeKeys() {
+  const time = page.frame / page.state.fps;
+  const values = { ...page.overrides };
+  if (trackNamed("camera.distance") && (values["camera.position"] || values["camera.target"])) {
+    values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
+  }
+  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
+}
+
+async function edit(edits, done) {
+  try {
+    const state = await (await api("/api/edit", { edits })).json();
+    alertShown("");
+    say(done);
+    page.overrides = {};
+    await loadState(state);
+  } catch (error) {
+    alertShown(error.message);
+  }
+}
+
+function keyChanges() {
+  if (!changedNames().length) { say("Nothing changed to key."); return; }
+  edit(changeKeys(), `Keyed ${changedNames().join(", ")} at frame ${page.frame}.`);
+}
+
+function setInScene() {
+  if (!changedNames().length) return;
+  const edits = Object.entries(page.overrides).map(([parameter, v]) => ({ kind: "set_scene", parameter, value: v }));
+  edit(edits, `Set ${changedNames().join(", ")} in the scene.`);
+}
+
+function discard() {
+  page.overrides = {};
+  fillControls();
+  refresh();
+}
+
+function moveSelected() {
+  const s = page.selected;
+  if (!s) { say("Select a key first."); return; }
+  edit([{ kind: "move_key", track: s.track, index: s.index, time: page.frame / page.state.fps }],
+    `Moved the key of ${s.track} to frame ${page.frame}.`);
+}
+
+function deleteSelected() {
+  const s = page.selected;
+  if (!s) { say("Select a key first."); return; }
+  page.selected = null;
+  edit([{ kind: "delete_key", track: s.track, index: s.index }], `Deleted a key of ${s.track}.`);
+}
+
+// ---- the strip of tracks ------------------------------------------------------------
+
+function drawStrip() {
+  const strip = $("strip");
+  strip.textContent = "";
+  const duration = Math.max(page.state.frames - 1, 1) / page.state.fps;
+  const at = (time) => `${Math.max(0, Math.min(100, (time / duration) * 100))}%`;
+  if (!page.state.tracks.length) {
+    strip.textContent = "No tracks yet: change a value and press Key changes.";
+    return;
+  }
+  for (const track of page.state.tracks) {
+    const row = document.createElement("div");
+    row.className = "track";
+    const label = document.createElement("span");
+    label.className = "label";
+    label.textContent = `${track.name} (${track.interpolation})`;
+    label.title = label.textContent;
+    const lane = document.createElement("div");
+    lane.className = "lane";
+    const cursor = document.createElement("div");
+    cursor.className = "cursor";
+    cursor.style.left = at(page.frame / page.state.fps);
+    lane.append(cursor);
+    track.keys.forEach((key, index) => {
+      const mark = document.createElement("button");
+      mark.className = "keymark";
+      const selected = page.selected && page.selected.track === track.name && page.selected.index === index;
+      if (selected) mark.classList.add("selected");
+      mark.style.left = at(key.time);
+      mark.title = `${track.name} at ${key.time} s: ${format(key.value)}`;
+      mark.setAttribute("aria-label", mark.title);
+      mark.dataset.track = track.name;
+      mark.dataset.index = index;
+      mark.addEventListener("click", () => {
+        page.selected = { track: track.name, index };
+        $("selected").textContent = `Selected: ${mark.title}`;
+        showFrame(Math.round(key.time * page.state.fps));
+      });
+      lane.append(mark);
+    });
+    row.append(label, lane);
+    strip.append(row);
+  }
+}
+
+// ---- the parameters -----------------------------------------------------------------
+
+function buildControls() {
+  const box = $("controls");
+  for (const old of box.querySelectorAll(".group")) old.remove();
+  const groups = new Map();
+  for (const [name, components] of page.state.parameters) {
+    const group = name.split(".")[0];
+    if (!groups.has(group)) {
+      const section = document.createElement("div");
+      section.className = "group";
+      const title = document.createElement("h2");
+      title.textContent = group;
+      section.append(title);
+      groups.set(group, section);
+      box.append(section);
+    }
+    const row = document.createElement("div");
+    row.className = "param";
+    row.dataset.name = name;
+    const label = document.createElement("label");
+    label.textContent = name.slice(group.length + 1);
+    label.title = name;
+    row.append(label);
+    for (let i = 0; i < components; i++) {
+      const input = document.createElement("input");
+      input.type = "number";
+      input.step = "any";
+      input.setAttribute("aria-label", components > 1 ? `${name} ${"xyz"[i]}` : name);
+      input.addEventListener("change", () => changeFromControl(row, name));
+      row.append(input);
+    }
+    groups.get(group).append(row);
+  }
+}
+
+function fillControls() {
+  for (const row of document.querySelectorAll(".param")) {
+    const name = row.dataset.name;
+    const numbers = page.overrides[name] || page.values[name];
+    row.classList.toggle("changed", name in page.overrides);
+    row.querySelectorAll("input").forEach((input, i) => {
+      input.value = numbers ? Number(numbers[i].toPrecision(10)) : "";
+      input.placeholder = numbers ? "" : "off";
+    });
+  }
+}
+
+function changeFromControl(row, name) {
+  const numbers = [...row.querySelectorAll("input")].map((input) => parseFloat(input.value));
+  if (numbers.some((v) => !Number.isFinite(v))) { say(`${name}: every field needs a number.`); return; }
+  page.overrides[name] = numbers;
+  row.classList.add("changed");
+  refresh();
+}
+
+// ---- playback -----------------------------------------------------------------------
+
+async function togglePlay() {
+  if (page.playing) { page.playing = false; $("play").textContent = "Play"; refresh(); return; }
+  page.playing = true;
+  $("play").textContent = "Stop";
+  const version = page.state;
+  let frame = page.frame;
+  while (page.playing && page.state === version) {
+    const started = performance.now();
+    let url = page.playCache.get(frame);
+    if (!url) {
+      try {
+        const response = await api("/api/render", { view: { ...currentView(false), frame }, stage: "play" });
+        url = URL.createObjectURL(await response.blob());
+        page.playCache.set(frame, url);
+      } catch (error) { alertShown(error.message); break; }
+    }
+    if (!page.playing) break;
+    $("view").src = url;
+    $("view").dataset.stage = "play";
+    $("frame").value = $("slider").value = frame;
+    $("overlay").textContent = `playing frame ${frame}`;
+    const wait = 1000 / page.state.fps - (performance.now() - started);
+    if (wait > 0) await new Promise((r) => setTimeout(r, wait));
+    frame = (frame + 1) % page.state.frames;
+  }
+  page.playing = false;
+  $("play").textContent = "Play";
+  page.frame = frame;
+}
+
+// ---- saving and the file -------------------------------------------------------------
+
+async function save(name) {
+  try {
+    const state = await (await api("/api/save", name ? { name } : {})).json();
+    alertShown("");
+    say(`Saved ${state.path}.`);
+    await loadState(state);
+  } catch (error) { alertShown(error.message); }
+}
+
+async function reload() {
+  try {
+    const state = await (await api("/api/reload", {})).json();
+    alertShown("");
+    say("Read the file again.");
+    page.overrides = {};
+    await loadState(state);
+  } catch (error) { alertShown(error.message); }
+}
+
+function listen() {
+  const events = new EventSource(`/api/events?token=${TOKEN}`);
+  events.onmessage = async (message) => {
+    const event = JSON.parse(message.data);
+    if (event.kind === "progress") {
+      $("progress").value = event.of ? event.done / event.of : 0;
+    } else if (event.kind === "file") {
+      if (event.error) alertShown(`The file on disk has an error; the page keeps the last valid timeline.\n${event.error}`);
+      else if (event.dirty) alertShown("The file changed on disk. Save writes over it; Reload takes it and drops the edits here.");
+      else { alertShown(""); say("The file changed on disk: taken in."); await loadState(); }
+    }
+  };
+}
+
+// ---- start ------------------------------------------------------------------------
+
+function setUp() {
+  setUpViewport();
+  setUpKeys();
+  $("prev").onclick = () => showFrame(page.frame - 1);
+  $("next").onclick = () => showFrame(page.frame + 1);
+  $("play").onclick = togglePlay;
+  $("frame").onchange = () => showFrame(parseInt($("frame").value, 10) || 0);
+  $("slider").oninput = () => showFrame(parseInt($("slider").value, 10));
+  $("key").onclick = keyChanges;
+  $("set-scene").onclick = setInScene;
+  $("discard").onclick = discard;
+  $("move-key").onclick = moveSelected;
+  $("delete-key").onclick = deleteSelected;
+  $("save").onclick = () => save(null);
+  $("save-as").onclick = () => {
+    const name = prompt("Save as a new file in the same folder (name.ron):");
+    if (name) save(name);
+  };
+  $("reload").onclick = reload;
+  $("size").onchange = refresh;
+  $("samples").onchange = refresh;
+  $("help-button").onclick = () => {
+    const help = $("help");
+    help.hidden = !help.hidden;
+    $("help-button").setAttribute("aria-expanded", String(!help.hidden));
+  };
+  $("estimate").onclick = async () => {
+    $("estimate-result").textContent = "Measuring…";
+    try {
+      const e = await (await api("/api/estimate", currentView(false))).json();
+      $("estimate-result").textContent =
+        `About ${duration(e.seconds)} for all ${page.state.frames} frames on this machine ` +
+        `(from ${e.frames_measured} frames rendered at ${e.measured_size.join("x")}, scaled by pixels).`;
+    } catch (error) { $("estimate-result").textContent = error.message; }
+  };
+  listen();
+  loadState().catch((error) => alertShown(error.message));
+}
+
+function duration(seconds) {
+  if (seconds < 90) return `${seconds.toFixed(1)} s`;
+  if (seconds < 5400) return `${(seconds / 60).toFixed(1)} min`;
+  return `${(seconds / 3600).toFixed(1)} h`;
+}
+
+setUp();

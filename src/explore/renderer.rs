@@ -1,0 +1,173 @@
+//! A view rendered in stages, each shown as it finishes: a quick small
+//! frame, then the full size at one sample, then every sample. A new view
+//! gives up the stages of the one before it; the last stage's pixels are
+//! those `render` writes for the same frame, size and samples.
+
+use super::view::Prepared;
+use crate::output::{self, Format};
+use crate::render::{Accumulation, Film, Layers};
+use crate::scene::Scene;
+use serde::{Deserialize, Serialize};
+use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
+use std::time::Instant;
+
+/// The most pixels of the quick stage: about 20 ms on two cores for the
+/// benchmark's plain scene, so it shows within a frame of a drag.
+const QUICK_PIXELS: u64 = 160 * 90;
+/// The most pixels of a playback frame.
+const PLAY_PIXELS: u64 = 320 * 180;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Stage {
+    /// Small, one sample.
+    Quick,
+    /// Full size, one sample.
+    Full,
+    /// Full size, every sample: what `render` writes.
+    Final,
+    /// A playback frame: small, one sample, and not given up for a view.
+    Play,
+}
+
+/// A finished stage as a PNG.
+pub struct Picture {
+    pub png: Vec<u8>,
+    pub width: u32,
+    pub height: u32,
+    pub samples: u32,
+    pub seconds: f64,
+}
+
+/// The renders of one server: which view is current, and its progress.
+#[derive(Default)]
+pub struct Renders {
+    generation: AtomicU64,
+    pub rows_done: AtomicU32,
+    pub rows_total: AtomicU32,
+}
+
+impl Renders {
+    /// Makes a new view current, giving up the stages of the one before.
+    pub fn begin(&self) -> u64 {
+        self.generation.fetch_add(1, Ordering::SeqCst) + 1
+    }
+
+    /// Renders `stage` of `view`: none where a newer view gave it up.
+    pub fn render(&self, view: &Prepared, stage: Stage, generation: u64) -> Option<Picture> {
+        let started = Instant::now();
+        let stop = || stage != Stage::Play && self.generation.load(Ordering::SeqCst) != generation;
+        let n = view.scenes[0].samples_per_pixel.max(1);
+        let (width, height, samples) = match stage {
+            Stage::Quick => shrunk(view, QUICK_PIXELS),
+            Stage::Play => shrunk(view, PLAY_PIXELS),
+            Stage::Full => (view.width, view.height, 1),
+            Stage::Final => (view.width, view.height, n),
+        };
+        let scenes: Vec<Scene> = if samples == n {
+            view.scenes.clone()
+        } else {
+            // One sample, one instant: as `render --preview` takes it.
+            let mut first = view.scenes[0].clone();
+            first.samples_per_pixel = 1;
+            vec![first]
+        };
+        if stage == Stage::Final {
+            self.rows_done.store(0, Ordering::Relaxed);
+            self.rows_total.store(height * samples, Ordering::Relaxed);
+        }
+        let on_row = || {
+            if stage == Stage::Final {
+                self.rows_done.fetch_add(1, Ordering::Relaxed);
+            }
+        };
+        let film = accumulate(&scenes, view.frame, (width, height), &on_row, &stop)?;
+        Some(Picture {
+            png: png_bytes(&film, &view.hash, &scenes[0]),
+            width,
+            height,
+            samples,
+            seconds: started.elapsed().as_secs_f64(),
+        })
+    }
+}
+
+/// The view's size scaled down, aspect kept, to at most `pixels`; one sample.
+fn shrunk(view: &Prepared, pixels: u64) -> (u32, u32, u32) {
+    let area = view.width as u64 * view.height as u64;
+    let scale = ((pixels as f64 / area as f64).sqrt()).min(1.0);
+    let side = |n: u32| ((n as f64 * scale).round() as u32).max(1);
+    (side(view.width), side(view.height), 1)
+}
+
+/// Every sample of `scenes`, in the waves `render` takes them, or none
+/// where `stop` says so first.
+fn accumulate(
+    scenes: &[Scene],
+    frame: u32,
+    (width, height): (u32, u32),
+    on_row: &(dyn Fn() + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<Film> {
+    let n = scenes[0].samples_per_pixel.max(1);
+    let wave = crate::job::waves::wave_size(n);
+    let mut acc = Accumulation::new(width, height, Layers::default());
+    while acc.samples_done < n {
+        let until = (acc.samples_done + wave).min(n);
+        if !crate::render::render_samples_unless(scenes, frame, &mut acc, until, on_row, stop) {
+            return None;
+        }
+    }
+    Some(acc.finish(n))
+}
+
+/// `film` as `render` writes it into a PNG file.
+fn png_bytes(film: &Film, hash: &str, scene: &Scene) -> Vec<u8> {
+    let encoding = output::Encoding {
+        display: scene.look.display_transform(),
+        transparent: scene.look.transparent_background,
+        exr_compression: Default::default(),
+    };
+    let key = output::frames::stored_key(Format::Png, hash, &[], encoding.exr_compression);
+    let mut bytes = Vec::new();
+    output::png::encode(&mut bytes, film, &key, Format::Png, &encoding)
+        .expect("a PNG encodes into memory");
+    bytes
+}
+
+/// How long the whole film would take to render, from a few of its frames
+/// rendered small with every sample and effect.
+#[derive(Serialize)]
+pub struct Estimate {
+    pub seconds: f64,
+    pub frames_measured: u32,
+    pub measured_size: (u32, u32),
+}
+
+/// The frames measured for an estimate, evenly spaced, and their most pixels.
+const ESTIMATE_FRAMES: u32 = 5;
+const ESTIMATE_PIXELS: u64 = 96 * 54;
+
+/// Times `ESTIMATE_FRAMES` frames of `timeline` at a small size and scales
+/// the time by pixels and frames: cost per pixel is about even at any size.
+pub fn estimate(timeline: &crate::timeline::Timeline, view: &Prepared) -> Estimate {
+    let (w, h, _) = shrunk(view, ESTIMATE_PIXELS);
+    let count = timeline.frame_count.min(ESTIMATE_FRAMES);
+    let started = Instant::now();
+    for i in 0..count {
+        let frame =
+            (i as u64 * (timeline.frame_count - 1) as u64 / (count.max(2) - 1) as u64) as u32;
+        let scenes = timeline
+            .clone()
+            .with_samples(Some(view.scenes[0].samples_per_pixel))
+            .scenes_for_frame(frame);
+        accumulate(&scenes, frame, (w, h), &|| {}, &|| false);
+    }
+    let per_frame = started.elapsed().as_secs_f64() / count as f64;
+    let scale = (view.width as f64 * view.height as f64) / (w as f64 * h as f64);
+    Estimate {
+        seconds: per_frame * scale * timeline.frame_count as f64,
+        frames_measured: count,
+        measured_size: (w, h),
+    }
+}

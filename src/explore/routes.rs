@@ -1,0 +1,367 @@
+//! The HTTP routes: the page, the timeline's state, renders, picks, edits,
+//! saves and server-sent events. Every route is behind `guard::check`.
+
+use super::renderer::Stage;
+use super::view::View;
+use super::{Event, State};
+use axum::http::{header, HeaderValue, StatusCode};
+use axum::response::sse::{KeepAlive, Sse};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::{Deserialize, Serialize};
+use std::sync::Arc;
+
+type Shared = axum::extract::State<Arc<State>>;
+
+pub fn router(state: Arc<State>) -> Router {
+    Router::new()
+        .route("/", get(super::page::index))
+        .route("/explore.js", get(super::page::script))
+        .route("/explore.css", get(super::page::style))
+        .route("/api/state", get(timeline_state))
+        .route("/api/values", get(values))
+        .route("/api/render", post(render))
+        .route("/api/pick", post(pick))
+        .route("/api/estimate", post(estimate))
+        .route("/api/edit", post(edit))
+        .route("/api/save", post(save))
+        .route("/api/reload", post(reload))
+        .route("/api/events", get(events))
+        .layer(axum::middleware::from_fn_with_state(
+            state.clone(),
+            super::guard::check,
+        ))
+        .layer(axum::middleware::map_response(never_cached))
+        .with_state(state)
+}
+
+/// Every answer is of this session only: nothing is cached or framed.
+async fn never_cached(mut response: Response) -> Response {
+    let headers = response.headers_mut();
+    headers.insert(header::CACHE_CONTROL, HeaderValue::from_static("no-store"));
+    headers.insert(header::X_FRAME_OPTIONS, HeaderValue::from_static("DENY"));
+    response
+}
+
+/// A refusal with its reason as plain text.
+fn refused(status: StatusCode, message: impl Into<String>) -> Response {
+    (status, message.into()).into_response()
+}
+
+/// A key as the page shows it.
+#[derive(Serialize)]
+struct KeyShown {
+    time: f64,
+    value: Vec<f64>,
+}
+
+#[derive(Serialize)]
+struct TrackShown {
+    name: String,
+    interpolation: String,
+    keys: Vec<KeyShown>,
+}
+
+/// The timeline as the page shows it.
+#[derive(Serialize)]
+struct TimelineState {
+    name: String,
+    path: Option<String>,
+    dirty: bool,
+    fps: f64,
+    frames: u32,
+    width: u32,
+    height: u32,
+    samples: u32,
+    tracks: Vec<TrackShown>,
+    parameters: Vec<(&'static str, usize)>,
+    plan: Vec<String>,
+    command: String,
+    text: String,
+}
+
+fn state_of(document: &super::Document) -> TimelineState {
+    let t = &document.timeline;
+    let tracks = t
+        .tracks
+        .iter()
+        .map(|track| TrackShown {
+            name: track.name.clone(),
+            interpolation: format!("{:?}", track.interpolation),
+            keys: track
+                .key_times
+                .iter()
+                .map(|&time| KeyShown {
+                    time,
+                    value: track.sample(time),
+                })
+                .collect(),
+        })
+        .collect();
+    let shown = document.path().map(|p| p.display().to_string());
+    TimelineState {
+        name: document.name(),
+        command: format!(
+            "mandelreel render {}",
+            shown.clone().unwrap_or_else(|| document.name())
+        ),
+        path: shown,
+        dirty: document.dirty(),
+        fps: t.fps,
+        frames: t.frame_count,
+        width: t.width,
+        height: t.height,
+        samples: t.base.samples_per_pixel.max(1),
+        tracks,
+        parameters: crate::timeline::PARAMETERS.to_vec(),
+        plan: crate::job::describe::plan_lines(&t.base),
+        text: document.text.clone(),
+    }
+}
+
+async fn timeline_state(state: Shared) -> Response {
+    let document = state.document.lock().expect("document");
+    Json(state_of(&document)).into_response()
+}
+
+#[derive(Deserialize)]
+struct FrameQuery {
+    frame: u32,
+}
+
+async fn values(state: Shared, query: axum::extract::Query<FrameQuery>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    if let Err(e) = crate::job::request::check_frame(&timeline, query.frame) {
+        return refused(StatusCode::UNPROCESSABLE_ENTITY, e.to_string());
+    }
+    Json(super::view::values(&timeline, query.frame)).into_response()
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RenderRequest {
+    view: View,
+    stage: Stage,
+    /// The view's generation from its first stage; none starts a new view.
+    #[serde(default)]
+    generation: Option<u64>,
+}
+
+async fn render(state: Shared, Json(request): Json<RenderRequest>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    let prepared = match request.view.prepare(&timeline) {
+        Ok(p) => p,
+        Err(message) => return refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    };
+    let generation = match (request.generation, request.stage) {
+        (Some(g), _) => g,
+        (None, Stage::Play) => 0,
+        (None, _) => state.renders.begin(),
+    };
+    let shared = state.clone();
+    let picture = tokio::task::spawn_blocking(move || {
+        shared.renders.render(&prepared, request.stage, generation)
+    })
+    .await;
+    match picture {
+        Ok(Some(p)) => (
+            [
+                (header::CONTENT_TYPE, "image/png".to_string()),
+                (
+                    header::HeaderName::from_static("x-generation"),
+                    generation.to_string(),
+                ),
+                (
+                    header::HeaderName::from_static("x-size"),
+                    format!("{}x{}", p.width, p.height),
+                ),
+                (
+                    header::HeaderName::from_static("x-samples"),
+                    p.samples.to_string(),
+                ),
+                (
+                    header::HeaderName::from_static("x-seconds"),
+                    format!("{:.3}", p.seconds),
+                ),
+            ],
+            p.png,
+        )
+            .into_response(),
+        Ok(None) => refused(StatusCode::CONFLICT, "a newer view replaced this one"),
+        Err(e) => refused(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            format!("render failed: {e}"),
+        ),
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PickRequest {
+    view: View,
+    x: u32,
+    y: u32,
+}
+
+async fn pick(state: Shared, Json(request): Json<PickRequest>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    let prepared = match request.view.prepare(&timeline) {
+        Ok(p) => p,
+        Err(message) => return refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    };
+    let (w, h) = (prepared.width, prepared.height);
+    if request.x >= w || request.y >= h {
+        let message = format!("pixel ({}, {}) is outside {w}x{h}", request.x, request.y);
+        return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
+    }
+    let report = tokio::task::spawn_blocking(move || {
+        let scene = &prepared.scenes[0];
+        crate::render::pick::pick(scene, prepared.frame, [request.x, request.y], [w, h])
+    })
+    .await;
+    match report {
+        Ok(report) => Json(report).into_response(),
+        Err(e) => refused(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            format!("pick failed: {e}"),
+        ),
+    }
+}
+
+async fn estimate(state: Shared, Json(view): Json<View>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    let prepared = match view.prepare(&timeline) {
+        Ok(p) => p,
+        Err(message) => return refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    };
+    let estimate =
+        tokio::task::spawn_blocking(move || super::renderer::estimate(&timeline, &prepared)).await;
+    match estimate {
+        Ok(e) => Json(e).into_response(),
+        Err(e) => refused(
+            StatusCode::INTERNAL_SERVER_ERROR,
+            format!("estimate failed: {e}"),
+        ),
+    }
+}
+
+/// An edit as the page sends it (`timeline::edit::Edit`, values as lists).
+#[derive(Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+enum EditRequest {
+    SetScene {
+        parameter: String,
+        value: Vec<f64>,
+    },
+    SetKey {
+        track: String,
+        time: f64,
+        value: Vec<f64>,
+    },
+    DeleteKey {
+        track: String,
+        index: usize,
+    },
+    MoveKey {
+        track: String,
+        index: usize,
+        time: f64,
+    },
+}
+
+impl EditRequest {
+    fn edit(self) -> Result<crate::timeline::edit::Edit, String> {
+        use crate::timeline::edit::Edit;
+        Ok(match self {
+            EditRequest::SetScene { parameter, value } => Edit::SetScene {
+                value: key_value(&parameter, &value)?,
+                parameter,
+            },
+            EditRequest::SetKey { track, time, value } => Edit::SetKey {
+                value: key_value(&track, &value)?,
+                track,
+                time,
+            },
+            EditRequest::DeleteKey { track, index } => Edit::DeleteKey { track, index },
+            EditRequest::MoveKey { track, index, time } => Edit::MoveKey { track, index, time },
+        })
+    }
+}
+
+fn key_value(name: &str, value: &[f64]) -> Result<crate::timeline::KeyValue, String> {
+    use crate::timeline::KeyValue;
+    match *value {
+        [v] => Ok(KeyValue::Number(v)),
+        [x, y, z] => Ok(KeyValue::Triple(x, y, z)),
+        _ => Err(format!(
+            "{name}: a value is one number or three, got {}",
+            value.len()
+        )),
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EditsRequest {
+    edits: Vec<EditRequest>,
+}
+
+async fn edit(state: Shared, Json(request): Json<EditsRequest>) -> Response {
+    let edits: Result<Vec<_>, String> = request.edits.into_iter().map(EditRequest::edit).collect();
+    let mut document = state.document.lock().expect("document");
+    match edits.and_then(|edits| document.edit(&edits)) {
+        Ok(()) => Json(state_of(&document)).into_response(),
+        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SaveRequest {
+    /// A new file in the timeline's folder; none saves the timeline itself.
+    #[serde(default)]
+    name: Option<String>,
+}
+
+async fn save(state: Shared, Json(request): Json<SaveRequest>) -> Response {
+    let mut document = state.document.lock().expect("document");
+    match document.save(request.name.as_deref()) {
+        Ok(_) => Json(state_of(&document)).into_response(),
+        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    }
+}
+
+async fn reload(state: Shared) -> Response {
+    let mut document = state.document.lock().expect("document");
+    match document.reload() {
+        Ok(()) => Json(state_of(&document)).into_response(),
+        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    }
+}
+
+/// File changes and render progress, as they happen.
+async fn events(state: Shared) -> Response {
+    let receiver = state.events.subscribe();
+    let stream = futures_util::stream::unfold(receiver, |mut receiver| async move {
+        loop {
+            match receiver.recv().await {
+                Ok(event) => {
+                    let data = serde_json::to_string(&event).unwrap_or_default();
+                    let sse = axum::response::sse::Event::default().data(data);
+                    return Some((Ok::<_, std::convert::Infallible>(sse), receiver));
+                }
+                Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
+                Err(_) => return None,
+            }
+        }
+    });
+    Sse::new(stream)
+        .keep_alive(KeepAlive::default())
+        .into_response()
+}
+
+/// Sends `event` to every page listening.
+pub fn announce(state: &State, event: Event) {
+    let _ = state.events.send(event);
+}

@@ -1,0 +1,115 @@
+//! What the page asks to see: a frame of the timeline, with the values it
+//! has changed but not yet keyed laid over the tracks', at a size and
+//! samples as `render --size --samples` take them; checked as the command
+//! line checks them.
+
+use crate::scene::Scene;
+use crate::timeline::Timeline;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+
+/// The most pixels a view may have: a 4K frame. A larger one is a render's
+/// job, whose memory is checked before it starts.
+pub const MAX_VIEW_PIXELS: u64 = 3840 * 2160;
+/// `--samples`'s upper bound.
+const MAX_SAMPLES: u32 = 4096;
+
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct View {
+    pub frame: u32,
+    /// Parameter values that replace the tracks' at this frame.
+    #[serde(default)]
+    pub overrides: BTreeMap<String, Vec<f64>>,
+    /// `WIDTHxHEIGHT`, as `--size`; the timeline's size where absent.
+    #[serde(default)]
+    pub size: Option<String>,
+    /// As `--samples`; the timeline's where absent.
+    #[serde(default)]
+    pub samples: Option<u32>,
+}
+
+/// A view's scenes (one per sample under motion blur), size and hash.
+pub struct Prepared {
+    pub scenes: Vec<Scene>,
+    pub frame: u32,
+    pub width: u32,
+    pub height: u32,
+    pub hash: String,
+}
+
+impl View {
+    /// The scenes `render` would render for this view, or what is wrong.
+    pub fn prepare(&self, timeline: &Timeline) -> Result<Prepared, String> {
+        crate::job::request::check_frame(timeline, self.frame).map_err(|e| e.to_string())?;
+        let (width, height) = match &self.size {
+            Some(s) => crate::job::request::parse_size("size", s).map_err(|e| e.to_string())?,
+            None => (timeline.width, timeline.height),
+        };
+        if width as u64 * height as u64 > MAX_VIEW_PIXELS {
+            return Err(format!(
+                "size {width}x{height}: the explorer shows at most 3840x2160 pixels; render larger frames with `render --size`"
+            ));
+        }
+        if self
+            .samples
+            .is_some_and(|n| !(1..=MAX_SAMPLES).contains(&n))
+        {
+            return Err(format!("samples must be 1..={MAX_SAMPLES}"));
+        }
+        let timeline = timeline.clone().with_samples(self.samples);
+        timeline
+            .check_scene_count()
+            .map_err(|(_, message)| format!("samples: {message}"))?;
+        let mut scenes = timeline.scenes_for_frame(self.frame);
+        for scene in &mut scenes {
+            self.lay_over(scene)?;
+        }
+        let hash = crate::output::frames::frame_hash(&scenes, self.frame, width, height);
+        Ok(Prepared {
+            scenes,
+            frame: self.frame,
+            width,
+            height,
+            hash,
+        })
+    }
+
+    /// The overrides written into `scene`, which must stay valid.
+    fn lay_over(&self, scene: &mut Scene) -> Result<(), String> {
+        for (name, values) in &self.overrides {
+            let parameter = crate::timeline::parameters::find(name)
+                .ok_or_else(|| format!("{name}: no such parameter"))?;
+            let wanted = parameter.shape.components();
+            if values.len() != wanted {
+                return Err(format!(
+                    "{name}: takes {wanted} numbers, got {}",
+                    values.len()
+                ));
+            }
+            if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
+                return Err(format!("{name}: values must be finite, got {bad}"));
+            }
+            (parameter.set)(scene, values);
+        }
+        crate::timeline::validate_scene(scene)
+            .map_err(|(field, message)| format!("{field}: {message}"))
+    }
+}
+
+/// Every animatable parameter's value at `frame`: none for a field of an
+/// effect the scene leaves off.
+pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<Vec<f64>>> {
+    let scene = serde_json::to_value(timeline.scene_at(frame)).unwrap_or_default();
+    crate::timeline::parameters::all()
+        .map(|p| {
+            let field = p.name.split('.').try_fold(&scene, |v, step| v.get(step));
+            let numbers = field.and_then(|v| match v {
+                serde_json::Value::Number(n) => Some(vec![n.as_f64()?]),
+                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+                _ => None,
+            });
+            (p.name, numbers)
+        })
+        .collect()
+}
