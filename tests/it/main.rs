@@ -8,6 +8,7 @@ mod cli;
 mod compositing;
 mod deep;
 mod deep_oracle;
+mod explore_api;
 mod farm;
 mod formats;
 mod fuzz;

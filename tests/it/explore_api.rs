@@ -1,0 +1,555 @@
+//! `explore`'s HTTP API, through the real binary: who may call it, that its
+//! final stage is `render`'s frame, what save and edit may do to the files,
+//! the file watch, refused views and picks. Requests are written by hand
+//! over a TcpStream so that Host and Origin are exactly what a test says.
+
+use crate::util::{stdout, tiny_timeline, with_scene, Dir};
+use serde_json::{json, Value};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::net::TcpStream;
+use std::process::{Child, ChildStdout, Stdio};
+use std::time::Duration;
+
+/// A running `mandelreel explore`, killed when dropped.
+struct Server {
+    child: Child,
+    /// Kept open: the server's later writes to stdout must not fail.
+    _stdout: BufReader<ChildStdout>,
+    port: u16,
+    token: String,
+}
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+/// A whole HTTP response.
+struct Response {
+    status: u16,
+    headers: Vec<(String, String)>,
+    body: Vec<u8>,
+}
+
+impl Response {
+    fn text(&self) -> String {
+        String::from_utf8_lossy(&self.body).into_owned()
+    }
+
+    fn json(&self) -> Value {
+        serde_json::from_slice(&self.body)
+            .unwrap_or_else(|e| panic!("{e}: {} {}", self.status, self.text()))
+    }
+
+    fn header(&self, name: &str) -> Option<&str> {
+        let found = self.headers.iter().find(|(n, _)| n == name);
+        found.map(|(_, v)| v.as_str())
+    }
+
+    /// Asserts the status, showing the body if it differs.
+    fn expect(self, status: u16) -> Response {
+        assert_eq!(self.status, status, "body: {}", self.text());
+        self
+    }
+}
+
+/// Starts `explore <timeline> --port 0` in `dir` and reads the address it prints.
+fn explore(dir: &Dir, timeline: &str) -> Server {
+    let mut child = dir
+        .command(&["explore", timeline, "--port", "0"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("start explore");
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut line = String::new();
+    out.read_line(&mut line).unwrap();
+    let url = line
+        .split_once(": open http://127.0.0.1:")
+        .unwrap_or_else(|| panic!("no address in {line:?}"))
+        .1
+        .trim();
+    let (port, token) = url.split_once("/?token=").expect("a token");
+    Server {
+        port: port.parse().expect("a port"),
+        token: token.to_string(),
+        child,
+        _stdout: out,
+    }
+}
+
+impl Server {
+    fn host(&self) -> String {
+        format!("127.0.0.1:{}", self.port)
+    }
+
+    /// Sends `head` (request line and headers, each ending in CRLF) and
+    /// `body`, and reads the whole response.
+    fn raw(&self, head: &str, body: &[u8]) -> Response {
+        let mut stream = self.connect(head, body);
+        let mut bytes = Vec::new();
+        stream.read_to_end(&mut bytes).expect("read response");
+        parse(&bytes)
+    }
+
+    fn connect(&self, head: &str, body: &[u8]) -> TcpStream {
+        let mut stream = TcpStream::connect(("127.0.0.1", self.port)).expect("connect");
+        // A hung server fails the test instead of hanging it.
+        stream
+            .set_read_timeout(Some(Duration::from_secs(120)))
+            .unwrap();
+        let request = format!(
+            "{head}Content-Length: {}\r\nConnection: close\r\n\r\n",
+            body.len()
+        );
+        stream.write_all(request.as_bytes()).unwrap();
+        stream.write_all(body).unwrap();
+        stream
+    }
+
+    /// A request as the page sends it: our Host and the token.
+    fn call(&self, method: &str, path: &str, body: Option<&Value>) -> Response {
+        let body = body.map_or_else(Vec::new, |b| b.to_string().into_bytes());
+        let head = format!(
+            "{method} {path} HTTP/1.1\r\nHost: {}\r\nx-mandelreel-token: {}\r\n\
+             Content-Type: application/json\r\n",
+            self.host(),
+            self.token
+        );
+        self.raw(&head, &body)
+    }
+
+    fn get(&self, path: &str) -> Response {
+        self.call("GET", path, None)
+    }
+
+    fn post(&self, path: &str, body: Value) -> Response {
+        self.call("POST", path, Some(&body))
+    }
+
+    fn state(&self) -> Value {
+        self.get("/api/state").expect(200).json()
+    }
+
+    /// Opens the server-sent events; returns the stream past the headers.
+    fn events(&self) -> BufReader<TcpStream> {
+        let head = format!(
+            "GET /api/events?token={} HTTP/1.1\r\nHost: {}\r\n",
+            self.token,
+            self.host()
+        );
+        let mut reader = BufReader::new(self.connect(&head, b""));
+        let mut line = String::new();
+        reader.read_line(&mut line).unwrap();
+        assert!(line.contains(" 200 "), "events: {line}");
+        while line != "\r\n" {
+            line.clear();
+            reader.read_line(&mut line).unwrap();
+        }
+        reader
+    }
+}
+
+/// The next `file` event's JSON on `events`, within 10 s.
+fn next_file_event(events: &mut BufReader<TcpStream>) -> Value {
+    events
+        .get_ref()
+        .set_read_timeout(Some(Duration::from_secs(10)))
+        .unwrap();
+    let mut line = String::new();
+    loop {
+        line.clear();
+        let n = events
+            .read_line(&mut line)
+            .expect("a file event within 10 s");
+        assert!(n > 0, "the event stream ended");
+        // Chunk sizes and blank lines come between the `data:` lines.
+        if let Some(data) = line.trim().strip_prefix("data:") {
+            let event: Value = serde_json::from_str(data.trim()).unwrap();
+            if event["kind"] == "file" {
+                return event;
+            }
+        }
+    }
+}
+
+fn parse(bytes: &[u8]) -> Response {
+    let end = bytes
+        .windows(4)
+        .position(|w| w == b"\r\n\r\n")
+        .unwrap_or_else(|| panic!("no header end in {:?}", String::from_utf8_lossy(bytes)));
+    let head = String::from_utf8_lossy(&bytes[..end]).into_owned();
+    let mut lines = head.split("\r\n");
+    let status = lines.next().unwrap().split(' ').nth(1).unwrap();
+    let headers: Vec<(String, String)> = lines
+        .filter_map(|l| l.split_once(':'))
+        .map(|(n, v)| (n.trim().to_ascii_lowercase(), v.trim().to_string()))
+        .collect();
+    let mut body = bytes[end + 4..].to_vec();
+    if headers.contains(&("transfer-encoding".into(), "chunked".into())) {
+        body = unchunk(&body);
+    }
+    Response {
+        status: status.parse().unwrap(),
+        headers,
+        body,
+    }
+}
+
+fn unchunk(mut rest: &[u8]) -> Vec<u8> {
+    let mut body = Vec::new();
+    loop {
+        let line = rest.windows(2).position(|w| w == b"\r\n").unwrap();
+        let size = std::str::from_utf8(&rest[..line]).unwrap();
+        let size = usize::from_str_radix(size.split(';').next().unwrap().trim(), 16).unwrap();
+        if size == 0 {
+            return body;
+        }
+        body.extend_from_slice(&rest[line + 2..line + 2 + size]);
+        rest = &rest[line + 2 + size + 2..];
+    }
+}
+
+/// A PNG's size and pixel bytes.
+fn pixels(png: &[u8]) -> (u32, u32, Vec<u8>) {
+    let image = image::load_from_memory(png).expect("a PNG");
+    (image.width(), image.height(), image.as_bytes().to_vec())
+}
+
+fn zoom_ron() -> String {
+    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/timelines/zoom.ron")).unwrap()
+}
+
+#[test]
+fn only_our_page_with_its_token_is_answered() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let (host, token) = (s.host(), s.token.clone());
+    let get = |headers: &str| s.raw(&format!("GET /api/state HTTP/1.1\r\n{headers}"), b"");
+
+    get(&format!("Host: {host}\r\n")).expect(403);
+    get(&format!(
+        "Host: {host}\r\nx-mandelreel-token: {}\r\n",
+        "0".repeat(32)
+    ))
+    .expect(403);
+    // DNS rebinding: a name that resolves here, with the right token.
+    let evil = format!(
+        "Host: evil.example:{}\r\nx-mandelreel-token: {token}\r\n",
+        s.port
+    );
+    let refused = get(&evil).expect(403);
+    assert!(refused.text().contains("Host"), "{}", refused.text());
+    let ours = format!("Host: {host}\r\nx-mandelreel-token: {token}\r\n");
+    get(&format!("{ours}Origin: http://evil.example\r\n")).expect(403);
+    get(&format!("{ours}Origin: http://{host}\r\n")).expect(200);
+    assert_eq!(get(&ours).expect(200).json()["name"], "t.ron");
+    assert!(get(&format!(
+        "Host: localhost:{}\r\nx-mandelreel-token: {token}\r\n",
+        s.port
+    ))
+    .expect(200)
+    .header("cache-control")
+    .is_some_and(|c| c == "no-store"));
+    // The page itself, with the token in the query as its address gives it.
+    let page = format!("GET /?token={token} HTTP/1.1\r\nHost: {host}\r\n");
+    s.raw(&page, b"").expect(200);
+    s.raw(
+        &format!("GET /?token=x{token} HTTP/1.1\r\nHost: {host}\r\n"),
+        b"",
+    )
+    .expect(403);
+
+    // Listening on loopback only: the machine's own outward address is refused.
+    match outward_address() {
+        None => eprintln!("no non-loopback address here: skipping the bind check"),
+        Some(ip) => {
+            let to = std::net::SocketAddr::new(ip, s.port);
+            let connected = TcpStream::connect_timeout(&to, Duration::from_secs(2));
+            assert!(connected.is_err(), "explore answered on {to}");
+        }
+    }
+}
+
+/// This machine's address on its default route, if it has one (a UDP
+/// "connect" sends nothing; it only picks the route).
+fn outward_address() -> Option<std::net::IpAddr> {
+    let socket = std::net::UdpSocket::bind("0.0.0.0:0").ok()?;
+    socket.connect("192.0.2.1:9").ok()?;
+    let ip = socket.local_addr().ok()?.ip();
+    (!ip.is_loopback() && !ip.is_unspecified()).then_some(ip)
+}
+
+#[test]
+fn the_final_stage_is_renders_frame() {
+    let d = Dir::new();
+    d.write(
+        "t.ron",
+        &with_scene(&tiny_timeline(3, 9.0), "samples_per_pixel: 4"),
+    );
+    let s = explore(&d, "t.ron");
+    // The timeline's own size and samples, and a view that changes both.
+    let cases = [
+        (json!({"frame": 0}), vec![], "48x27", "4"),
+        (json!({"frame": 2}), vec![], "48x27", "4"),
+        (
+            json!({"frame": 2, "size": "32x18", "samples": 2}),
+            vec!["--size", "32x18", "--samples", "2"],
+            "32x18",
+            "2",
+        ),
+    ];
+    for (i, (view, args, size, samples)) in cases.into_iter().enumerate() {
+        let frame = view["frame"].to_string();
+        let shown = s
+            .post("/api/render", json!({"view": view, "stage": "final"}))
+            .expect(200);
+        let out = format!("o{i}");
+        let mut render = vec!["render", "t.ron", "--frames", &frame, "--out", &out, "-q"];
+        render.extend(args);
+        d.ok(&render);
+        let written = d.bytes(&format!("{out}/frame_{frame:0>5}.png"));
+        assert!(
+            pixels(&shown.body) == pixels(&written),
+            "{view}: the final stage's pixels differ from render's"
+        );
+        assert_eq!(shown.header("content-type"), Some("image/png"));
+        assert_eq!(shown.header("x-size"), Some(size));
+        assert_eq!(shown.header("x-samples"), Some(samples));
+    }
+}
+
+#[test]
+fn save_writes_only_its_file_and_new_plain_names() {
+    let d = Dir::new();
+    // The timeline in a folder of its own, so that `../x.ron` would land in
+    // a folder this test lists; `a/` exists so `a/b.ron` could be written.
+    std::fs::create_dir_all(d.path().join("work/a")).unwrap();
+    let original = tiny_timeline(2, 9.0);
+    d.write("work/t.ron", &original);
+    d.write("work/other.ron", "// someone else's\n");
+    let s = explore(&d, "work/t.ron");
+    let listing = || (d.files(""), d.files("work"), d.files("work/a"));
+    let before = listing();
+    let bad = [
+        "../x.ron",
+        "a/b.ron",
+        ".hidden.ron",
+        "x.txt",
+        "other.ron",
+        "t.ron",
+    ];
+    for name in bad {
+        let refused = s.post("/api/save", json!({ "name": name }));
+        assert!(
+            (400..500).contains(&refused.status),
+            "{name}: {} {}",
+            refused.status,
+            refused.text()
+        );
+        assert_eq!(listing(), before, "{name} wrote a file");
+    }
+    assert_eq!(d.bytes("work/other.ron"), b"// someone else's\n");
+    assert_eq!(d.bytes("work/t.ron"), original.as_bytes());
+
+    // A plain save after an edit writes the timeline it opened.
+    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
+    assert_eq!(s.post("/api/edit", edit).expect(200).json()["dirty"], true);
+    let saved = s.post("/api/save", json!({})).expect(200).json();
+    assert_eq!(saved["dirty"], false);
+    let text = saved["text"].as_str().unwrap();
+    assert_ne!(text, original);
+    assert_eq!(d.bytes("work/t.ron"), text.as_bytes());
+
+    // A new plain name: a new file beside it, with the same text.
+    let copy = s.post("/api/save", json!({"name": "copy.ron"})).expect(200);
+    assert_eq!(d.bytes("work/copy.ron"), text.as_bytes());
+    assert!(copy.json()["path"].as_str().unwrap().ends_with("copy.ron"));
+    assert_eq!(d.files("work"), ["a", "copy.ron", "other.ron", "t.ron"]);
+}
+
+#[test]
+fn edits_keep_comments_and_bad_ones_change_nothing() {
+    let d = Dir::new();
+    let original = zoom_ron();
+    d.write("zoom.ron", &original);
+    let s = explore(&d, "zoom.ron");
+
+    // Invalid values are placed where they are written, as `render` places them.
+    let fov = 1 + original
+        .lines()
+        .position(|l| l.contains("fov_degrees"))
+        .unwrap();
+    let fov = format!("zoom.ron:{fov}:");
+    let refusals = [
+        (
+            json!({"kind": "set_scene", "parameter": "camera.fov_degrees", "value": [0]}),
+            "fov_degrees",
+            Some(&fov),
+        ),
+        (
+            json!({"kind": "set_scene", "parameter": "camera.fov_degrees", "value": [500]}),
+            "fov_degrees",
+            Some(&fov),
+        ),
+        (
+            json!({"kind": "set_key", "track": "camera.nope", "time": 1, "value": [1]}),
+            "camera.nope",
+            None,
+        ),
+        (
+            json!({"kind": "set_key", "track": "camera.position", "time": 1, "value": [1, 2]}),
+            "camera.position",
+            None,
+        ),
+    ];
+    for (edit, names, at) in refusals {
+        let refused = s.post("/api/edit", json!({ "edits": [edit] })).expect(422);
+        let message = refused.text();
+        assert!(message.contains(names), "{edit}: {message}");
+        assert!(
+            at.is_none_or(|at| message.starts_with(at.as_str())),
+            "{edit}: {message}"
+        );
+        let state = s.state();
+        assert_eq!(state["text"], original.as_str(), "{edit} changed the text");
+        assert_eq!(state["dirty"], false);
+    }
+
+    let key = json!({"kind": "set_key", "track": "camera.distance", "time": 2.5, "value": [0.5]});
+    let edited = s
+        .post("/api/edit", json!({"edits": [key]}))
+        .expect(200)
+        .json();
+    let keys = &edited["tracks"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|t| t["name"] == "camera.distance")
+        .unwrap()["keys"];
+    assert_eq!(keys.as_array().unwrap().len(), 3, "{keys}");
+    s.post("/api/save", json!({})).expect(200);
+    let saved = String::from_utf8(d.bytes("zoom.ron")).unwrap();
+    assert!(saved.contains("2.5"), "{saved}");
+    for comment in original
+        .lines()
+        .filter_map(|l| l.find("//").map(|i| &l[i..]))
+    {
+        assert!(saved.contains(comment), "lost {comment:?}:\n{saved}");
+    }
+    let info = d.run(&["info", "zoom.ron"]);
+    assert!(info.status.success(), "{}", crate::util::stderr(&info));
+    assert!(!stdout(&info).is_empty());
+}
+
+/// Writes `name` whole at once, as editors save (a plain write could be
+/// read half-written, which the server rightly reports as an error).
+fn replace(d: &Dir, name: &str, text: &str) {
+    d.write(".next", text);
+    std::fs::rename(d.path().join(".next"), d.path().join(name)).unwrap();
+}
+
+#[test]
+fn disk_changes_are_taken_in_unless_edited_here() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let mut events = s.events();
+
+    replace(&d, "t.ron", &tiny_timeline(2, 11.0));
+    let event = next_file_event(&mut events);
+    assert_eq!(
+        event,
+        json!({"kind": "file", "dirty": false, "error": null})
+    );
+    let state = s.state();
+    assert!(
+        state["text"].as_str().unwrap().contains("value: 11"),
+        "{state}"
+    );
+    assert_eq!(state["dirty"], false);
+
+    // An edit not saved: the file's change is reported, not taken in.
+    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
+    let edited = s.post("/api/edit", edit).expect(200).json()["text"].clone();
+    replace(&d, "t.ron", &tiny_timeline(2, 12.0));
+    let event = next_file_event(&mut events);
+    assert_eq!(event["dirty"], true, "{event}");
+    let state = s.state();
+    assert_eq!(state["text"], edited);
+    assert!(!state["text"].as_str().unwrap().contains("value: 12"));
+    assert_eq!(state["dirty"], true);
+
+    // Reload drops the edit for the file's text.
+    let reloaded = s.post("/api/reload", json!({})).expect(200).json();
+    assert_eq!(reloaded["text"], tiny_timeline(2, 12.0).as_str());
+    assert_eq!(reloaded["dirty"], false);
+}
+
+#[test]
+fn bad_views_are_refused_with_the_reason() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(3, 9.0));
+    let s = explore(&d, "t.ron");
+    let views = [
+        (json!({"frame": 3}), "past the last frame"),
+        (json!({"frame": 0, "size": "0x5"}), "0x5"),
+        (json!({"frame": 0, "size": "99999x99999"}), "99999x99999"),
+        (json!({"frame": 0, "size": "3841x2160"}), "3840x2160"),
+        (
+            json!({"frame": 0, "overrides": {"camera.nope": [1]}}),
+            "camera.nope",
+        ),
+        (
+            json!({"frame": 0, "overrides": {"camera.position": [1, 2]}}),
+            "camera.position",
+        ),
+        (
+            json!({"frame": 0, "overrides": {"camera.fov_degrees": [0]}}),
+            "fov_degrees",
+        ),
+        (json!({"frame": 0, "samples": 0}), "samples"),
+    ];
+    for (view, reason) in views {
+        for stage in ["quick", "final"] {
+            let refused = s.post("/api/render", json!({"view": view, "stage": stage}));
+            let message = refused.expect(422).text();
+            assert!(message.contains(reason), "{view}: {message}");
+        }
+        let picked = s.post("/api/pick", json!({"view": view, "x": 0, "y": 0}));
+        assert!(picked.expect(422).text().contains(reason));
+        let estimated = s.post("/api/estimate", view.clone());
+        assert!(estimated.expect(422).text().contains(reason));
+    }
+    let outside = s.post("/api/pick", json!({"view": {"frame": 0}, "x": 48, "y": 0}));
+    assert!(outside.expect(422).text().contains("outside 48x27"));
+    s.get("/api/values?frame=3").expect(422);
+    // Still answering, and still renders a good view.
+    assert_eq!(s.state()["frames"], 3);
+    let quick = s.post(
+        "/api/render",
+        json!({"view": {"frame": 2}, "stage": "quick"}),
+    );
+    assert_eq!(quick.expect(200).header("x-size"), Some("48x27"));
+}
+
+#[test]
+fn a_pick_at_the_centre_of_the_zoom_finds_its_target() {
+    let d = Dir::new();
+    d.write("zoom.ron", &zoom_ron());
+    let s = explore(&d, "zoom.ron");
+    let pick = json!({"view": {"frame": 119, "size": "64x36"}, "x": 32, "y": 18});
+    let report = s.post("/api/pick", pick).expect(200).json();
+    assert_eq!(report["hit"], true, "{report}");
+    let target = [0.503044367725, 0.443308880733, 0.397566446799];
+    for (axis, want) in target.iter().enumerate() {
+        let got = report["point"][axis].as_f64().unwrap();
+        assert!(
+            (got - want).abs() < 1e-3,
+            "axis {axis}: {got} vs {want}: {report}"
+        );
+    }
+}
