@@ -19,6 +19,9 @@ pub struct Document {
     saved: Option<String>,
     /// Edited here since then.
     edited: bool,
+    /// The file's text at the last look, taken in only once two looks
+    /// agree: an editor that writes in place is seen half-way through.
+    last_look: Option<String>,
     pub timeline: Timeline,
 }
 
@@ -34,6 +37,7 @@ impl Document {
                 text: STARTER.to_string(),
                 saved: None,
                 edited: false,
+                last_look: None,
                 timeline: Timeline::parse(STARTER, name)?,
             });
         };
@@ -48,6 +52,7 @@ impl Document {
             path: Some(path.to_path_buf()),
             saved: Some(text.clone()),
             edited: false,
+            last_look: None,
             text,
             timeline,
         })
@@ -159,7 +164,9 @@ impl Document {
     pub fn check_disk(&mut self) -> Option<Event> {
         let path = self.path.clone()?;
         let text = crate::timeline::read_text(&path).ok()?;
-        if Some(&text) == self.saved.as_ref() {
+        let settled = self.last_look.as_ref() == Some(&text);
+        self.last_look = Some(text.clone());
+        if !settled || Some(&text) == self.saved.as_ref() {
             return None;
         }
         self.saved = Some(text.clone());

@@ -132,8 +132,12 @@ struct FrameQuery {
 
 async fn values(state: Shared, query: axum::extract::Query<FrameQuery>) -> Response {
     let timeline = state.document.lock().expect("document").timeline.clone();
-    if let Err(e) = crate::job::request::check_frame(&timeline, query.frame) {
-        return refused(StatusCode::UNPROCESSABLE_ENTITY, e.to_string());
+    let view = View {
+        frame: query.frame,
+        ..View::default()
+    };
+    if let Err(message) = view.prepare(&timeline) {
+        return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
     }
     Json(super::view::values(&timeline, query.frame)).into_response()
 }

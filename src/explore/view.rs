@@ -41,7 +41,13 @@ pub struct Prepared {
 impl View {
     /// The scenes `render` would render for this view, or what is wrong.
     pub fn prepare(&self, timeline: &Timeline) -> Result<Prepared, String> {
-        crate::job::request::check_frame(timeline, self.frame).map_err(|e| e.to_string())?;
+        if self.frame >= timeline.frame_count {
+            let last = timeline.frame_count - 1;
+            return Err(format!(
+                "frame {} is past the last frame ({last})",
+                self.frame
+            ));
+        }
         let (width, height) = match &self.size {
             Some(s) => crate::job::request::parse_size("size", s).map_err(|e| e.to_string())?,
             None => (timeline.width, timeline.height),
@@ -100,9 +106,15 @@ impl View {
 /// Every animatable parameter's value at `frame`: none for a field of an
 /// effect the scene leaves off.
 pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<Vec<f64>>> {
-    let scene = serde_json::to_value(timeline.scene_at(frame)).unwrap_or_default();
+    let scene = timeline.scene_at(frame);
+    let distance = (scene.camera.position - scene.camera.target).length();
+    let scene = serde_json::to_value(scene).unwrap_or_default();
     crate::timeline::parameters::all()
         .map(|p| {
+            // The zoom's distance is a track's alone, not a field of the scene.
+            if p.name == crate::timeline::ZOOM_TRACK {
+                return (p.name, Some(vec![distance]));
+            }
             let field = p.name.split('.').try_fold(&scene, |v, step| v.get(step));
             let numbers = field.and_then(|v| match v {
                 serde_json::Value::Number(n) => Some(vec![n.as_f64()?]),

@@ -4,6 +4,7 @@ mod util;
 
 mod accuracy;
 mod bench;
+mod browser;
 mod cli;
 mod compositing;
 mod deep;

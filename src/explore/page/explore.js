@@ -17,6 +17,7 @@ const page = {
   playing: false,
   playCache: new Map(), // frame -> blob URL of its playback frame
   pickCache: null,      // {x, y, serial, hit} for a burst of wheel events
+  shown: null,          // the PNG shown, as the server sent it
 };
 
 // ---- talking to the server ------------------------------------------------
@@ -116,6 +117,7 @@ async function stage(view, name, generation, serial) {
   const blob = await response.blob();
   if (serial !== page.serial || page.playing) return null;
   const img = $("view");
+  page.shown = blob;
   const old = img.src;
   img.src = URL.createObjectURL(blob);
   if (old.startsWith("blob:")) URL.revokeObjectURL(old);
@@ -124,6 +126,7 @@ async function stage(view, name, generation, serial) {
   const seconds = response.headers.get("x-seconds");
   img.dataset.stage = name;
   img.dataset.frame = view.frame;
+  img.dataset.serial = serial;
   img.dataset.size = size;
   $("overlay").textContent = `frame ${view.frame} · ${name} · ${size} · ${samples} sample(s) · ${seconds} s`;
   if (name === "final") { $("progress").value = 1; alertShown(""); }
@@ -213,6 +216,16 @@ function viewSize() {
   return [page.state.width, page.state.height];
 }
 
+async function aimAt(pixel) {
+  try {
+    const hit = await pickAt(pixel);
+    if (!hit) { say("That pixel sees no surface."); return; }
+    change("camera.target", hit);
+    say(`Aimed at (${hit.map((v) => v.toPrecision(8)).join(", ")}).`);
+    refresh();
+  } catch (error) { alertShown(error.message); }
+}
+
 async function pickAt(pixel) {
   const response = await api("/api/pick", { view: currentView(), x: pixel[0], y: pixel[1] });
   const report = await response.json();
@@ -241,7 +254,8 @@ function setUpViewport() {
     down.y = event.clientY;
     refreshSoon();
   });
-  viewport.addEventListener("pointerup", async (event) => {
+  // A press that did not move is a click: aim at the surface point under it.
+  const release = async (event, clicked) => {
     const was = down;
     down = null;
     viewport.classList.remove("dragging");
@@ -251,16 +265,12 @@ function setUpViewport() {
       if (!moving) refresh();
       return;
     }
-    const pixel = pixelAt(event);
-    if (!pixel) return;
-    try {
-      const hit = await pickAt(pixel);
-      if (!hit) { say("That pixel sees no surface."); return; }
-      change("camera.target", hit);
-      say(`Aimed at (${hit.map((v) => v.toPrecision(8)).join(", ")}).`);
-      refresh();
-    } catch (error) { alertShown(error.message); }
-  });
+    const pixel = clicked && pixelAt(event);
+    if (pixel) aimAt(pixel);
+  };
+  viewport.addEventListener("pointerup", (event) => release(event, true));
+  viewport.addEventListener("pointercancel", (event) => release(event, false));
+  viewport.addEventListener("lostpointercapture", (event) => release(event, false));
   viewport.addEventListener("wheel", async (event) => {
     event.preventDefault();
     const factor = Math.exp(Math.max(-1, Math.min(1, event.deltaY * 0.0015)));

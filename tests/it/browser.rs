@@ -1,0 +1,347 @@
+//! The explorer in a real browser: headless Chromium, driven through
+//! chromedriver (WebDriver), loads the page, orbits by dragging, zooms
+//! with the wheel, aims by clicking, keys and saves; the saved timeline
+//! then renders the frames the page showed.
+
+use crate::util::{tool, Dir};
+use fantoccini::actions::{InputSource, MouseActions, PointerAction, WheelAction, WheelActions};
+use fantoccini::{Client, Locator};
+use serde_json::{json, Value};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A child process killed when the test ends, however it ends.
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `mandelreel explore timeline` in `dir`, and the address it printed.
+fn explore(dir: &Dir, timeline: &str) -> (Killed, String) {
+    let mut child = dir
+        .command(&["explore", timeline])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("start explore");
+    let mut line = String::new();
+    let mut out = std::io::BufReader::new(child.stdout.take().expect("stdout"));
+    std::io::BufRead::read_line(&mut out, &mut line).expect("explore's first line");
+    let url = line
+        .split_whitespace()
+        .last()
+        .expect("an address")
+        .to_string();
+    assert!(url.starts_with("http://127.0.0.1:"), "{line}");
+    (Killed(child), url)
+}
+
+/// chromedriver on a free port, answering.
+fn chromedriver() -> (Killed, String) {
+    let port = std::net::TcpListener::bind("127.0.0.1:0")
+        .and_then(|l| l.local_addr())
+        .expect("a free port")
+        .port();
+    let child = Command::new("chromedriver")
+        .arg(format!("--port={port}"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start chromedriver");
+    let started = Instant::now();
+    while std::net::TcpStream::connect(("127.0.0.1", port)).is_err() {
+        assert!(
+            started.elapsed() < Duration::from_secs(20),
+            "chromedriver did not start"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    (Killed(child), format!("http://127.0.0.1:{port}"))
+}
+
+/// Headless Chromium as root in a container needs no sandbox, and must not
+/// reach out to the network it does not have.
+async fn browser(driver: &str, profile: &std::path::Path) -> Client {
+    let args = [
+        "--headless=new",
+        "--no-sandbox",
+        "--disable-gpu",
+        "--disable-dev-shm-usage",
+        "--disable-quic",
+        "--no-first-run",
+        "--disable-background-networking",
+        "--disable-component-update",
+        "--disable-sync",
+        "--window-size=1366,800",
+    ]
+    .map(String::from)
+    .into_iter()
+    .chain([format!("--user-data-dir={}", profile.display())])
+    .collect::<Vec<_>>();
+    let mut caps = serde_json::Map::new();
+    caps.insert("goog:chromeOptions".into(), json!({ "args": args }));
+    let connector = hyper_util::client::legacy::connect::HttpConnector::new();
+    fantoccini::ClientBuilder::new(connector)
+        .capabilities(caps)
+        .connect(driver)
+        .await
+        .expect("a browser session")
+}
+
+async fn js(client: &Client, script: &str) -> Value {
+    client.execute(script, vec![]).await.expect(script)
+}
+
+/// Waits until the page shows every sample of its latest view.
+async fn settled(client: &Client) {
+    let started = Instant::now();
+    let script = "const img = document.getElementById('view');
+        return !moving && img.dataset.stage === 'final' && Number(img.dataset.serial) === page.serial;";
+    while js(client, script).await != json!(true) {
+        let shown = "const img = document.getElementById('view');
+            return [document.getElementById('alert').textContent, img.dataset, page.serial, String(moving), page.dragging];";
+        let shown = js(client, shown).await;
+        assert!(
+            started.elapsed() < Duration::from_secs(60),
+            "never settled: {shown}"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// Waits until `condition` (a JavaScript expression) holds.
+async fn until(client: &Client, condition: &str) {
+    let started = Instant::now();
+    let script = format!("return Boolean({condition});");
+    while js(client, &script).await != json!(true) {
+        let alert = js(
+            client,
+            "return document.getElementById('alert').textContent",
+        )
+        .await;
+        assert!(
+            started.elapsed() < Duration::from_secs(30),
+            "never {condition}: {alert}"
+        );
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+/// The pixels of the PNG the page shows.
+async fn shown(client: &Client) -> Vec<u8> {
+    let script = "const done = arguments[arguments.length - 1];
+        page.shown.arrayBuffer().then((b) => done(Array.from(new Uint8Array(b))));";
+    let bytes = client
+        .execute_async(script, vec![])
+        .await
+        .expect("the image");
+    let bytes: Vec<u8> = serde_json::from_value(bytes).expect("bytes");
+    pixels(&bytes)
+}
+
+fn pixels(png_bytes: &[u8]) -> Vec<u8> {
+    image::load_from_memory(png_bytes)
+        .expect("a PNG")
+        .to_rgb8()
+        .into_raw()
+}
+
+/// The centre of the viewport element, in the window's coordinates.
+async fn centre(client: &Client) -> (f64, f64) {
+    let r = js(
+        client,
+        "const r = document.getElementById('view').getBoundingClientRect();
+        return [r.left + r.width / 2, r.top + r.height / 2];",
+    )
+    .await;
+    (r[0].as_f64().unwrap(), r[1].as_f64().unwrap())
+}
+
+/// A left-button drag from the image's centre by (dx, dy), in steps.
+async fn drag(client: &Client, (dx, dy): (f64, f64)) {
+    let (x, y) = centre(client).await;
+    let step = Some(Duration::from_millis(40));
+    let mut mouse = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x,
+            y,
+        })
+        .then(PointerAction::Down { button: 0 });
+    for i in 1..=4 {
+        let f = i as f64 / 4.0;
+        mouse = mouse.then(PointerAction::MoveTo {
+            duration: step,
+            x: x + dx * f,
+            y: y + dy * f,
+        });
+    }
+    mouse = mouse.then(PointerAction::Up { button: 0 });
+    client.perform_actions(mouse).await.expect("drag");
+}
+
+async fn click_at(client: &Client, (dx, dy): (f64, f64)) {
+    let (x, y) = centre(client).await;
+    let mouse = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: x + dx,
+            y: y + dy,
+        })
+        .then(PointerAction::Down { button: 0 })
+        .then(PointerAction::Up { button: 0 });
+    client.perform_actions(mouse).await.expect("click");
+}
+
+async fn wheel(client: &Client, delta_y: i64) {
+    let (x, y) = centre(client).await;
+    let mut wheel = WheelActions::new("wheel".into());
+    wheel.push(WheelAction::Scroll {
+        duration: None,
+        x: x as i64,
+        y: y as i64,
+        delta_x: 0,
+        delta_y,
+    });
+    client.perform_actions(wheel).await.expect("wheel");
+}
+
+/// The camera's distance from its target in the view.
+async fn distance(client: &Client) -> f64 {
+    let d = js(
+        client,
+        "return Math.hypot(...sub(value('camera.position'), value('camera.target')));",
+    )
+    .await;
+    d.as_f64().expect("a distance")
+}
+
+#[test]
+fn the_page_drags_zooms_keys_and_saves_what_render_renders() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    let dir = Dir::new();
+    let original = std::fs::read_to_string("timelines/zoom.ron")
+        .expect("zoom.ron")
+        .replace("size: (320, 180)", "size: (128, 72)");
+    dir.write("zoom.ron", &original);
+    let (_server, url) = explore(&dir, "zoom.ron");
+    let (_driver, driver_url) = chromedriver();
+    let profile = dir.path().join("chromium-profile");
+    let runtime = tokio::runtime::Runtime::new().expect("runtime");
+    let (seen_0, seen_12) = runtime.block_on(async {
+        let client = browser(&driver_url, &profile).await;
+        let seen = author(&client, &url).await;
+        if let Some(path) = std::env::var_os("MANDELREEL_EXPLORE_SCREENSHOT") {
+            std::fs::write(path, client.screenshot().await.expect("screenshot")).expect("write");
+        }
+        client.close().await.expect("close the browser");
+        seen
+    });
+    let saved = std::fs::read_to_string(dir.path().join("zoom.ron")).expect("saved");
+    for comment in original
+        .lines()
+        .filter(|l| l.trim_start().starts_with("//"))
+    {
+        assert!(saved.contains(comment), "lost the comment {comment:?}");
+    }
+    assert!(saved.contains("\"camera.position\""), "{saved}");
+    for (frame, seen) in [(0, seen_0), (12, seen_12)] {
+        let out = format!("r{frame}");
+        dir.ok(&[
+            "render",
+            "zoom.ron",
+            "--frames",
+            &frame.to_string(),
+            "--out",
+            &out,
+        ]);
+        let rendered = pixels(&dir.bytes(&format!("{out}/frame_{frame:05}.png")));
+        assert!(
+            rendered == seen,
+            "frame {frame}: the saved timeline renders other pixels than the page showed"
+        );
+    }
+}
+
+/// Makes keys at frames 0 and 12 by dragging, zooming and clicking, saves,
+/// and returns the pixels the page showed at each.
+async fn author(client: &Client, url: &str) -> (Vec<u8>, Vec<u8>) {
+    client.goto(url).await.expect("load the page");
+    settled(client).await;
+    let start = js(client, "return value('camera.position');").await;
+    drag(client, (80.0, 30.0)).await;
+    settled(client).await;
+    let moved = js(client, "return page.overrides['camera.position'];").await;
+    assert!(
+        moved.is_array() && moved != start,
+        "the drag did not orbit: {moved}"
+    );
+    let before = distance(client).await;
+    wheel(client, -300).await;
+    until(
+        client,
+        &format!(
+            "Math.hypot(...sub(value('camera.position'), value('camera.target'))) < {before} * 0.9"
+        ),
+    )
+    .await;
+    settled(client).await;
+    let seen_0 = shown(client).await;
+
+    // K, with the image focused, keys the changes.
+    let viewport = client
+        .find(Locator::Id("viewport"))
+        .await
+        .expect("viewport");
+    js(client, "document.getElementById('viewport').focus();").await;
+    viewport.send_keys("k").await.expect("press K");
+    until(client, "page.state.tracks.some((t) => t.name === 'camera.position') && !Object.keys(page.overrides).length").await;
+    settled(client).await;
+    assert!(
+        shown(client).await == seen_0,
+        "frame 0 keyed shows other pixels than before"
+    );
+
+    let frame = client
+        .find(Locator::Id("frame"))
+        .await
+        .expect("frame field");
+    frame.clear().await.expect("clear");
+    frame.send_keys("12\u{E007}").await.expect("type a frame");
+    until(client, "page.frame === 12").await;
+    settled(client).await;
+    drag(client, (-60.0, 0.0)).await;
+    settled(client).await;
+    click_at(client, (10.0, 5.0)).await;
+    until(client, "page.overrides['camera.target']").await;
+    settled(client).await;
+    let seen_12 = shown(client).await;
+    client
+        .find(Locator::Id("key"))
+        .await
+        .expect("key")
+        .click()
+        .await
+        .expect("key");
+    until(
+        client,
+        "page.state.tracks.find((t) => t.name === 'camera.position').keys.length === 2",
+    )
+    .await;
+
+    client
+        .find(Locator::Id("save"))
+        .await
+        .expect("save")
+        .click()
+        .await
+        .expect("save");
+    until(client, "!page.state.dirty").await;
+    (seen_0, seen_12)
+}
