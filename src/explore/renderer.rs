@@ -11,9 +11,10 @@ use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
 use std::time::Instant;
 
-/// The most pixels of the quick stage: about 20 ms on two cores for the
-/// benchmark's plain scene, so it shows within a frame of a drag.
-const QUICK_PIXELS: u64 = 160 * 90;
+/// The time the quick stage aims at: a drag's views follow the pointer.
+const QUICK_SECONDS: f64 = 0.05;
+/// The quick stage's fewest and most pixels, and its first guess.
+const QUICK_PIXELS: (u64, u64, u64) = (64 * 36, 320 * 180, 160 * 90);
 /// The most pixels of a playback frame.
 const PLAY_PIXELS: u64 = 320 * 180;
 
@@ -40,11 +41,23 @@ pub struct Picture {
 }
 
 /// The renders of one server: which view is current, and its progress.
-#[derive(Default)]
 pub struct Renders {
     generation: AtomicU64,
     pub rows_done: AtomicU32,
     pub rows_total: AtomicU32,
+    /// Pixels the next quick stage takes, from the pace of the last ones.
+    quick_pixels: AtomicU64,
+}
+
+impl Default for Renders {
+    fn default() -> Self {
+        Renders {
+            generation: AtomicU64::new(0),
+            rows_done: AtomicU32::new(0),
+            rows_total: AtomicU32::new(0),
+            quick_pixels: AtomicU64::new(QUICK_PIXELS.2),
+        }
+    }
 }
 
 impl Renders {
@@ -59,7 +72,7 @@ impl Renders {
         let stop = || stage != Stage::Play && self.generation.load(Ordering::SeqCst) != generation;
         let n = view.scenes[0].samples_per_pixel.max(1);
         let (width, height, samples) = match stage {
-            Stage::Quick => shrunk(view, QUICK_PIXELS),
+            Stage::Quick => shrunk(view, self.quick_pixels.load(Ordering::Relaxed)),
             Stage::Play => shrunk(view, PLAY_PIXELS),
             Stage::Full => (view.width, view.height, 1),
             Stage::Final => (view.width, view.height, n),
@@ -82,13 +95,27 @@ impl Renders {
             }
         };
         let film = accumulate(&scenes, view.frame, (width, height), &on_row, &stop)?;
+        let seconds = started.elapsed().as_secs_f64();
+        if matches!(stage, Stage::Quick | Stage::Full) {
+            self.pace((width * height) as f64 / seconds.max(1e-4));
+        }
         Some(Picture {
             png: png_bytes(&film, &view.hash, &scenes[0]),
             width,
             height,
             samples,
-            seconds: started.elapsed().as_secs_f64(),
+            seconds,
         })
+    }
+}
+
+impl Renders {
+    /// Sizes the next quick stage from `pixels_per_second` at one sample.
+    fn pace(&self, pixels_per_second: f64) {
+        let (fewest, most, _) = QUICK_PIXELS;
+        let pixels = (pixels_per_second * QUICK_SECONDS) as u64;
+        self.quick_pixels
+            .store(pixels.clamp(fewest, most), Ordering::Relaxed);
     }
 }
 
@@ -142,32 +169,41 @@ pub struct Estimate {
     pub seconds: f64,
     pub frames_measured: u32,
     pub measured_size: (u32, u32),
+    pub measured_samples: u32,
 }
 
-/// The frames measured for an estimate, evenly spaced, and their most pixels.
+/// The frames measured for an estimate, evenly spaced, their most pixels
+/// and samples: a second or so on two cores however many the view takes.
 const ESTIMATE_FRAMES: u32 = 5;
 const ESTIMATE_PIXELS: u64 = 96 * 54;
+const ESTIMATE_SAMPLES: u32 = 4;
 
-/// Times `ESTIMATE_FRAMES` frames of `timeline` at a small size and scales
-/// the time by pixels and frames: cost per pixel is about even at any size.
+/// Times a few frames of `timeline` small, at few samples, and scales the
+/// time by pixels, samples and frames: each costs about the same anywhere.
 pub fn estimate(timeline: &crate::timeline::Timeline, view: &Prepared) -> Estimate {
     let (w, h, _) = shrunk(view, ESTIMATE_PIXELS);
+    let n = view.scenes[0].samples_per_pixel.max(1);
+    let samples = n.min(ESTIMATE_SAMPLES);
+    let sampled = timeline.clone().with_samples(Some(samples));
     let count = timeline.frame_count.min(ESTIMATE_FRAMES);
     let started = Instant::now();
     for i in 0..count {
-        let frame =
-            (i as u64 * (timeline.frame_count - 1) as u64 / (count.max(2) - 1) as u64) as u32;
-        let scenes = timeline
-            .clone()
-            .with_samples(Some(view.scenes[0].samples_per_pixel))
-            .scenes_for_frame(frame);
-        accumulate(&scenes, frame, (w, h), &|| {}, &|| false);
+        let last = (timeline.frame_count - 1) as u64;
+        let frame = (i as u64 * last / (count.max(2) - 1) as u64) as u32;
+        accumulate(
+            &sampled.scenes_for_frame(frame),
+            frame,
+            (w, h),
+            &|| {},
+            &|| false,
+        );
     }
     let per_frame = started.elapsed().as_secs_f64() / count as f64;
-    let scale = (view.width as f64 * view.height as f64) / (w as f64 * h as f64);
+    let pixels = (view.width as f64 * view.height as f64) / (w as f64 * h as f64);
     Estimate {
-        seconds: per_frame * scale * timeline.frame_count as f64,
+        seconds: per_frame * pixels * (n as f64 / samples as f64) * timeline.frame_count as f64,
         frames_measured: count,
         measured_size: (w, h),
+        measured_samples: samples,
     }
 }

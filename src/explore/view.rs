@@ -81,9 +81,13 @@ impl View {
         })
     }
 
-    /// The overrides written into `scene`, which must stay valid.
+    /// The overrides written into `scene`, which must stay valid. The zoom's
+    /// distance goes last, as a timeline applies it: along the line from the
+    /// target through the position.
     fn lay_over(&self, scene: &mut Scene) -> Result<(), String> {
-        for (name, values) in &self.overrides {
+        let zoom = crate::timeline::ZOOM_TRACK;
+        let (last, first): (Vec<_>, Vec<_>) = self.overrides.iter().partition(|(n, _)| *n == zoom);
+        for (name, values) in first.into_iter().chain(last) {
             let parameter = crate::timeline::parameters::find(name)
                 .ok_or_else(|| format!("{name}: no such parameter"))?;
             let wanted = parameter.shape.components();

@@ -224,11 +224,18 @@ fn with_parts(text: &str, key: Range<usize>, parts: &[(&str, &str)]) -> Result<S
     Ok(written)
 }
 
-/// A new track with its one key, at the end of `tracks` (made where absent).
+/// A new track with its one key, at the end of `tracks` (made where absent):
+/// laid out over lines as the examples are, where `tracks` is.
 fn add_track(text: &str, track: &str, key: &str) -> Result<String, String> {
     let entry = format!("\"{track}\": (keys: [{key}])");
     match spans::block_at(text, &tracks_path()) {
-        Some(tracks) => Ok(insert(text, &tracks, tracks.children.len(), &entry)),
+        Some(tracks) => {
+            let entry = match text[tracks.inside.clone()].contains('\n') {
+                true => format!("\"{track}\": (\n    keys: [\n        {key},\n    ],\n)"),
+                false => entry,
+            };
+            Ok(insert(text, &tracks, tracks.children.len(), &entry))
+        }
         None if spans::range_at(text, &tracks_path()).is_some() => {
             Err("tracks is not a map".into())
         }
@@ -285,20 +292,42 @@ fn insert(text: &str, block: &Block, index: usize, entry: &str) -> String {
         return insert_after(text, block, index - 1, entry);
     }
     if block.children.is_empty() {
-        let at = block.inside.start;
-        return spliced(text, at..at, entry);
+        return insert_into_empty(text, block, entry);
     }
     let start = entry_start(text, block, 0);
     let line = line_start(text, start);
     if text[line..start].trim().is_empty() {
-        spliced(
-            text,
-            line..line,
-            &format!("{}{entry},\n", &text[line..start]),
-        )
+        let indent = &text[line..start];
+        let entry = indented(entry, indent);
+        spliced(text, line..line, &format!("{indent}{entry},\n"))
     } else {
         spliced(text, start..start, &format!("{entry}, "))
     }
+}
+
+/// `entry` as the only child of `block`: on a line of its own, indented a
+/// step past the closing bracket, where the empty block spans lines.
+fn insert_into_empty(text: &str, block: &Block, entry: &str) -> String {
+    let at = block.inside.start;
+    if !text[block.inside.clone()].contains('\n') {
+        return spliced(text, at..at, entry);
+    }
+    let close = block.inside.end;
+    let line = line_start(text, close);
+    let closing = &text[line..close];
+    let base = if closing.trim().is_empty() {
+        closing
+    } else {
+        ""
+    };
+    let indent = format!("{base}    ");
+    let entry = indented(entry, &indent);
+    spliced(text, at..at, &format!("\n{indent}{entry},"))
+}
+
+/// `entry`'s later lines indented as its first stands.
+fn indented(entry: &str, indent: &str) -> String {
+    entry.replace('\n', &format!("\n{indent}"))
 }
 
 fn insert_after(text: &str, block: &Block, index: usize, entry: &str) -> String {
@@ -313,6 +342,7 @@ fn insert_after(text: &str, block: &Block, index: usize, entry: &str) -> String 
             let line = line_start(text, entry_start(text, block, index));
             let indent = &text[line..line + text[line..].len() - text[line..].trim_start().len()];
             let comma_text = if comma.is_some() { "," } else { "" };
+            let entry = indented(entry, indent);
             let with_line = spliced(
                 text,
                 eol + 1..eol + 1,

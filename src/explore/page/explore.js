@@ -187,6 +187,8 @@ function orbit(dx, dy) {
 // Moves the camera and target towards `point` by `factor` (< 1 is closer):
 // the point stays where it is in the frame.
 function zoomAbout(point, factor) {
+  const typed = page.overrides["camera.distance"];
+  if (typed) change("camera.distance", [typed[0] * factor]);
   change("camera.position", add(point, scale(sub(value("camera.position"), point), factor)));
   if (point !== value("camera.target")) {
     change("camera.target", add(point, scale(sub(value("camera.target"), point), factor)));
@@ -237,12 +239,14 @@ async function pickAt(pixel) {
 function setUpViewport() {
   const viewport = $("viewport");
   let down = null;
+  // The drag follows the pointer over the whole window, not just the image.
   viewport.addEventListener("pointerdown", (event) => {
     if (event.button !== 0) return;
-    viewport.setPointerCapture(event.pointerId);
-    down = { x: event.clientX, y: event.clientY, moved: false, event };
+    event.preventDefault();
+    viewport.focus();
+    down = { x: event.clientX, y: event.clientY, moved: false };
   });
-  viewport.addEventListener("pointermove", (event) => {
+  window.addEventListener("pointermove", (event) => {
     if (!down) return;
     const dx = event.clientX - down.x, dy = event.clientY - down.y;
     if (!down.moved && Math.hypot(dx, dy) < 4) return;
@@ -255,7 +259,7 @@ function setUpViewport() {
     refreshSoon();
   });
   // A press that did not move is a click: aim at the surface point under it.
-  const release = async (event, clicked) => {
+  const release = (event, clicked) => {
     const was = down;
     down = null;
     viewport.classList.remove("dragging");
@@ -268,9 +272,8 @@ function setUpViewport() {
     const pixel = clicked && pixelAt(event);
     if (pixel) aimAt(pixel);
   };
-  viewport.addEventListener("pointerup", (event) => release(event, true));
-  viewport.addEventListener("pointercancel", (event) => release(event, false));
-  viewport.addEventListener("lostpointercapture", (event) => release(event, false));
+  window.addEventListener("pointerup", (event) => release(event, true));
+  window.addEventListener("pointercancel", (event) => release(event, false));
   viewport.addEventListener("wheel", async (event) => {
     event.preventDefault();
     const factor = Math.exp(Math.max(-1, Math.min(1, event.deltaY * 0.0015)));
@@ -329,6 +332,7 @@ function setUpKeys() {
 function changedNames() { return Object.keys(page.overrides); }
 
 function showChanges() {
+  fillControls();
   const names = changedNames();
   $("changed").textContent = names.length
     ? "Changed: " + names.map((n) => `${n} = ${format(page.overrides[n])}`).join("; ")
@@ -347,7 +351,8 @@ function format(numbers) {
 function changeKeys() {
   const time = page.frame / page.state.fps;
   const values = { ...page.overrides };
-  if (trackNamed("camera.distance") && (values["camera.position"] || values["camera.target"])) {
+  const moved = values["camera.position"] || values["camera.target"];
+  if (trackNamed("camera.distance") && moved && !values["camera.distance"]) {
     values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
   }
   return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
@@ -367,7 +372,8 @@ async function edit(edits, done) {
 
 function keyChanges() {
   if (!changedNames().length) { say("Nothing changed to key."); return; }
-  edit(changeKeys(), `Keyed ${changedNames().join(", ")} at frame ${page.frame}.`);
+  const edits = changeKeys();
+  edit(edits, `Keyed ${edits.map((e) => e.track).join(", ")} at frame ${page.frame}.`);
 }
 
 function setInScene() {
@@ -426,7 +432,8 @@ function drawStrip() {
       const selected = page.selected && page.selected.track === track.name && page.selected.index === index;
       if (selected) mark.classList.add("selected");
       mark.style.left = at(key.time);
-      mark.title = `${track.name} at ${key.time} s: ${format(key.value)}`;
+      const frame = Math.round(key.time * page.state.fps);
+      mark.title = `${track.name}, key at frame ${frame} (${Number(key.time.toFixed(4))} s): ${format(key.value)}`;
       mark.setAttribute("aria-label", mark.title);
       mark.dataset.track = track.name;
       mark.dataset.index = index;
@@ -481,7 +488,11 @@ function buildControls() {
 function fillControls() {
   for (const row of document.querySelectorAll(".param")) {
     const name = row.dataset.name;
-    const numbers = page.overrides[name] || page.values[name];
+    let numbers = page.overrides[name] || page.values[name];
+    // A moved camera's distance is the one it now stands at.
+    if (name === "camera.distance" && !page.overrides[name]) {
+      numbers = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
+    }
     row.classList.toggle("changed", name in page.overrides);
     row.querySelectorAll("input").forEach((input, i) => {
       input.value = numbers ? Number(numbers[i].toPrecision(10)) : "";
@@ -599,7 +610,8 @@ function setUp() {
       const e = await (await api("/api/estimate", currentView(false))).json();
       $("estimate-result").textContent =
         `About ${duration(e.seconds)} for all ${page.state.frames} frames on this machine ` +
-        `(from ${e.frames_measured} frames rendered at ${e.measured_size.join("x")}, scaled by pixels).`;
+        `(from ${e.frames_measured} frames rendered at ${e.measured_size.join("x")} with ` +
+        `${e.measured_samples} sample(s), scaled by pixels and samples).`;
     } catch (error) { $("estimate-result").textContent = error.message; }
   };
   listen();

@@ -467,3 +467,38 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_track_in_an_empty_block_over_lines_is_laid_out_as_the_examples_are() {
+    let text = "(\n    fps: 10,\n    frames: 11,\n    size: (8, 6),\n    tracks: {\n    },\n)\n";
+    let set = |text: &str, time: Real, value: Real| {
+        edited(
+            text,
+            Edit::SetKey {
+                track: "fractal.power".into(),
+                time,
+                value: KeyValue::Number(value),
+            },
+        )
+    };
+    let one = set(text, 0.0, 7.0);
+    let expected = "    tracks: {\n        \"fractal.power\": (\n            keys: [\n                (time: 0, value: 7),\n            ],\n        ),\n    },\n";
+    assert!(one.contains(expected), "{one}");
+    let two = set(&one, 1.0, 9.0);
+    assert!(
+        two.contains("                (time: 1, value: 9),\n            ],"),
+        "{two}"
+    );
+    assert_eq!(
+        parsed(&two, Path::new("t.ron"))
+            .scene_at_time(1.0)
+            .fractal
+            .power,
+        9.0
+    );
+    let delete = Edit::DeleteKey {
+        track: "fractal.power".into(),
+        index: 0,
+    };
+    assert_eq!(edited(&edited(&two, delete.clone()), delete), text);
+}
