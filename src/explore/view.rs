@@ -129,3 +129,64 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
         })
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn zoom() -> Timeline {
+        let text = std::fs::read_to_string("timelines/zoom.ron").unwrap();
+        Timeline::parse(&text, Path::new("zoom.ron")).unwrap()
+    }
+
+    #[test]
+    fn a_typed_distance_places_the_moved_camera_along_its_line() {
+        let mut view = View {
+            frame: 30,
+            ..View::default()
+        };
+        view.overrides.insert("camera.distance".into(), vec![0.5]);
+        view.overrides
+            .insert("camera.position".into(), vec![0.0, 1.0, 3.0]);
+        view.overrides
+            .insert("camera.target".into(), vec![0.0, 1.0, 0.0]);
+        let camera = &view.prepare(&zoom()).unwrap().scenes[0].camera;
+        assert!((camera.position - crate::math::DVec3::new(0.0, 1.0, 0.5)).length() < 1e-12);
+    }
+
+    #[test]
+    fn values_are_the_frames_and_the_distance_is_the_cameras() {
+        let t = zoom();
+        let values = values(&t, 119);
+        let scene = t.scene_at(119);
+        let distance = (scene.camera.position - scene.camera.target).length();
+        assert_eq!(values["camera.distance"], Some(vec![distance]));
+        assert_eq!(values["fractal.iterations"], Some(vec![18.0]));
+        assert_eq!(values["fractal.julia"], None);
+    }
+
+    #[test]
+    fn bad_views_say_what_is_wrong() {
+        let t = zoom();
+        let error = |view: View| view.prepare(&t).err().unwrap();
+        let at = |name: &str, v: Vec<f64>| View {
+            overrides: [(name.to_string(), v)].into(),
+            ..View::default()
+        };
+        assert!(error(View {
+            frame: 120,
+            ..View::default()
+        })
+        .contains("past the last frame (119)"));
+        assert!(error(at("camera.nope", vec![1.0])).contains("no such parameter"));
+        assert!(error(at("camera.position", vec![1.0])).contains("takes 3 numbers"));
+        assert!(error(at("camera.fov_degrees", vec![f64::NAN])).contains("finite"));
+        assert!(error(at("camera.fov_degrees", vec![0.0])).contains("fov_degrees"));
+        let huge = View {
+            size: Some("3841x2160".into()),
+            ..View::default()
+        };
+        assert!(error(huge).contains("at most 3840x2160"));
+    }
+}

@@ -615,7 +615,10 @@ function setUp() {
     } catch (error) { $("estimate-result").textContent = error.message; }
   };
   listen();
-  loadState().catch((error) => alertShown(error.message));
+  // The estimate once the first view has had its turn.
+  loadState()
+    .then(() => setTimeout(() => $("estimate").click(), 2000))
+    .catch((error) => alertShown(error.message));
 }
 
 function duration(seconds) {
