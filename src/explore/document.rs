@@ -10,10 +10,17 @@ use std::path::{Path, PathBuf};
 /// A new timeline's text, where `explore` starts without one.
 const STARTER: &str = include_str!("starter.ron");
 
+/// Edits in one request: enough for any key the page makes, few enough
+/// that checking each result stays well under a second.
+pub const MAX_EDITS: usize = 64;
+
 pub struct Document {
     folder: PathBuf,
-    /// Where Save writes; none until a new timeline is named.
+    /// The file as the user named it; none until a new timeline is named.
     path: Option<PathBuf>,
+    /// The file Save writes: through a link, the file it names, whose own
+    /// permissions are kept.
+    target: Option<(PathBuf, Option<std::fs::Permissions>)>,
     pub text: String,
     /// The file's text when last read or written (none for a new timeline).
     saved: Option<String>,
@@ -22,6 +29,8 @@ pub struct Document {
     /// The file's text at the last look, taken in only once two looks
     /// agree: an editor that writes in place is seen half-way through.
     last_look: Option<String>,
+    /// The file holds text this session has neither taken in nor written.
+    disk_changed: bool,
     pub timeline: Timeline,
 }
 
@@ -30,16 +39,14 @@ impl Document {
     /// none, a new one in the current folder.
     pub fn open(path: Option<&Path>) -> anyhow::Result<Document> {
         let Some(path) = path else {
-            let name = Path::new("untitled.ron");
-            return Ok(Document {
-                folder: std::env::current_dir()?,
-                path: None,
-                text: STARTER.to_string(),
-                saved: None,
-                edited: false,
-                last_look: None,
-                timeline: Timeline::parse(STARTER, name)?,
-            });
+            let timeline = Timeline::parse(STARTER, Path::new("untitled.ron"))?;
+            return Ok(Document::new(
+                std::env::current_dir()?,
+                None,
+                None,
+                timeline,
+                STARTER,
+            ));
         };
         let text = crate::timeline::read_text(path)?;
         let timeline = Timeline::parse(&text, path)?;
@@ -47,15 +54,31 @@ impl Document {
             Some(p) if !p.as_os_str().is_empty() => p.to_path_buf(),
             _ => PathBuf::from("."),
         };
-        Ok(Document {
+        let real = std::fs::canonicalize(path).map_err(|e| crate::error::Error::io(path, e))?;
+        let mode = std::fs::metadata(&real).ok().map(|m| m.permissions());
+        let mut document = Document::new(folder, Some(path), Some((real, mode)), timeline, &text);
+        document.saved = Some(text);
+        Ok(document)
+    }
+
+    fn new(
+        folder: PathBuf,
+        path: Option<&Path>,
+        target: Option<(PathBuf, Option<std::fs::Permissions>)>,
+        timeline: Timeline,
+        text: &str,
+    ) -> Document {
+        Document {
             folder,
-            path: Some(path.to_path_buf()),
-            saved: Some(text.clone()),
+            path: path.map(Path::to_path_buf),
+            target,
+            text: text.to_string(),
+            saved: None,
             edited: false,
             last_look: None,
-            text,
+            disk_changed: false,
             timeline,
-        })
+        }
     }
 
     /// The file's name, or `untitled.ron` before it has one.
@@ -74,10 +97,21 @@ impl Document {
         self.edited || self.saved.is_none()
     }
 
+    /// The file changed on disk since this session last read or wrote it.
+    pub fn disk_changed(&self) -> bool {
+        self.disk_changed
+    }
+
     /// Applies `edits` in turn; all of them take, or none (the first that
     /// fails, or a result that is not a valid timeline, is the error, placed
     /// at its line as the command line places it).
     pub fn edit(&mut self, edits: &[Edit]) -> Result<(), String> {
+        if edits.len() > MAX_EDITS {
+            return Err(format!(
+                "at most {MAX_EDITS} edits at once, got {}",
+                edits.len()
+            ));
+        }
         let mut text = self.text.clone();
         for edit in edits {
             text = crate::timeline::edit::apply(&text, edit)?;
@@ -87,8 +121,16 @@ impl Document {
         Ok(())
     }
 
-    /// `text` in place of the document's, where it is a valid timeline.
+    /// `text` in place of the document's, where it is a valid timeline
+    /// that `render` would read.
     fn take(&mut self, text: String) -> Result<(), String> {
+        let most = crate::timeline::MAX_TIMELINE_BYTES;
+        if text.len() as u64 > most {
+            let mib = most >> 20;
+            return Err(format!(
+                "the timeline would be longer than {mib} MiB, which render refuses"
+            ));
+        }
         let shown = self.path.clone().unwrap_or_else(|| self.name().into());
         let timeline = Timeline::parse(&text, &shown).map_err(|e| format!("{e:#}"))?;
         (self.text, self.timeline) = (text, timeline);
@@ -98,22 +140,29 @@ impl Document {
     /// Writes the text to its file, or to `new_name`: a new file in the
     /// same folder, which becomes the document's file.
     pub fn save(&mut self, new_name: Option<&str>) -> Result<PathBuf, String> {
-        let path = match new_name {
-            Some(name) => self.create(name)?,
-            None => self
-                .path
-                .clone()
-                .ok_or("a new timeline needs a file name to be saved under")?,
+        let (path, target) = match new_name {
+            Some(name) => {
+                let path = self.create(name)?;
+                (path.clone(), (path, None))
+            }
+            None => match (&self.path, &self.target) {
+                (Some(path), Some(target)) => (path.clone(), target.clone()),
+                _ => return Err("a new timeline needs a file name to be saved under".into()),
+            },
         };
-        let text = self.text.clone();
-        crate::output::atomic::write_atomic(&path, |writer, temp| {
-            use std::io::Write as _;
-            writer
-                .write_all(text.as_bytes())
-                .map_err(|e| crate::error::Error::io(temp, e))
-        })
-        .map_err(|e| format!("{e:#}"))?;
-        (self.path, self.saved, self.edited) = (Some(path.clone()), Some(text), false);
+        if let Err(e) = write(&target.0, &self.text) {
+            if new_name.is_some() {
+                // The empty file made to claim the name goes with the save.
+                let _ = std::fs::remove_file(&target.0);
+            }
+            return Err(e);
+        }
+        if let Some(mode) = &target.1 {
+            let _ = std::fs::set_permissions(&target.0, mode.clone());
+        }
+        (self.path, self.target) = (Some(path.clone()), Some(target));
+        (self.saved, self.edited) = (Some(self.text.clone()), false);
+        self.disk_changed = false;
         Ok(path)
     }
 
@@ -148,13 +197,12 @@ impl Document {
 
     /// Reads the file again, dropping edits not saved.
     pub fn reload(&mut self) -> Result<(), String> {
-        let path = self
-            .path
-            .clone()
-            .ok_or("a new timeline has no file to reload")?;
+        let Some(path) = self.path.clone() else {
+            return Err("a new timeline has no file to reload".into());
+        };
         let text = crate::timeline::read_text(&path).map_err(|e| format!("{e:#}"))?;
         self.take(text.clone())?;
-        (self.saved, self.edited) = (Some(text), false);
+        (self.saved, self.edited, self.disk_changed) = (Some(text), false, false);
         Ok(())
     }
 
@@ -171,6 +219,7 @@ impl Document {
         }
         self.saved = Some(text.clone());
         if self.edited {
+            self.disk_changed = true;
             return Some(Event::File {
                 dirty: true,
                 error: None,
@@ -179,9 +228,21 @@ impl Document {
         // An invalid file is shown as its error, and the last valid text
         // stays what the page renders until the file is mended.
         let error = self.take(text).err();
+        self.disk_changed = error.is_some();
         Some(Event::File {
             dirty: false,
             error,
         })
     }
+}
+
+/// `text` written over `path` whole, through a temporary file.
+fn write(path: &Path, text: &str) -> Result<(), String> {
+    crate::output::atomic::write_atomic(path, |writer, temp| {
+        use std::io::Write as _;
+        writer
+            .write_all(text.as_bytes())
+            .map_err(|e| crate::error::Error::io(temp, e))
+    })
+    .map_err(|e| format!("{e:#}"))
 }

@@ -158,10 +158,10 @@ async fn render(state: Shared, Json(request): Json<RenderRequest>) -> Response {
         Ok(p) => p,
         Err(message) => return refused(StatusCode::UNPROCESSABLE_ENTITY, message),
     };
-    let generation = match (request.generation, request.stage) {
-        (Some(g), _) => g,
-        (None, Stage::Play) => 0,
-        (None, _) => state.renders.begin(),
+    // A first stage, or a playback frame, stops the view's render before it.
+    let generation = match request.generation {
+        Some(g) => g,
+        None => state.renders.begin(),
     };
     let shared = state.clone();
     let picture = tokio::task::spawn_blocking(move || {
@@ -312,12 +312,12 @@ struct EditsRequest {
 }
 
 async fn edit(state: Shared, Json(request): Json<EditsRequest>) -> Response {
-    let edits: Result<Vec<_>, String> = request.edits.into_iter().map(EditRequest::edit).collect();
-    let mut document = state.document.lock().expect("document");
-    match edits.and_then(|edits| document.edit(&edits)) {
-        Ok(()) => Json(state_of(&document)).into_response(),
-        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    if request.edits.len() > super::document::MAX_EDITS {
+        let message = format!("at most {} edits at once", super::document::MAX_EDITS);
+        return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
     }
+    let edits: Result<Vec<_>, String> = request.edits.into_iter().map(EditRequest::edit).collect();
+    with_document(state.0, move |document| document.edit(&edits?)).await
 }
 
 #[derive(Deserialize)]
@@ -326,34 +326,59 @@ struct SaveRequest {
     /// A new file in the timeline's folder; none saves the timeline itself.
     #[serde(default)]
     name: Option<String>,
+    /// Write over the file though it changed on disk since it was read.
+    #[serde(default)]
+    overwrite: bool,
 }
 
 async fn save(state: Shared, Json(request): Json<SaveRequest>) -> Response {
-    let mut document = state.document.lock().expect("document");
-    match document.save(request.name.as_deref()) {
-        Ok(_) => Json(state_of(&document)).into_response(),
-        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    let changed = state.document.lock().expect("document").disk_changed();
+    if changed && request.name.is_none() && !request.overwrite {
+        let message = "the file changed on disk since it was read: Reload takes it in, Save as writes a new file, or save again to write over it";
+        return refused(StatusCode::CONFLICT, message);
     }
+    with_document(state.0, move |document| {
+        document.save(request.name.as_deref()).map(drop)
+    })
+    .await
 }
 
 async fn reload(state: Shared) -> Response {
-    let mut document = state.document.lock().expect("document");
-    match document.reload() {
-        Ok(()) => Json(state_of(&document)).into_response(),
-        Err(message) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+    with_document(state.0, |document| document.reload()).await
+}
+
+/// Runs `change` on the document off the async threads (parsing a long
+/// timeline takes a while), and answers with the new state or the error.
+async fn with_document(
+    state: Arc<State>,
+    change: impl FnOnce(&mut super::Document) -> Result<(), String> + Send + 'static,
+) -> Response {
+    let answer = tokio::task::spawn_blocking(move || {
+        let mut document = state.document.lock().expect("document");
+        change(&mut document).map(|()| state_of(&document))
+    })
+    .await;
+    match answer {
+        Ok(Ok(shown)) => Json(shown).into_response(),
+        Ok(Err(message)) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+        Err(e) => refused(StatusCode::INTERNAL_SERVER_ERROR, format!("failed: {e}")),
     }
 }
 
 /// File changes and render progress, as they happen.
 async fn events(state: Shared) -> Response {
-    let receiver = state.events.subscribe();
-    let stream = futures_util::stream::unfold(receiver, |mut receiver| async move {
+    let listening = (state.events.subscribe(), state.closing.subscribe());
+    let stream = futures_util::stream::unfold(listening, |(mut events, mut closing)| async move {
         loop {
-            match receiver.recv().await {
+            let received = tokio::select! {
+                received = events.recv() => received,
+                _ = closing.wait_for(|&closed| closed) => return None,
+            };
+            match received {
                 Ok(event) => {
                     let data = serde_json::to_string(&event).unwrap_or_default();
                     let sse = axum::response::sse::Event::default().data(data);
-                    return Some((Ok::<_, std::convert::Infallible>(sse), receiver));
+                    return Some((Ok::<_, std::convert::Infallible>(sse), (events, closing)));
                 }
                 Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
                 Err(_) => return None,

@@ -87,7 +87,7 @@ impl View {
     fn lay_over(&self, scene: &mut Scene) -> Result<(), String> {
         let zoom = crate::timeline::ZOOM_TRACK;
         let (last, first): (Vec<_>, Vec<_>) = self.overrides.iter().partition(|(n, _)| *n == zoom);
-        for (name, values) in first.into_iter().chain(last) {
+        for (name, values) in first.iter().chain(&last) {
             let parameter = crate::timeline::parameters::find(name)
                 .ok_or_else(|| format!("{name}: no such parameter"))?;
             let wanted = parameter.shape.components();
@@ -100,7 +100,21 @@ impl View {
             if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
                 return Err(format!("{name}: values must be finite, got {bad}"));
             }
+            if *name == zoom && values[0] <= 0.0 {
+                return Err(format!(
+                    "{name}: a camera distance must be positive, got {}",
+                    values[0]
+                ));
+            }
             (parameter.set)(scene, values);
+        }
+        // A field of an effect the scene leaves off takes no value.
+        let shown = serde_json::to_value(&*scene).unwrap_or_default();
+        if let Some((name, _)) = first.iter().find(|(name, _)| field(&shown, name).is_none()) {
+            let effect = name.rsplit_once('.').map_or(name.as_str(), |(e, _)| e);
+            return Err(format!(
+                "{name}: the scene leaves {effect} off; turn it on in the timeline first"
+            ));
         }
         crate::timeline::validate_scene(scene)
             .map_err(|(field, message)| format!("{field}: {message}"))
@@ -119,15 +133,19 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
             if p.name == crate::timeline::ZOOM_TRACK {
                 return (p.name, Some(vec![distance]));
             }
-            let field = p.name.split('.').try_fold(&scene, |v, step| v.get(step));
-            let numbers = field.and_then(|v| match v {
-                serde_json::Value::Number(n) => Some(vec![n.as_f64()?]),
-                serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
-                _ => None,
-            });
-            (p.name, numbers)
+            (p.name, field(&scene, p.name))
         })
         .collect()
+}
+
+/// The numbers at parameter `name`'s field of a scene written as JSON.
+fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
+    let value = name.split('.').try_fold(scene, |v, step| v.get(step))?;
+    match value {
+        serde_json::Value::Number(n) => Some(vec![n.as_f64()?]),
+        serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+        _ => None,
+    }
 }
 
 #[cfg(test)]
@@ -183,6 +201,8 @@ mod tests {
         assert!(error(at("camera.position", vec![1.0])).contains("takes 3 numbers"));
         assert!(error(at("camera.fov_degrees", vec![f64::NAN])).contains("finite"));
         assert!(error(at("camera.fov_degrees", vec![0.0])).contains("fov_degrees"));
+        assert!(error(at("camera.distance", vec![-1.0])).contains("positive"));
+        assert!(error(at("effects.glow.strength", vec![1.0])).contains("leaves effects.glow off"));
         let huge = View {
             size: Some("3841x2160".into()),
             ..View::default()

@@ -18,8 +18,11 @@ pub async fn watch(state: Arc<State>) {
     loop {
         tokio::select! {
             _ = file.tick() => {
-                let changed = state.document.lock().expect("document").check_disk();
-                if let Some(event) = changed {
+                let looked = state.clone();
+                let changed = tokio::task::spawn_blocking(move || {
+                    looked.document.lock().expect("document").check_disk()
+                });
+                if let Ok(Some(event)) = changed.await {
                     super::routes::announce(&state, event);
                 }
             }

@@ -38,8 +38,18 @@ const SAME_TIME: Real = 1e-9;
 /// Scene fields held as whole numbers: RON refuses `8.5` (or `8.0`) there.
 const WHOLE_NUMBERS: [&str; 2] = ["fractal.iterations", "quality.max_steps"];
 
-/// `text` with `edit` made, or what stops it.
+/// `text` with `edit` made, or what stops it. A file whose lines all end
+/// in CR LF keeps them so: it is edited with LF and turned back.
 pub fn apply(text: &str, edit: &Edit) -> Result<String, String> {
+    let crlf = text.contains("\r\n") && text.matches('\n').count() == text.matches("\r\n").count();
+    if crlf {
+        let edited = apply_lf(&text.replace("\r\n", "\n"), edit)?;
+        return Ok(edited.replace('\n', "\r\n"));
+    }
+    apply_lf(text, edit)
+}
+
+fn apply_lf(text: &str, edit: &Edit) -> Result<String, String> {
     spans::block_at(text, &[]).ok_or("the text is not a timeline in RON: `( … )`")?;
     match edit {
         Edit::SetScene { parameter, value } => set_scene(text, parameter, value),

@@ -53,7 +53,7 @@ pub struct Timeline {
 /// a file past this (`/dev/zero`) is refused before it fills the memory. At
 /// 1 MiB an error's place is found within a second (`spans` reads the text
 /// once per level of the field path, and RON reads about 5 MB/s untyped).
-const MAX_TIMELINE_BYTES: u64 = 1 << 20;
+pub const MAX_TIMELINE_BYTES: u64 = 1 << 20;
 
 /// A timeline file's text: a regular file (a FIFO is refused, not waited
 /// on), at most `MAX_TIMELINE_BYTES`, UTF-8 (a byte that is not is a syntax

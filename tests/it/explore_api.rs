@@ -316,6 +316,11 @@ fn the_final_stage_is_renders_frame() {
             pixels(&shown.body) == pixels(&written),
             "{view}: the final stage's pixels differ from render's"
         );
+        // The whole file, its hash and statistics as well.
+        assert!(
+            shown.body == written,
+            "{view}: the PNG differs from render's"
+        );
         assert_eq!(shown.header("content-type"), Some("image/png"));
         assert_eq!(shown.header("x-size"), Some(size));
         assert_eq!(shown.header("x-samples"), Some(samples));
@@ -551,5 +556,87 @@ fn a_pick_at_the_centre_of_the_zoom_finds_its_target() {
             (got - want).abs() < 1e-3,
             "axis {axis}: {got} vs {want}: {report}"
         );
+    }
+}
+
+#[test]
+fn save_does_not_silently_write_over_a_file_changed_on_disk() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let mut events = s.events();
+    // The editor's text is not valid yet: the page keeps the last valid one.
+    replace(&d, "t.ron", "(fps: 0, size: (8, 6))");
+    assert!(next_file_event(&mut events)["error"].is_string());
+    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
+    s.post("/api/edit", edit).expect(200);
+    let refused = s.post("/api/save", json!({})).expect(409);
+    assert!(
+        refused.text().contains("changed on disk"),
+        "{}",
+        refused.text()
+    );
+    assert_eq!(d.bytes("t.ron"), b"(fps: 0, size: (8, 6))");
+    s.post("/api/save", json!({"overwrite": true})).expect(200);
+    assert!(String::from_utf8(d.bytes("t.ron"))
+        .unwrap()
+        .contains("value: 10"));
+}
+
+#[cfg(unix)]
+#[test]
+fn save_writes_through_a_link_and_keeps_the_files_mode() {
+    use std::os::unix::fs::PermissionsExt;
+    let d = Dir::new();
+    std::fs::create_dir(d.path().join("real")).unwrap();
+    let real = d.write("real/t.ron", &tiny_timeline(2, 9.0));
+    std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o600)).unwrap();
+    std::os::unix::fs::symlink("real/t.ron", d.path().join("link.ron")).unwrap();
+    let s = explore(&d, "link.ron");
+    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
+    s.post("/api/edit", edit).expect(200);
+    s.post("/api/save", json!({})).expect(200);
+    let link = std::fs::symlink_metadata(d.path().join("link.ron")).unwrap();
+    assert!(
+        link.file_type().is_symlink(),
+        "the link was replaced by a file"
+    );
+    assert!(std::fs::read_to_string(&real)
+        .unwrap()
+        .contains("value: 10"));
+    let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
+    assert_eq!(mode, 0o600);
+}
+
+#[test]
+fn many_edits_at_once_are_refused_and_the_text_kept() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let before = s.state()["text"].clone();
+    let edits: Vec<Value> = (0..65)
+        .map(|i| json!({"kind": "set_key", "track": "fractal.power", "time": 0.01 * i as f64 + 0.1, "value": [9]}))
+        .collect();
+    let refused = s.post("/api/edit", json!({ "edits": edits })).expect(422);
+    assert!(refused.text().contains("at most 64"), "{}", refused.text());
+    assert_eq!(s.state()["text"], before);
+}
+
+#[cfg(unix)]
+#[test]
+fn an_interrupt_stops_the_server_while_a_page_listens() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let mut s = explore(&d, "t.ron");
+    let _events = s.events();
+    let pid = nix::unistd::Pid::from_raw(s.child.id() as i32);
+    nix::sys::signal::kill(pid, nix::sys::signal::Signal::SIGINT).unwrap();
+    let started = std::time::Instant::now();
+    while s.child.try_wait().unwrap().is_none() {
+        assert!(
+            started.elapsed() < Duration::from_secs(4),
+            "still serving after Ctrl-C"
+        );
+        std::thread::sleep(Duration::from_millis(20));
     }
 }

@@ -67,7 +67,7 @@ async function loadState(state) {
   $("plan").textContent = s.plan.join("\n");
   $("command").textContent = s.command;
   $("text").textContent = s.text;
-  if (page.selected && !trackNamed(page.selected.track)) page.selected = null;
+  page.selected = reselected(page.selected);
   buildControls();
   await showFrame(page.frame);
 }
@@ -75,10 +75,13 @@ async function loadState(state) {
 function trackNamed(name) { return page.state.tracks.find((t) => t.name === name); }
 
 async function showFrame(frame) {
-  page.frame = Math.max(0, Math.min(page.state.frames - 1, frame | 0));
-  $("frame").value = $("slider").value = page.frame;
-  $("time").textContent = `t = ${(page.frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
-  page.values = await (await api(`/api/values?frame=${page.frame}`)).json();
+  frame = Math.max(0, Math.min(page.state.frames - 1, frame | 0));
+  page.frame = frame;
+  $("frame").value = $("slider").value = frame;
+  $("time").textContent = `t = ${(frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
+  const values = await (await api(`/api/values?frame=${frame}`)).json();
+  if (page.frame !== frame) return;  // a later frame was asked for meanwhile
+  page.values = values;
   drawStrip();
   fillControls();
   refresh();
@@ -179,8 +182,10 @@ function orbit(dx, dy) {
   away = rotate(away, up, -dx * 0.008);
   const right = norm(cross(up, away));
   const turned = rotate(away, right, -dy * 0.008);
-  // Not over the pole: the view would flip about the up direction.
-  if (Math.abs(dot(norm(turned), up)) < 0.995) away = turned;
+  // Not over the pole, where the view would flip about the up direction;
+  // a turn away from it is always taken.
+  const pole = (v) => Math.abs(dot(norm(v), up));
+  if (pole(turned) < 0.995 || pole(turned) < pole(away)) away = turned;
   change("camera.position", add(target, away));
 }
 
@@ -248,6 +253,8 @@ function setUpViewport() {
   });
   window.addEventListener("pointermove", (event) => {
     if (!down) return;
+    // Released outside the window: no pointerup came.
+    if (event.buttons === 0) { release(event, false); return; }
     const dx = event.clientX - down.x, dy = event.clientY - down.y;
     if (!down.moved && Math.hypot(dx, dy) < 4) return;
     down.moved = true;
@@ -299,7 +306,11 @@ function setUpViewport() {
 
 function setUpKeys() {
   document.addEventListener("keydown", (event) => {
-    if (event.ctrlKey && event.key === "s") { event.preventDefault(); save(null); return; }
+    if ((event.ctrlKey || event.metaKey) && event.key.toLowerCase() === "s") {
+      event.preventDefault();
+      save(null);
+      return;
+    }
     const typing = ["INPUT", "TEXTAREA", "SELECT"].includes(document.activeElement.tagName);
     if (typing || event.ctrlKey || event.metaKey || event.altKey) return;
     const actions = {
@@ -351,9 +362,15 @@ function format(numbers) {
 function changeKeys() {
   const time = page.frame / page.state.fps;
   const values = { ...page.overrides };
+  // A zoom track places the camera along the line from the target through
+  // the position track's value: key all three as the view has them.
   const moved = values["camera.position"] || values["camera.target"];
-  if (trackNamed("camera.distance") && moved && !values["camera.distance"]) {
-    values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
+  if (trackNamed("camera.distance") && moved) {
+    values["camera.position"] = value("camera.position");
+    values["camera.target"] = value("camera.target");
+    if (!values["camera.distance"]) {
+      values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
+    }
   }
   return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
 }
@@ -376,10 +393,18 @@ function keyChanges() {
   edit(edits, `Keyed ${edits.map((e) => e.track).join(", ")} at frame ${page.frame}.`);
 }
 
+// The zoom's distance is a track's alone, and a zoom track places the camera
+// whatever the scene says: such changes are keyed, not set.
 function setInScene() {
-  if (!changedNames().length) return;
-  const edits = Object.entries(page.overrides).map(([parameter, v]) => ({ kind: "set_scene", parameter, value: v }));
-  edit(edits, `Set ${changedNames().join(", ")} in the scene.`);
+  const names = changedNames().filter((n) => n !== "camera.distance");
+  const camera = names.some((n) => n.startsWith("camera.position") || n.startsWith("camera.target"));
+  if (changedNames().includes("camera.distance") || (camera && trackNamed("camera.distance"))) {
+    alertShown("The camera's distance is set by the camera.distance track: key the camera (K) instead.");
+    return;
+  }
+  if (!names.length) return;
+  const edits = names.map((parameter) => ({ kind: "set_scene", parameter, value: page.overrides[parameter] }));
+  edit(edits, `Set ${names.join(", ")} in the scene.`);
 }
 
 function discard() {
@@ -391,7 +416,9 @@ function discard() {
 function moveSelected() {
   const s = page.selected;
   if (!s) { say("Select a key first."); return; }
-  edit([{ kind: "move_key", track: s.track, index: s.index, time: page.frame / page.state.fps }],
+  const time = page.frame / page.state.fps;
+  page.selected = { ...s, time };
+  edit([{ kind: "move_key", track: s.track, index: s.index, time }],
     `Moved the key of ${s.track} to frame ${page.frame}.`);
 }
 
@@ -438,7 +465,7 @@ function drawStrip() {
       mark.dataset.track = track.name;
       mark.dataset.index = index;
       mark.addEventListener("click", () => {
-        page.selected = { track: track.name, index };
+        page.selected = { track: track.name, index, time: key.time };
         $("selected").textContent = `Selected: ${mark.title}`;
         showFrame(Math.round(key.time * page.state.fps));
       });
@@ -447,6 +474,14 @@ function drawStrip() {
     row.append(label, lane);
     strip.append(row);
   }
+}
+
+// The selected key found again by its time, as the keys may have moved.
+function reselected(selected) {
+  const track = selected && trackNamed(selected.track);
+  const index = track ? track.keys.findIndex((k) => Math.abs(k.time - selected.time) < 1e-9) : -1;
+  if (index < 0) { $("selected").textContent = "No key selected."; return null; }
+  return { ...selected, index };
 }
 
 // ---- the parameters -----------------------------------------------------------------
@@ -511,45 +546,59 @@ function changeFromControl(row, name) {
 
 // ---- playback -----------------------------------------------------------------------
 
+// Plays from this frame until stopped, then shows the last frame played.
 async function togglePlay() {
-  if (page.playing) { page.playing = false; $("play").textContent = "Play"; refresh(); return; }
-  page.playing = true;
+  if (page.playing) { page.playing = false; return; }
+  const run = page.playing = {};
   $("play").textContent = "Stop";
   const version = page.state;
-  let frame = page.frame;
-  while (page.playing && page.state === version) {
+  page.serial++;  // the view's stages in flight are dropped
+  let frame = page.frame, shown = page.frame;
+  while (page.playing === run && page.state === version) {
     const started = performance.now();
-    let url = page.playCache.get(frame);
+    const view = { ...currentView(false), frame };
+    const cached = `${frame} ${view.size || ""} ${view.samples || ""}`;
+    let url = page.playCache.get(cached);
     if (!url) {
       try {
-        const response = await api("/api/render", { view: { ...currentView(false), frame }, stage: "play" });
+        const response = await api("/api/render", { view, stage: "play" });
         url = URL.createObjectURL(await response.blob());
-        page.playCache.set(frame, url);
+        page.playCache.set(cached, url);
       } catch (error) { alertShown(error.message); break; }
     }
-    if (!page.playing) break;
+    if (page.playing !== run) break;
     $("view").src = url;
     $("view").dataset.stage = "play";
-    $("frame").value = $("slider").value = frame;
+    $("frame").value = $("slider").value = shown = frame;
     $("overlay").textContent = `playing frame ${frame}`;
     const wait = 1000 / page.state.fps - (performance.now() - started);
     if (wait > 0) await new Promise((r) => setTimeout(r, wait));
     frame = (frame + 1) % page.state.frames;
   }
-  page.playing = false;
+  if (page.playing === run) page.playing = false;
   $("play").textContent = "Play";
-  page.frame = frame;
+  if (!page.playing) await showFrame(shown);
 }
 
 // ---- saving and the file -------------------------------------------------------------
 
-async function save(name) {
+async function save(name, overwrite = false) {
+  if (!name && !page.state.path) {
+    name = prompt("Save the new timeline as (name.ron, in the folder explore started in):");
+    if (!name) return;
+  }
   try {
-    const state = await (await api("/api/save", name ? { name } : {})).json();
+    const body = name ? { name } : { overwrite };
+    const state = await (await api("/api/save", body)).json();
     alertShown("");
     say(`Saved ${state.path}.`);
     await loadState(state);
-  } catch (error) { alertShown(error.message); }
+  } catch (error) {
+    if (error.status === 409 && confirm(`${error.message}\n\nWrite over the file on disk?`)) {
+      return save(null, true);
+    }
+    alertShown(error.message);
+  }
 }
 
 async function reload() {

@@ -502,3 +502,25 @@ fn a_track_in_an_empty_block_over_lines_is_laid_out_as_the_examples_are() {
     };
     assert_eq!(edited(&edited(&two, delete.clone()), delete), text);
 }
+
+#[test]
+fn a_file_with_crlf_lines_keeps_them() {
+    let text = "(\r\n    fps: 10,\r\n    frames: 11,\r\n    size: (8, 6), // small\r\n    tracks: {\r\n    },\r\n)\r\n";
+    let set = Edit::SetKey {
+        track: "fractal.power".into(),
+        time: 0.0,
+        value: KeyValue::Number(7.0),
+    };
+    let result = edited(text, set);
+    assert_eq!(
+        result.matches('\n').count(),
+        result.matches("\r\n").count(),
+        "{result:?}"
+    );
+    assert!(result.contains("(time: 0, value: 7),\r\n"), "{result:?}");
+    let delete = Edit::DeleteKey {
+        track: "fractal.power".into(),
+        index: 0,
+    };
+    assert_eq!(edited(&result, delete), text);
+}
