@@ -49,7 +49,28 @@ pub fn apply(text: &str, edit: &Edit) -> Result<String, String> {
     apply_lf(text, edit)
 }
 
+/// The edit made after RON's inner attributes (`#![enable(…)]`), if any.
 fn apply_lf(text: &str, edit: &Edit) -> Result<String, String> {
+    let (attributes, value) = text.split_at(attributes_end(text));
+    Ok(format!("{attributes}{}", apply_to_value(value, edit)?))
+}
+
+/// Where RON's inner attributes before the document's value end.
+fn attributes_end(text: &str) -> usize {
+    let mut at = 0;
+    loop {
+        let start = spans::skip_blank(text, at);
+        let close = text[start..]
+            .strip_prefix("#![")
+            .and_then(|rest| rest.find(']'));
+        match close {
+            Some(close) => at = start + 3 + close + 1,
+            None => return at,
+        }
+    }
+}
+
+fn apply_to_value(text: &str, edit: &Edit) -> Result<String, String> {
     spans::block_at(text, &[]).ok_or("the text is not a timeline in RON: `( … )`")?;
     match edit {
         Edit::SetScene { parameter, value } => set_scene(text, parameter, value),
@@ -134,7 +155,7 @@ fn set_key(text: &str, track: &str, time: Real, value: &KeyValue) -> Result<Stri
 fn delete_key(text: &str, track: &str, index: usize) -> Result<String, String> {
     let keys = existing_keys(text, track, index)?;
     if keys.block.children.len() > 1 {
-        return Ok(remove(text, &keys.block, index));
+        return Ok(remove(text, &keys.block, index, true));
     }
     let tracks = spans::block_at(text, &tracks_path()).ok_or("tracks is not a map")?;
     let entry = tracks
@@ -142,7 +163,7 @@ fn delete_key(text: &str, track: &str, index: usize) -> Result<String, String> {
         .iter()
         .position(|(step, _)| matches!(step, Step::Key(k) | Step::Field(k) if k == track))
         .ok_or_else(|| format!("there is no track \"{track}\""))?;
-    Ok(remove(text, &tracks, entry))
+    Ok(remove(text, &tracks, entry, true))
 }
 
 fn move_key(text: &str, track: &str, index: usize, time: Real) -> Result<String, String> {
@@ -160,7 +181,8 @@ fn move_key(text: &str, track: &str, index: usize, time: Real) -> Result<String,
         return Ok(spliced(text, range, &time_text));
     }
     let key = with_parts(text, keys.range(index), &[("time", &time_text)])?;
-    let without = remove(text, &keys.block, index);
+    // A moved key's comment stays where it was written.
+    let without = remove(text, &keys.block, index, false);
     let keys = self::keys(&without, track)?.ok_or("the track went missing")?;
     Ok(insert(&without, &keys.block, target, &key))
 }
@@ -369,8 +391,9 @@ fn insert_after(text: &str, block: &Block, index: usize, entry: &str) -> String 
 }
 
 /// `text` without child `index` of `block`: its whole line where it stands
-/// on its own, else the child and its comma.
-fn remove(text: &str, block: &Block, index: usize) -> String {
+/// on its own (with the comment after it, where `comment_too`), else the
+/// child and its comma.
+fn remove(text: &str, block: &Block, index: usize, comment_too: bool) -> String {
     let start = entry_start(text, block, index);
     let end = block.children[index].1.end;
     let comma = comma_after(text, end);
@@ -378,7 +401,9 @@ fn remove(text: &str, block: &Block, index: usize) -> String {
     let eol = text[past..].find('\n').map_or(text.len(), |n| past + n);
     let line = line_start(text, start);
     let rest = &text[past..eol];
-    if text[line..start].trim().is_empty() && rest.trim().is_empty() {
+    // A comment after an entry on its line is the entry's.
+    let gone = rest.trim().is_empty() || (comment_too && rest.trim_start().starts_with("//"));
+    if text[line..start].trim().is_empty() && gone {
         return spliced(text, line..(eol + 1).min(text.len()), "");
     }
     match (comma, index) {

@@ -330,7 +330,19 @@ fn keys_move_past_neighbours_and_the_last_one_deleted_takes_its_track() {
         )
     };
     let last = delete(&delete(text));
-    assert!(last.contains("// low"), "{last}");
+    // The comment on a key's line goes with the key.
+    assert!(!last.contains("// low"), "{last}");
+    let commented = "(fps: 10, frames: 11, size: (8, 6), tracks: {\n    \"fractal.power\": (keys: [\n        (time: 0, value: 8), // first\n        (time: 1, value: 9) // last\n    ]),\n})";
+    let second = Edit::DeleteKey {
+        track: "fractal.power".into(),
+        index: 1,
+    };
+    let first_left = edited(commented, second);
+    assert!(
+        first_left.contains("(time: 0, value: 8), // first\n    ]"),
+        "{first_left}"
+    );
+    assert!(!first_left.contains("// last"), "{first_left}");
     assert_eq!(
         delete(&last),
         "(fps: 10, frames: 11, size: (8, 6), tracks: {\n})"
@@ -523,4 +535,16 @@ fn a_file_with_crlf_lines_keeps_them() {
         index: 0,
     };
     assert_eq!(edited(&result, delete), text);
+}
+
+#[test]
+fn inner_attributes_before_the_timeline_are_kept() {
+    let text = "// made by hand\n#![enable(implicit_some)]\n(\n    fps: 10,\n    frames: 11,\n    size: (8, 6),\n    scene: (fractal: (power: 8)),\n)\n";
+    let set = Edit::SetScene {
+        parameter: "fractal.power".into(),
+        value: KeyValue::Number(5.0),
+    };
+    let result = edited(text, set);
+    assert_eq!(result, text.replace("power: 8", "power: 5"));
+    assert_eq!(parsed(&result, Path::new("t.ron")).base.fractal.power, 5.0);
 }
