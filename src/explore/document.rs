@@ -10,9 +10,11 @@ use std::path::{Path, PathBuf};
 /// A new timeline's text, where `explore` starts without one.
 const STARTER: &str = include_str!("starter.ron");
 
-/// Edits in one request: enough for any key the page makes, few enough
-/// that checking each result stays well under a second.
+/// Edits in one request: enough for any key the page makes.
 pub const MAX_EDITS: usize = 64;
+/// Edits times the text's bytes in one request: each edit reads the text
+/// (about a second a MiB), so a request stays within a few seconds.
+const MAX_EDIT_WORK: usize = 4 << 20;
 
 pub struct Document {
     folder: PathBuf,
@@ -102,21 +104,22 @@ impl Document {
         self.disk_changed
     }
 
-    /// Applies `edits` in turn; all of them take, or none (the first that
-    /// fails, or a result that is not a valid timeline, is the error, placed
-    /// at its line as the command line places it).
-    pub fn edit(&mut self, edits: &[Edit]) -> Result<(), String> {
-        if edits.len() > MAX_EDITS {
-            return Err(format!(
-                "at most {MAX_EDITS} edits at once, got {}",
-                edits.len()
-            ));
+    /// The text, and the name its messages give: what an edit starts from.
+    pub fn snapshot(&self) -> (String, PathBuf) {
+        (self.text.clone(), self.shown())
+    }
+
+    fn shown(&self) -> PathBuf {
+        self.path.clone().unwrap_or_else(|| self.name().into())
+    }
+
+    /// An edit's result (`edited`) in place of `base`, unless the text
+    /// changed meanwhile.
+    pub fn put_edited(&mut self, base: &str, made: (String, Timeline)) -> Result<(), String> {
+        if self.text != base {
+            return Err("the timeline changed while the edit was checked: try again".into());
         }
-        let mut text = self.text.clone();
-        for edit in edits {
-            text = crate::timeline::edit::apply(&text, edit)?;
-        }
-        self.take(text)?;
+        (self.text, self.timeline) = made;
         self.edited = true;
         Ok(())
     }
@@ -124,17 +127,18 @@ impl Document {
     /// `text` in place of the document's, where it is a valid timeline
     /// that `render` would read.
     fn take(&mut self, text: String) -> Result<(), String> {
-        let most = crate::timeline::MAX_TIMELINE_BYTES;
-        if text.len() as u64 > most {
-            let mib = most >> 20;
-            return Err(format!(
-                "the timeline would be longer than {mib} MiB, which render refuses"
-            ));
-        }
-        let shown = self.path.clone().unwrap_or_else(|| self.name().into());
-        let timeline = Timeline::parse(&text, &shown).map_err(|e| format!("{e:#}"))?;
-        (self.text, self.timeline) = (text, timeline);
+        (self.text, self.timeline) = checked(text, &self.shown())?;
         Ok(())
+    }
+
+    /// Whether the file holds other text than this session last read or
+    /// wrote, now or at the last look.
+    pub fn changed_on_disk(&self) -> bool {
+        let Some((target, _)) = &self.target else {
+            return false;
+        };
+        let now = crate::timeline::read_text(target).ok();
+        self.disk_changed || now != self.saved
     }
 
     /// Writes the text to its file, or to `new_name`: a new file in the
@@ -234,6 +238,36 @@ impl Document {
             error,
         })
     }
+}
+
+/// `edits` made in turn to `text`: all of them take, or none (the first
+/// that fails, or a result that is not a valid timeline, is the error,
+/// placed at its line as the command line places it).
+pub fn edited(text: &str, shown: &Path, edits: &[Edit]) -> Result<(String, Timeline), String> {
+    if edits.len() > MAX_EDITS || edits.len() * text.len() > MAX_EDIT_WORK {
+        let (n, kib) = (edits.len(), text.len() >> 10);
+        return Err(format!(
+            "{n} edits at once of a {kib} KiB timeline: too many, send fewer"
+        ));
+    }
+    let mut text = text.to_string();
+    for edit in edits {
+        text = crate::timeline::edit::apply(&text, edit)?;
+    }
+    checked(text, shown)
+}
+
+/// `text` and its timeline, where it is valid and `render` would read it.
+fn checked(text: String, shown: &Path) -> Result<(String, Timeline), String> {
+    let most = crate::timeline::MAX_TIMELINE_BYTES;
+    if text.len() as u64 > most {
+        let mib = most >> 20;
+        return Err(format!(
+            "the timeline would be longer than {mib} MiB, which render refuses"
+        ));
+    }
+    let timeline = Timeline::parse(&text, shown).map_err(|e| format!("{e:#}"))?;
+    Ok((text, timeline))
 }
 
 /// `text` written over `path` whole, through a temporary file.

@@ -34,8 +34,6 @@ pub struct State {
     pub document: std::sync::Mutex<Document>,
     pub renders: renderer::Renders,
     pub events: tokio::sync::broadcast::Sender<Event>,
-    /// Set when the server stops: event streams end, so it can.
-    pub closing: tokio::sync::watch::Sender<bool>,
 }
 
 /// What the page is told without asking (server-sent events).
@@ -50,8 +48,10 @@ pub enum Event {
 }
 
 /// Opens the timeline, listens, prints the page's address, and serves
-/// until Ctrl-C.
+/// until Ctrl-C or SIGTERM, which end the process as they end a render:
+/// a save under way finishes or leaves nothing behind (`interrupt`).
 pub fn serve(options: Options) -> anyhow::Result<()> {
+    let _ = crate::interrupt::install();
     let document = Document::open(options.timeline.as_deref())?;
     let runtime = tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -70,38 +70,12 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
             document: std::sync::Mutex::new(document),
             renders: renderer::Renders::default(),
             events: tokio::sync::broadcast::channel(64).0,
-            closing: tokio::sync::watch::channel(false).0,
         });
         announce(&state)?;
         tokio::spawn(watch::watch(state.clone()));
-        axum::serve(listener, routes::router(state.clone()))
-            .with_graceful_shutdown(stopped(state))
-            .await?;
+        axum::serve(listener, routes::router(state)).await?;
         Ok(())
     })
-}
-
-/// Resolves on Ctrl-C or SIGTERM, once the server is closing: event
-/// streams end and renders in progress give up. A request that still runs
-/// after a few seconds does not keep the process.
-async fn stopped(state: Arc<State>) {
-    #[cfg(unix)]
-    {
-        use tokio::signal::unix::{signal, SignalKind};
-        let mut term = signal(SignalKind::terminate()).expect("a SIGTERM handler");
-        tokio::select! {
-            _ = tokio::signal::ctrl_c() => {}
-            _ = term.recv() => {}
-        }
-    }
-    #[cfg(not(unix))]
-    let _ = tokio::signal::ctrl_c().await;
-    state.closing.send_replace(true);
-    state.renders.begin();
-    std::thread::spawn(|| {
-        std::thread::sleep(std::time::Duration::from_secs(5));
-        std::process::exit(1);
-    });
 }
 
 /// The address to open, on standard output (a script reads it from there).

@@ -317,7 +317,23 @@ async fn edit(state: Shared, Json(request): Json<EditsRequest>) -> Response {
         return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
     }
     let edits: Result<Vec<_>, String> = request.edits.into_iter().map(EditRequest::edit).collect();
-    with_document(state.0, move |document| document.edit(&edits?)).await
+    // Checked without the document's lock, which every route takes.
+    let (base, shown) = state.document.lock().expect("document").snapshot();
+    let result = tokio::task::spawn_blocking(move || {
+        let made = super::document::edited(&base, &shown, &edits?);
+        made.map(|made| (base, made))
+    })
+    .await;
+    let (base, made) = match result {
+        Ok(Ok(done)) => done,
+        Ok(Err(message)) => return refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+        Err(e) => return refused(StatusCode::INTERNAL_SERVER_ERROR, format!("failed: {e}")),
+    };
+    let mut document = state.document.lock().expect("document");
+    match document.put_edited(&base, made) {
+        Ok(()) => Json(state_of(&document)).into_response(),
+        Err(message) => refused(StatusCode::CONFLICT, message),
+    }
 }
 
 #[derive(Deserialize)]
@@ -332,26 +348,31 @@ struct SaveRequest {
 }
 
 async fn save(state: Shared, Json(request): Json<SaveRequest>) -> Response {
-    let changed = state.document.lock().expect("document").disk_changed();
-    if changed && request.name.is_none() && !request.overwrite {
-        let message = "the file changed on disk since it was read: Reload takes it in, Save as writes a new file, or save again to write over it";
-        return refused(StatusCode::CONFLICT, message);
-    }
     with_document(state.0, move |document| {
-        document.save(request.name.as_deref()).map(drop)
+        // Looked at under the same lock as the write, just before it.
+        if request.name.is_none() && !request.overwrite && document.changed_on_disk() {
+            let message = "the file changed on disk since it was read: Reload takes it in, Save as writes a new file, or save again to write over it";
+            return Err((StatusCode::CONFLICT, message.into()));
+        }
+        let saved = document.save(request.name.as_deref());
+        saved.map(drop).map_err(unprocessable)
     })
     .await
 }
 
 async fn reload(state: Shared) -> Response {
-    with_document(state.0, |document| document.reload()).await
+    with_document(state.0, |document| document.reload().map_err(unprocessable)).await
 }
 
-/// Runs `change` on the document off the async threads (parsing a long
-/// timeline takes a while), and answers with the new state or the error.
+fn unprocessable(message: String) -> (StatusCode, String) {
+    (StatusCode::UNPROCESSABLE_ENTITY, message)
+}
+
+/// Runs `change` on the document off the async threads (it reads and
+/// writes files), and answers with the new state or the refusal.
 async fn with_document(
     state: Arc<State>,
-    change: impl FnOnce(&mut super::Document) -> Result<(), String> + Send + 'static,
+    change: impl FnOnce(&mut super::Document) -> Result<(), (StatusCode, String)> + Send + 'static,
 ) -> Response {
     let answer = tokio::task::spawn_blocking(move || {
         let mut document = state.document.lock().expect("document");
@@ -360,25 +381,21 @@ async fn with_document(
     .await;
     match answer {
         Ok(Ok(shown)) => Json(shown).into_response(),
-        Ok(Err(message)) => refused(StatusCode::UNPROCESSABLE_ENTITY, message),
+        Ok(Err((status, message))) => refused(status, message),
         Err(e) => refused(StatusCode::INTERNAL_SERVER_ERROR, format!("failed: {e}")),
     }
 }
 
 /// File changes and render progress, as they happen.
 async fn events(state: Shared) -> Response {
-    let listening = (state.events.subscribe(), state.closing.subscribe());
-    let stream = futures_util::stream::unfold(listening, |(mut events, mut closing)| async move {
+    let events = state.events.subscribe();
+    let stream = futures_util::stream::unfold(events, |mut events| async move {
         loop {
-            let received = tokio::select! {
-                received = events.recv() => received,
-                _ = closing.wait_for(|&closed| closed) => return None,
-            };
-            match received {
+            match events.recv().await {
                 Ok(event) => {
                     let data = serde_json::to_string(&event).unwrap_or_default();
                     let sse = axum::response::sse::Event::default().data(data);
-                    return Some((Ok::<_, std::convert::Infallible>(sse), (events, closing)));
+                    return Some((Ok::<_, std::convert::Infallible>(sse), events));
                 }
                 Err(tokio::sync::broadcast::error::RecvError::Lagged(_)) => continue,
                 Err(_) => return None,

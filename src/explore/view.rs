@@ -87,7 +87,7 @@ impl View {
     fn lay_over(&self, scene: &mut Scene) -> Result<(), String> {
         let zoom = crate::timeline::ZOOM_TRACK;
         let (last, first): (Vec<_>, Vec<_>) = self.overrides.iter().partition(|(n, _)| *n == zoom);
-        for (name, values) in first.iter().chain(&last) {
+        for (name, values) in first.into_iter().chain(last) {
             let parameter = crate::timeline::parameters::find(name)
                 .ok_or_else(|| format!("{name}: no such parameter"))?;
             let wanted = parameter.shape.components();
@@ -100,6 +100,11 @@ impl View {
             if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
                 return Err(format!("{name}: values must be finite, got {bad}"));
             }
+            if let Some(effect) = effect_left_off(scene, name) {
+                return Err(format!(
+                    "{name}: the scene leaves {effect} off; turn it on in the timeline first"
+                ));
+            }
             if *name == zoom && values[0] <= 0.0 {
                 return Err(format!(
                     "{name}: a camera distance must be positive, got {}",
@@ -107,14 +112,6 @@ impl View {
                 ));
             }
             (parameter.set)(scene, values);
-        }
-        // A field of an effect the scene leaves off takes no value.
-        let shown = serde_json::to_value(&*scene).unwrap_or_default();
-        if let Some((name, _)) = first.iter().find(|(name, _)| field(&shown, name).is_none()) {
-            let effect = name.rsplit_once('.').map_or(name.as_str(), |(e, _)| e);
-            return Err(format!(
-                "{name}: the scene leaves {effect} off; turn it on in the timeline first"
-            ));
         }
         crate::timeline::validate_scene(scene)
             .map_err(|(field, message)| format!("{field}: {message}"))
@@ -138,14 +135,28 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
         .collect()
 }
 
-/// The numbers at parameter `name`'s field of a scene written as JSON.
+/// The numbers at parameter `name`'s field of a scene written as JSON
+/// (coordinates written as digits, as their nearest numbers). A look's
+/// exposure of 1 is left out of the JSON.
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
-    let value = name.split('.').try_fold(scene, |v, step| v.get(step))?;
-    match value {
-        serde_json::Value::Number(n) => Some(vec![n.as_f64()?]),
-        serde_json::Value::Array(a) => a.iter().map(|x| x.as_f64()).collect(),
+    let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
+    match name.split('.').try_fold(scene, |v, step| v.get(step)) {
+        Some(serde_json::Value::Array(a)) => a.iter().map(number).collect(),
+        Some(v) if !v.is_null() => Some(vec![number(v)?]),
+        _ if name == "look.exposure" => Some(vec![1.0]),
         _ => None,
     }
+}
+
+/// The effect `name` is a field of (`effects.glow`), where the scene
+/// leaves it off: its fields take no value then.
+fn effect_left_off(scene: &Scene, name: &str) -> Option<String> {
+    let (effect, _) = name.strip_prefix("effects.")?.split_once('.')?;
+    let effects = serde_json::to_value(&scene.effects).ok()?;
+    effects
+        .get(effect)
+        .is_none_or(serde_json::Value::is_null)
+        .then(|| format!("effects.{effect}"))
 }
 
 #[cfg(test)]
@@ -203,6 +214,11 @@ mod tests {
         assert!(error(at("camera.fov_degrees", vec![0.0])).contains("fov_degrees"));
         assert!(error(at("camera.distance", vec![-1.0])).contains("positive"));
         assert!(error(at("effects.glow.strength", vec![1.0])).contains("leaves effects.glow off"));
+        // Values the scene's JSON leaves out, or writes as digits, are values.
+        assert!(at("look.exposure", vec![1.0]).prepare(&t).is_ok());
+        assert!(at("fractal.julia", vec![0.1, 0.2, 0.3]).prepare(&t).is_ok());
+        assert!(at("camera.focus_distance", vec![2.0]).prepare(&t).is_ok());
+        assert_eq!(values(&t, 0)["look.exposure"], Some(vec![1.0]));
         let huge = View {
             size: Some("3841x2160".into()),
             ..View::default()

@@ -640,3 +640,17 @@ fn an_interrupt_stops_the_server_while_a_page_listens() {
         std::thread::sleep(Duration::from_millis(20));
     }
 }
+
+#[test]
+fn a_change_on_disk_just_before_save_is_not_written_over() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
+    s.post("/api/edit", edit).expect(200);
+    // Saved by an editor a moment ago: the watch has not looked twice yet.
+    let theirs = format!("{}// theirs\n", tiny_timeline(2, 9.0));
+    d.write("t.ron", &theirs);
+    s.post("/api/save", json!({})).expect(409);
+    assert_eq!(d.bytes("t.ron"), theirs.as_bytes());
+}

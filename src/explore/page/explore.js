@@ -79,8 +79,9 @@ async function showFrame(frame) {
   page.frame = frame;
   $("frame").value = $("slider").value = frame;
   $("time").textContent = `t = ${(frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
+  const asked = page.valuesAsked = (page.valuesAsked || 0) + 1;
   const values = await (await api(`/api/values?frame=${frame}`)).json();
-  if (page.frame !== frame) return;  // a later frame was asked for meanwhile
+  if (asked !== page.valuesAsked) return;  // asked again meanwhile
   page.values = values;
   drawStrip();
   fillControls();
@@ -246,13 +247,13 @@ function setUpViewport() {
   let down = null;
   // The drag follows the pointer over the whole window, not just the image.
   viewport.addEventListener("pointerdown", (event) => {
-    if (event.button !== 0) return;
+    if (event.button !== 0 || down) return;
     event.preventDefault();
     viewport.focus();
-    down = { x: event.clientX, y: event.clientY, moved: false };
+    down = { x: event.clientX, y: event.clientY, moved: false, id: event.pointerId };
   });
   window.addEventListener("pointermove", (event) => {
-    if (!down) return;
+    if (!down || event.pointerId !== down.id) return;
     // Released outside the window: no pointerup came.
     if (event.buttons === 0) { release(event, false); return; }
     const dx = event.clientX - down.x, dy = event.clientY - down.y;
@@ -267,6 +268,7 @@ function setUpViewport() {
   });
   // A press that did not move is a click: aim at the surface point under it.
   const release = (event, clicked) => {
+    if (down && event.pointerId !== down.id) return;
     const was = down;
     down = null;
     viewport.classList.remove("dragging");
@@ -381,6 +383,8 @@ async function edit(edits, done) {
     alertShown("");
     say(done);
     page.overrides = {};
+    const moved = edits.find((e) => e.kind === "move_key");
+    if (moved && page.selected) page.selected.time = moved.time;
     await loadState(state);
   } catch (error) {
     alertShown(error.message);
@@ -398,8 +402,12 @@ function keyChanges() {
 function setInScene() {
   const names = changedNames().filter((n) => n !== "camera.distance");
   const camera = names.some((n) => n.startsWith("camera.position") || n.startsWith("camera.target"));
-  if (changedNames().includes("camera.distance") || (camera && trackNamed("camera.distance"))) {
-    alertShown("The camera's distance is set by the camera.distance track: key the camera (K) instead.");
+  if (changedNames().includes("camera.distance")) {
+    alertShown("camera.distance is a track's value, never the scene's: key it (K) instead.");
+    return;
+  }
+  if (camera && trackNamed("camera.distance")) {
+    alertShown("The camera.distance track places the camera whatever the scene says: key the camera (K) instead.");
     return;
   }
   if (!names.length) return;
@@ -417,7 +425,6 @@ function moveSelected() {
   const s = page.selected;
   if (!s) { say("Select a key first."); return; }
   const time = page.frame / page.state.fps;
-  page.selected = { ...s, time };
   edit([{ kind: "move_key", track: s.track, index: s.index, time }],
     `Moved the key of ${s.track} to frame ${page.frame}.`);
 }
@@ -548,7 +555,7 @@ function changeFromControl(row, name) {
 
 // Plays from this frame until stopped, then shows the last frame played.
 async function togglePlay() {
-  if (page.playing) { page.playing = false; return; }
+  if (page.playing) { page.playing = false; $("play").textContent = "Play"; return; }
   const run = page.playing = {};
   $("play").textContent = "Stop";
   const version = page.state;
@@ -576,8 +583,9 @@ async function togglePlay() {
     frame = (frame + 1) % page.state.frames;
   }
   if (page.playing === run) page.playing = false;
+  if (page.playing) return;  // a new run started meanwhile
   $("play").textContent = "Play";
-  if (!page.playing) await showFrame(shown);
+  await showFrame(shown);
 }
 
 // ---- saving and the file -------------------------------------------------------------
