@@ -34,6 +34,9 @@ pub struct State {
     pub document: std::sync::Mutex<Document>,
     pub renders: renderer::Renders,
     pub events: tokio::sync::broadcast::Sender<Event>,
+    /// Held by an edit from its snapshot to its result: edits take turns,
+    /// while the other routes never wait on one.
+    pub editing: tokio::sync::Mutex<()>,
 }
 
 /// What the page is told without asking (server-sent events).
@@ -70,6 +73,7 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
             document: std::sync::Mutex::new(document),
             renders: renderer::Renders::default(),
             events: tokio::sync::broadcast::channel(64).0,
+            editing: tokio::sync::Mutex::new(()),
         });
         announce(&state)?;
         tokio::spawn(watch::watch(state.clone()));

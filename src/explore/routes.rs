@@ -318,6 +318,7 @@ async fn edit(state: Shared, Json(request): Json<EditsRequest>) -> Response {
     }
     let edits: Result<Vec<_>, String> = request.edits.into_iter().map(EditRequest::edit).collect();
     // Checked without the document's lock, which every route takes.
+    let _turn = state.editing.lock().await;
     let (base, shown) = state.document.lock().expect("document").snapshot();
     let result = tokio::task::spawn_blocking(move || {
         let made = super::document::edited(&base, &shown, &edits?);

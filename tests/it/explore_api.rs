@@ -654,3 +654,33 @@ fn a_change_on_disk_just_before_save_is_not_written_over() {
     s.post("/api/save", json!({})).expect(409);
     assert_eq!(d.bytes("t.ron"), theirs.as_bytes());
 }
+
+#[test]
+fn edits_sent_together_take_turns() {
+    let d = Dir::new();
+    // Long enough that one edit is still being checked when the next comes.
+    let keys: String = (0..4000)
+        .map(|i| format!("(time: {}, value: 8),\n", i as f64 * 0.001))
+        .collect();
+    let text = format!(
+        "(fps: 24, frames: 2, size: (48, 27), tracks: {{\"fractal.power\": (keys: [\n{keys}])}})"
+    );
+    d.write("t.ron", &text);
+    let s = explore(&d, "t.ron");
+    let statuses: Vec<u16> = std::thread::scope(|scope| {
+        let sent: Vec<_> = [5.5, 6.5]
+            .map(|time| {
+                let s = &s;
+                scope.spawn(move || {
+                    let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": time, "value": [9]}]});
+                    s.post("/api/edit", edit).status
+                })
+            })
+            .into_iter()
+            .collect();
+        sent.into_iter().map(|t| t.join().unwrap()).collect()
+    });
+    assert_eq!(statuses, [200, 200]);
+    let state = s.state()["text"].as_str().unwrap().to_string();
+    assert!(state.contains("time: 5.5") && state.contains("time: 6.5"));
+}

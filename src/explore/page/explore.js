@@ -247,7 +247,9 @@ function setUpViewport() {
   let down = null;
   // The drag follows the pointer over the whole window, not just the image.
   viewport.addEventListener("pointerdown", (event) => {
-    if (event.button !== 0 || down) return;
+    // A press of the pointer already down is not a new drag; another
+    // pointer's press starts one (a lost release must not block drags).
+    if (event.button !== 0 || (down && event.pointerId === down.id)) return;
     event.preventDefault();
     viewport.focus();
     down = { x: event.clientX, y: event.clientY, moved: false, id: event.pointerId };
@@ -377,14 +379,13 @@ function changeKeys() {
   return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
 }
 
-async function edit(edits, done) {
+async function edit(edits, done, then = () => {}) {
   try {
     const state = await (await api("/api/edit", { edits })).json();
     alertShown("");
     say(done);
     page.overrides = {};
-    const moved = edits.find((e) => e.kind === "move_key");
-    if (moved && page.selected) page.selected.time = moved.time;
+    then();
     await loadState(state);
   } catch (error) {
     alertShown(error.message);
@@ -425,8 +426,10 @@ function moveSelected() {
   const s = page.selected;
   if (!s) { say("Select a key first."); return; }
   const time = page.frame / page.state.fps;
+  // The moved key stays selected, unless another was chosen meanwhile.
+  const keep = () => { if (page.selected === s) page.selected = { ...s, time }; };
   edit([{ kind: "move_key", track: s.track, index: s.index, time }],
-    `Moved the key of ${s.track} to frame ${page.frame}.`);
+    `Moved the key of ${s.track} to frame ${page.frame}.`, keep);
 }
 
 function deleteSelected() {
