@@ -55,7 +55,7 @@ pub struct AccuracyArgs {
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
     /// Override the timeline's samples_per_pixel for the scene measured.
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4096))]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=crate::job::request::MAX_SAMPLES as i64))]
     pub samples: Option<u32>,
     /// Folder for accuracy.csv, accuracy.md and accuracy.png [default: out/<timeline name>].
     #[arg(long)]
@@ -116,7 +116,7 @@ pub struct SequenceArgs {
     /// Override the timeline's samples_per_pixel: anti-aliasing for a final
     /// (4 or 9 takes the flicker out of fine detail; time grows with it).
     #[arg(long, value_name = "N", conflicts_with = "preview",
-          value_parser = clap::value_parser!(u32).range(1..=4096))]
+          value_parser = clap::value_parser!(u32).range(1..=crate::job::request::MAX_SAMPLES as i64))]
     pub samples: Option<u32>,
     /// Extra EXR layers, comma-separated (needs --format exr): normal, albedo, traps, steps.
     #[arg(long, value_enum, value_delimiter = ',')]

@@ -96,11 +96,6 @@ impl Document {
         self.edited || self.saved.is_none()
     }
 
-    /// The file changed on disk since this session last read or wrote it.
-    pub fn disk_changed(&self) -> bool {
-        self.disk_changed
-    }
-
     /// The text, and the name its messages give: what an edit starts from.
     pub fn snapshot(&self) -> (String, PathBuf) {
         (self.text.clone(), self.shown())

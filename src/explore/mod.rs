@@ -96,9 +96,13 @@ fn announce(state: &State) -> anyhow::Result<()> {
         state.address.port(),
         state.token
     );
-    let mut out = std::io::stdout();
-    writeln!(out, "Exploring {name}: open {url}")?;
-    writeln!(out, "(Ctrl-C stops the server; edits not saved are lost.)")?;
+    // One write: a reader that takes the first line and goes cannot make
+    // the second fail, which would end the server.
+    let said = format!(
+        "Exploring {name}: open {url}\n(Ctrl-C stops the server; edits not saved are lost.)\n"
+    );
+    let mut out = std::io::stdout().lock();
+    out.write_all(said.as_bytes())?;
     out.flush()?;
     Ok(())
 }

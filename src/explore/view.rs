@@ -3,6 +3,7 @@
 //! samples as `render --size --samples` take them; checked as the command
 //! line checks them.
 
+use crate::job::request::MAX_SAMPLES;
 use crate::scene::Scene;
 use crate::timeline::Timeline;
 use serde::Deserialize;
@@ -11,8 +12,6 @@ use std::collections::BTreeMap;
 /// The most pixels a view may have: a 4K frame. A larger one is a render's
 /// job, whose memory is checked before it starts.
 pub const MAX_VIEW_PIXELS: u64 = 3840 * 2160;
-/// `--samples`'s upper bound.
-const MAX_SAMPLES: u32 = 4096;
 
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]

@@ -56,6 +56,9 @@ pub struct Request {
     pub checkpoint_every: Duration,
 }
 
+/// The most samples per pixel `--samples` (and the explorer) take.
+pub const MAX_SAMPLES: u32 = 4096;
+
 /// Parses `WxH`.
 pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
     let bad = || {

@@ -11,12 +11,17 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 /// A child process killed when the test ends, however it ends.
-struct Killed(Child);
+/// Its standard output, where piped, stays open as long: a server's later
+/// writes there must not fail.
+struct Killed {
+    child: Child,
+    _stdout: Option<std::io::BufReader<std::process::ChildStdout>>,
+}
 
 impl Drop for Killed {
     fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
     }
 }
 
@@ -37,7 +42,13 @@ fn explore(dir: &Dir, timeline: &str) -> (Killed, String) {
         .expect("an address")
         .to_string();
     assert!(url.starts_with("http://127.0.0.1:"), "{line}");
-    (Killed(child), url)
+    (
+        Killed {
+            child,
+            _stdout: Some(out),
+        },
+        url,
+    )
 }
 
 /// chromedriver on a free port, answering.
@@ -60,7 +71,13 @@ fn chromedriver() -> (Killed, String) {
         );
         std::thread::sleep(Duration::from_millis(50));
     }
-    (Killed(child), format!("http://127.0.0.1:{port}"))
+    (
+        Killed {
+            child,
+            _stdout: None,
+        },
+        format!("http://127.0.0.1:{port}"),
+    )
 }
 
 /// Headless Chromium as root in a container needs no sandbox, and must not
@@ -269,6 +286,12 @@ fn the_page_drags_zooms_keys_and_saves_what_render_renders() {
     }
 }
 
+/// Clicks the button with id `id`.
+async fn press(client: &Client, id: &str) {
+    let button = client.find(Locator::Id(id)).await.expect(id);
+    button.click().await.expect(id);
+}
+
 /// Makes keys at frames 0 and 12 by dragging, zooming and clicking, saves,
 /// and returns the pixels the page showed at each.
 async fn author(client: &Client, url: &str) -> (Vec<u8>, Vec<u8>) {
@@ -322,26 +345,14 @@ async fn author(client: &Client, url: &str) -> (Vec<u8>, Vec<u8>) {
     until(client, "page.overrides['camera.target']").await;
     settled(client).await;
     let seen_12 = shown(client).await;
-    client
-        .find(Locator::Id("key"))
-        .await
-        .expect("key")
-        .click()
-        .await
-        .expect("key");
+    press(client, "key").await;
     until(
         client,
         "page.state.tracks.find((t) => t.name === 'camera.position').keys.length === 2",
     )
     .await;
 
-    client
-        .find(Locator::Id("save"))
-        .await
-        .expect("save")
-        .click()
-        .await
-        .expect("save");
+    press(client, "save").await;
     until(client, "!page.state.dirty").await;
     (seen_0, seen_12)
 }
