@@ -39,6 +39,10 @@ pub enum Error {
     /// Encoding or decoding an image failed.
     #[error("{}: {message}", path.display())]
     Image { path: PathBuf, message: String },
+    /// A frame does not match what it is measured against (another size,
+    /// no reference frame of its number).
+    #[error("frame {frame}: {message}")]
+    Frame { frame: u32, message: String },
 }
 
 impl Error {

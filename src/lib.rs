@@ -25,6 +25,7 @@ pub mod job;
 pub mod march;
 pub mod math;
 pub mod output;
+pub mod quality;
 pub mod render;
 pub mod scene;
 pub mod shade;

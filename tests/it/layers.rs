@@ -11,6 +11,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("explorer", &["explore"]),
     ("benchmark", &["bench"]),
     ("accuracy", &["accuracy"]),
+    ("quality", &["quality"]),
     ("job", &["job"]),
     ("files", &["output"]),
     ("film", &["timeline", "render"]),
