@@ -94,6 +94,27 @@ pub struct SheetArgs {
     pub labels: bool,
 }
 
+#[derive(Debug, clap::Args)]
+pub struct QualityArgs {
+    /// Folder holding the PNG frames to measure (frame_00000.png, …).
+    pub dir: PathBuf,
+    /// Folder of a reference render of the same frames (more samples, finer
+    /// settings): each frame's PSNR is measured against the frame of its number there.
+    #[arg(long, value_name = "REFDIR")]
+    pub reference: Option<PathBuf>,
+    /// Frames to measure, by number, as a Rust range: 0..4 is frames 0 to 3, 0..=4
+    /// frames 0 to 4; also A.., ..B, or N [default: every frame in DIR].
+    #[arg(long, value_name = "A..B")]
+    pub frames: Option<String>,
+    /// How the frames are named in both folders, as render's --frame-name [default:
+    /// what each folder's mandelreel-job.json records, else frame_#####].
+    #[arg(long, value_name = "PATTERN")]
+    pub frame_name: Option<FrameName>,
+    /// Print the measures as JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// What a sequence is made of: shared by `render` and `status`, so both
 /// compute the same frames and hashes.
 #[derive(Debug, clap::Args)]

@@ -1,5 +1,5 @@
 //! The command line: clap arguments, one file per subcommand (`render`,
-//! `info`, `pick`, `explore`, `sheet`, `status`, `accuracy`, `bench`) that turns them
+//! `info`, `pick`, `explore`, `sheet`, `status`, `accuracy`, `quality`, `bench`) that turns them
 //! into a job's request and prints what comes back, and exit codes.
 
 use crate::error::Error;
@@ -37,12 +37,14 @@ mod args;
 mod bench;
 mod info;
 mod pick;
+mod quality;
 mod render;
 mod sheet;
 mod status;
 
 pub use args::{
-    AccuracyArgs, BenchArgs, ExploreArgs, PickArgs, RenderArgs, SequenceArgs, SheetArgs, StatusArgs,
+    AccuracyArgs, BenchArgs, ExploreArgs, PickArgs, QualityArgs, RenderArgs, SequenceArgs,
+    SheetArgs, StatusArgs,
 };
 
 /// Exit status: success.
@@ -93,6 +95,9 @@ pub enum Command {
     /// Measure what accuracy costs: sweep every quality knob, distance estimator and
     /// precision on one frame against a reference; write accuracy.csv, .md and .png.
     Accuracy(AccuracyArgs),
+    /// Measure a rendered sequence's image quality: PSNR against a reference render,
+    /// speckles and frame-to-frame pops.
+    Quality(QualityArgs),
     /// Time the benchmark scenes (timelines/bench) against Mandelbulber2 where it is
     /// installed, measure the kernel against the FMA peak and the machine's own
     /// measured ceiling, thread scaling and peak memory; write
@@ -128,6 +133,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Sheet(args) => sheet::sheet(args),
         Command::Status(args) => status::status(args),
         Command::Accuracy(args) => accuracy::accuracy(args),
+        Command::Quality(args) => quality::quality(args),
         Command::Bench(args) => bench::bench(args),
         Command::Measure { program, args } => measure(&program, &args),
     };

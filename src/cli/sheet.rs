@@ -58,7 +58,7 @@ pub fn sheet(args: SheetArgs) -> anyhow::Result<()> {
 
 /// How the PNG frames in `dir` are named, by its job record: the default
 /// where it has none, or records none (it predates `--frame-name`).
-fn recorded_names(dir: &std::path::Path) -> FrameName {
+pub(super) fn recorded_names(dir: &std::path::Path) -> FrameName {
     let record = crate::job::record::JobRecord::read(dir).ok();
     let outputs = record.map(|r| r.outputs()).unwrap_or_default();
     outputs
