@@ -17,6 +17,7 @@ mod layers;
 mod limits;
 mod locations;
 mod names;
+mod quality;
 mod resume;
 mod stability;
 mod surface;
