@@ -6,6 +6,7 @@ use crate::error::Error;
 use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use crate::quality::{report, FrameImage, Meter};
+use anyhow::Context as _;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -16,20 +17,16 @@ pub fn quality(args: QualityArgs) -> anyhow::Result<()> {
     if let Some(text) = &args.frames {
         frames = in_range(frames, text, &args.dir)?;
     }
-    let reference = match &args.reference {
-        Some(dir) => Some(reference_files(
-            &frames,
-            dir,
-            &names_in(dir, &args.frame_name),
-        )?),
-        None => None,
+    let pairs = match &args.reference {
+        Some(dir) => with_reference(frames, dir, &names_in(dir, &args.frame_name))?,
+        None => frames.into_iter().map(|(n, p)| (n, p, None)).collect(),
     };
-    let measured = measure(&frames, reference.as_deref());
+    let measured = measure(&pairs);
     let context = match &args.reference {
         Some(r) => format!("{} against {}", args.dir.display(), r.display()),
         None => args.dir.display().to_string(),
     };
-    let measured = anyhow::Context::context(measured, context)?;
+    let measured = measured.context(context)?;
     if args.json {
         let json = serde_json::to_string_pretty(&measured).expect("measures serialise");
         out!("{json}");
@@ -87,50 +84,39 @@ fn in_range(
     Ok(kept)
 }
 
-/// The reference frame file for each of `frames`, by number; an error
-/// naming the first frame `dir` lacks.
-fn reference_files(
-    frames: &[(u32, PathBuf)],
+/// Each of `frames` with its reference frame file in `dir`, by number;
+/// an error naming the first frame `dir` lacks.
+fn with_reference(
+    frames: Vec<(u32, PathBuf)>,
     dir: &Path,
     names: &FrameName,
-) -> anyhow::Result<Vec<PathBuf>> {
-    let mut files = Vec::with_capacity(frames.len());
-    for (frame, _) in frames {
-        let path = dir.join(names.file_name(*frame, Format::Png));
-        if !path.is_file() {
-            let message = format!(
-                "the reference has no such frame: {} is missing",
-                path.display()
-            );
-            return Err(Error::Frame {
-                frame: *frame,
-                message,
-            }
-            .into());
+) -> anyhow::Result<Vec<FrameFiles>> {
+    let mut pairs = Vec::with_capacity(frames.len());
+    for (frame, path) in frames {
+        let reference = dir.join(names.file_name(frame, Format::Png));
+        if !reference.is_file() {
+            let missing = reference.display();
+            let message = format!("the reference has no such frame: {missing} is missing");
+            return Err(Error::Frame { frame, message }.into());
         }
-        files.push(path);
+        pairs.push((frame, path, Some(reference)));
     }
-    Ok(files)
+    Ok(pairs)
 }
+
+/// A frame's number, its file, and its reference's file if there is one.
+type FrameFiles = (u32, PathBuf, Option<PathBuf>);
 
 /// Reads and measures the frames a few at a time (decoding in parallel),
 /// so a long sequence is never all in memory.
-fn measure(
-    frames: &[(u32, PathBuf)],
-    reference: Option<&[PathBuf]>,
-) -> crate::error::Result<crate::quality::SequenceQuality> {
-    let chunk = 2 * rayon::current_num_threads();
+fn measure(pairs: &[FrameFiles]) -> crate::error::Result<crate::quality::SequenceQuality> {
     let mut meter = Meter::default();
-    for (i, batch) in frames.chunks(chunk).enumerate() {
+    for batch in pairs.chunks(2 * rayon::current_num_threads()) {
         let decoded: Vec<(FrameImage, Option<image::RgbImage>)> = batch
             .par_iter()
-            .enumerate()
-            .map(|(j, (frame, path))| {
+            .map(|(frame, path, reference)| {
                 let image = read_png(path)?;
-                let reference = match reference {
-                    Some(files) => Some(read_png(&files[i * chunk + j])?),
-                    None => None,
-                };
+                let reference = reference.as_deref().map(read_png).transpose()?;
                 Ok((
                     FrameImage {
                         frame: *frame,
