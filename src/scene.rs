@@ -27,8 +27,13 @@ pub struct Scene {
     pub look: crate::shade::Look,
     /// Optional effects; each off unless declared.
     pub effects: crate::shade::Effects,
-    /// Anti-aliasing samples per pixel (1 = one ray through the pixel centre).
+    /// Anti-aliasing samples per pixel (1 = one ray through the pixel
+    /// centre); with `adaptive`, the most a pixel takes.
     pub samples_per_pixel: u32,
+    /// Samples where they are needed instead of the same in every pixel;
+    /// left out of the frame's hash when off, so uniform frames keep theirs.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub adaptive: Option<Adaptive>,
     /// Seed of the deterministic sample pattern.
     pub seed: u64,
 }
@@ -42,7 +47,30 @@ impl Default for Scene {
             look: crate::shade::Look::default(),
             effects: crate::shade::Effects::default(),
             samples_per_pixel: 1,
+            adaptive: None,
             seed: 0,
+        }
+    }
+}
+
+/// Adaptive sampling: every pixel takes `first` samples, then pixels whose
+/// estimated error is still above `noise` take as many again, wave after
+/// wave, up to `samples_per_pixel` (see `render::adaptive`).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Adaptive {
+    /// Samples every pixel takes before any is judged.
+    pub first: u32,
+    /// The error a pixel may keep: the standard error of its mean, in
+    /// display values (0 to 1, after tone map and sRGB curve).
+    pub noise: f32,
+}
+
+impl Default for Adaptive {
+    fn default() -> Self {
+        Adaptive {
+            first: 2,
+            noise: 0.02,
         }
     }
 }
@@ -68,6 +96,21 @@ impl Scene {
             Some(MarchAlone::Estimator(self.fractal.de))
         } else {
             None
+        }
+    }
+}
+
+impl Scene {
+    /// How many samples a pixel takes, in words: `4 sample(s) per pixel`,
+    /// or `adaptive: 2 to 16 samples per pixel, to noise 0.01`.
+    pub fn sampling_summary(&self) -> String {
+        let n = self.samples_per_pixel;
+        match &self.adaptive {
+            Some(a) if a.first.min(n) < n => format!(
+                "adaptive: {} to {n} samples per pixel, to noise {}",
+                a.first, a.noise
+            ),
+            _ => format!("{n} sample(s) per pixel"),
         }
     }
 }

@@ -14,13 +14,13 @@ pub fn info(path: &Path) -> anyhow::Result<()> {
     let base = &first;
     out!("timeline: {}", path.display());
     out!(
-        "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {} sample(s) per pixel",
+        "frames:   {} at {} fps ({:.3} s), {}x{} pixels, {}",
         t.frame_count,
         t.fps,
         t.duration_seconds(),
         t.width,
         t.height,
-        base.samples_per_pixel
+        base.sampling_summary()
     );
     if t.looping {
         out!(

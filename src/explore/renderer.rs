@@ -137,10 +137,9 @@ fn accumulate(
     stop: &(dyn Fn() -> bool + Sync),
 ) -> Option<Film> {
     let n = scenes[0].samples_per_pixel.max(1);
-    let wave = crate::job::waves::wave_size(n);
     let mut acc = Accumulation::new(width, height, Layers::default());
     while acc.samples_done < n {
-        let until = (acc.samples_done + wave).min(n);
+        let until = crate::render::next_wave(&scenes[0], acc.samples_done);
         if !crate::render::render_samples_unless(scenes, frame, &mut acc, until, on_row, stop) {
             return None;
         }

@@ -17,6 +17,9 @@ struct CheckpointHeader {
     height: u32,
     samples_done: u32,
     layers: [bool; 3],
+    /// Whether each pixel's adaptive-sampling spread follows the layers.
+    #[serde(default)]
+    spreads: bool,
     stats: crate::render::FrameStats,
 }
 
@@ -32,6 +35,7 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
             !acc.albedo.is_empty(),
             !acc.traps.is_empty(),
         ],
+        spreads: !acc.spread.is_empty(),
         stats: acc.stats,
     };
     // Streamed through the file's buffer, not assembled first: the
@@ -65,6 +69,12 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
             for x in v {
                 put(&x.to_le_bytes())?;
             }
+        }
+        for p in &acc.spread {
+            put(&p.taken.to_le_bytes())?;
+            put(&p.grazes.to_le_bytes())?;
+            put(&p.sum.to_le_bytes())?;
+            put(&p.squares.to_le_bytes())?;
         }
         Ok(())
     })
@@ -150,6 +160,15 @@ pub fn read_checkpoint(
     for v in acc.traps.iter_mut() {
         for x in v.iter_mut() {
             *x = f32::from_le_bytes(take(&mut file)?);
+        }
+    }
+    if header.spreads {
+        acc.spread.resize(acc.colour.len(), Default::default());
+        for p in acc.spread.iter_mut() {
+            p.taken = u32::from_le_bytes(take(&mut file)?);
+            p.grazes = u32::from_le_bytes(take(&mut file)?);
+            p.sum = f64::from_le_bytes(take(&mut file)?);
+            p.squares = f64::from_le_bytes(take(&mut file)?);
         }
     }
     // Whole: nothing after the arrays.

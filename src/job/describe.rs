@@ -76,9 +76,15 @@ pub fn plan_lines(base: &Scene) -> Vec<String> {
             lens.aperture_radius, lens.focus_distance, crate::scene::LENS_SAMPLES
         ));
     }
-    lines.push(format!(
-        "          {} sample(s) per pixel: {}x the per-sample work",
-        base.samples_per_pixel, base.samples_per_pixel
-    ));
+    lines.push(match &base.adaptive {
+        Some(a) if a.first.min(base.samples_per_pixel) < base.samples_per_pixel => format!(
+            "          {}: {}x the per-sample work in every pixel, up to {}x where a pixel's error says so",
+            base.sampling_summary(), a.first, base.samples_per_pixel
+        ),
+        _ => format!(
+            "          {} sample(s) per pixel: {}x the per-sample work",
+            base.samples_per_pixel, base.samples_per_pixel
+        ),
+    });
     lines
 }

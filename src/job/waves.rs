@@ -55,7 +55,6 @@ impl Plan {
             layers,
         )
         .filter(|a| a.samples_done < n);
-        let wave = wave_size(n);
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
         if acc.samples_done > 0 {
@@ -68,7 +67,7 @@ impl Plan {
         let mut saved = Instant::now();
         let mut saving = true;
         while acc.samples_done < n {
-            let until = (acc.samples_done + wave).min(n);
+            let until = crate::render::next_wave(&scenes[0], acc.samples_done);
             crate::render::render_samples(scenes, frame, &mut acc, until, on_row);
             if saving && until < n && saved.elapsed() >= checkpoint_every {
                 if let Err(e) = crate::job::checkpoint::write_checkpoint(&checkpoint, &acc, light) {
@@ -117,15 +116,8 @@ pub enum Said {
     CheckpointFailed { frame: u32, error: Error },
 }
 
-/// Samples per pixel in one wave: about 16 waves a frame, so a long frame
-/// can be checkpointed between them.
-pub fn wave_size(samples_per_pixel: u32) -> u32 {
-    samples_per_pixel.div_ceil(16).max(1)
-}
-
 /// Passes over a frame's rows that rendering its `scenes` takes: one per
 /// wave of samples.
 pub fn waves(scenes: &[crate::scene::Scene]) -> u32 {
-    let n = scenes[0].samples_per_pixel.max(1);
-    n.div_ceil(wave_size(n))
+    crate::render::wave_count(&scenes[0])
 }

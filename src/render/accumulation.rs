@@ -1,6 +1,7 @@
 //! A frame in progress: per-pixel running sums that waves of samples add
 //! to and a resumed render continues from.
 
+use super::adaptive::Spread;
 use super::band::{optional_bands, BAND_ROWS, BAND_TASKS};
 use super::film::{finish_pixels, Film, FilmPixels, Layers};
 use super::stats::FrameStats;
@@ -25,6 +26,9 @@ pub struct Accumulation {
     pub normal: Vec<Vec3>,
     pub albedo: Vec<Vec3>,
     pub traps: Vec<[f32; 4]>,
+    /// Each pixel's samples and their spread under adaptive sampling;
+    /// empty for uniform sampling, where every pixel has `samples_done`.
+    pub spread: Vec<Spread>,
     pub stats: FrameStats,
 }
 
@@ -56,6 +60,7 @@ impl Accumulation {
         refill(&mut self.normal, layer(layers.normal), Vec3::ZERO);
         refill(&mut self.albedo, layer(layers.albedo), Vec3::ZERO);
         refill(&mut self.traps, layer(layers.traps), [0.0; 4]);
+        self.spread.clear();
         self.stats = FrameStats::default();
     }
 
@@ -78,7 +83,15 @@ impl Accumulation {
             normal: (!self.normal.is_empty()).then_some(&mut self.normal[..]),
             albedo: (!self.albedo.is_empty()).then_some(&mut self.albedo[..]),
             traps: (!self.traps.is_empty()).then_some(&mut self.traps[..]),
+            spread: (!self.spread.is_empty()).then_some(&mut self.spread[..]),
         }
+    }
+
+    /// Starts the per-pixel spreads of adaptive sampling, before any sample.
+    pub(super) fn start_spreads(&mut self) {
+        debug_assert_eq!(self.samples_done, 0);
+        self.spread.clear();
+        self.spread.resize(self.colour.len(), Spread::default());
     }
 
     /// The sums a band of `BAND_ROWS` rows at a time, for rendering bands
@@ -95,8 +108,9 @@ impl Accumulation {
             .zip(optional_bands(&mut self.normal, w, h))
             .zip(optional_bands(&mut self.albedo, w, h))
             .zip(optional_bands(&mut self.traps, w, h))
+            .zip(optional_bands(&mut self.spread, w, h))
             .map(
-                |((((((colour, hits), depth), spent), normal), albedo), traps)| RowSums {
+                |(((((((colour, hits), depth), spent), normal), albedo), traps), spread)| RowSums {
                     colour,
                     hits,
                     depth,
@@ -104,6 +118,7 @@ impl Accumulation {
                     normal,
                     albedo,
                     traps,
+                    spread,
                 },
             )
             .with_max_len(BAND_TASKS)
@@ -136,4 +151,5 @@ pub(super) struct RowSums<'a> {
     pub(super) normal: Option<&'a mut [Vec3]>,
     pub(super) albedo: Option<&'a mut [Vec3]>,
     pub(super) traps: Option<&'a mut [[f32; 4]]>,
+    pub(super) spread: Option<&'a mut [Spread]>,
 }

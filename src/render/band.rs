@@ -3,6 +3,7 @@
 //! radiance of each sample.
 
 use super::accumulation::{Accumulation, RowSums};
+use super::adaptive::progressive_subpixel;
 use super::stats::FrameStats;
 use super::subpixel;
 use crate::march::{normals_many, walk_many, MarchResult};
@@ -26,6 +27,11 @@ pub(super) struct FrameSetup<'a> {
     pub(super) scales: Vec<Real>,
     /// An environment map is looked up once per frame, not per ray.
     pub(super) environment: Option<std::sync::Arc<crate::environment::EnvironmentMap>>,
+    /// Under adaptive sampling, the pixels (of the whole frame) that take
+    /// these samples; every pixel when `None`.
+    pub(super) active: Option<&'a [bool]>,
+    /// How samples will be displayed, for adaptive sampling's error.
+    pub(super) display: crate::color::Display,
     pub(super) on_row: &'a (dyn Fn() + Sync),
 }
 
@@ -58,6 +64,8 @@ impl<'a> FrameSetup<'a> {
                 .path_tracing
                 .as_ref()
                 .and_then(|pt| pt.sky.environment()),
+            active: None,
+            display: scenes[0].look.display_transform(),
             scenes,
             on_row,
         }
@@ -95,12 +103,15 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
     let mut scratch = ROW_SCRATCH.take();
     scratch.marched.resize(rows * w, MarchResult::default());
     for s in frame.samples.clone() {
-        let k = s as usize % scenes.len();
+        let k = match scenes[0].adaptive {
+            Some(_) => super::adaptive::progressive_instant(s, scenes.len()),
+            None => s as usize % scenes.len(),
+        };
         let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
         scratch.camera_rays(frame, scene, camera, y0, rows, s);
         let RowScratch {
-            order,
-            runs,
+            picked: order,
+            picked_runs: runs,
             rays,
             marched,
             surfaces,
@@ -112,6 +123,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
             ..
         } = &mut scratch;
         let (f, q) = (&scene.fractal, &scene.quality);
+        let marched = &mut marched[..rays.len()];
         crate::march::march_camera_rays(rays, f, q, runs, marched, cone_free);
         // Where each ray met the surface, with its normal (the band's hits
         // four to a kernel call); each pixel's cost goes straight to its sum.
@@ -175,6 +187,14 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
                 stats.repaired_samples += 1;
             }
             let c = finite_or_zero(c);
+            if let Some(spread) = sums.spread.as_deref_mut() {
+                let closest = if at.is_some() {
+                    Real::INFINITY
+                } else {
+                    result.closest
+                };
+                spread[p].add(c, &frame.display, closest);
+            }
             sums.colour[p][0] += c.x as f64;
             sums.colour[p][1] += c.y as f64;
             sums.colour[p][2] += c.z as f64;
@@ -245,11 +265,15 @@ impl RowScratch {
             crate::march::cone_blocks(w, rows, layout.2, &mut self.order, &mut self.runs);
             self.laid_out = Some(layout);
         }
+        self.pick(frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]));
         self.rays.clear();
-        self.rays.extend(self.order.iter().map(|&p| {
+        self.rays.extend(self.picked.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
             let pixel = (y0 * w + p) as u64;
-            let (ox, oy) = subpixel(scene, frame.frame_index, pixel, s, n);
+            let (ox, oy) = match scene.adaptive {
+                Some(_) if n > 1 => progressive_subpixel(scene, frame.frame_index, pixel, s),
+                _ => subpixel(scene, frame.frame_index, pixel, s, n),
+            };
             if camera.has_lens() {
                 let u = sample_1d(scene.seed, frame.frame_index, pixel, s, 2);
                 let v = sample_1d(scene.seed, frame.frame_index, pixel, s, 3);
@@ -258,6 +282,32 @@ impl RowScratch {
                 camera.ray(x as Real + ox, y as Real + oy, width, height)
             }
         }));
+    }
+}
+
+impl RowScratch {
+    /// The band's pixels that take this sample, from the whole layout:
+    /// each block's `active` pixels, their run as long as they are.
+    fn pick(&mut self, active: Option<&[bool]>) {
+        self.picked.clear();
+        self.picked_runs.clear();
+        let Some(active) = active else {
+            self.picked.extend_from_slice(&self.order);
+            self.picked_runs.extend_from_slice(&self.runs);
+            return;
+        };
+        let mut start = 0;
+        for &run in &self.runs {
+            let block = &self.order[start..start + run as usize];
+            let before = self.picked.len();
+            self.picked
+                .extend(block.iter().copied().filter(|&p| active[p]));
+            let taken = (self.picked.len() - before) as u32;
+            if taken > 0 {
+                self.picked_runs.push(taken);
+            }
+            start += run as usize;
+        }
     }
 }
 
@@ -354,6 +404,9 @@ pub(super) struct RowScratch {
     pub(super) laid_out: Option<(usize, usize, (usize, usize))>,
     pub(super) order: Vec<usize>,
     pub(super) runs: Vec<u32>,
+    /// The pixels of `order` that take this sample, and their blocks' sizes.
+    pub(super) picked: Vec<usize>,
+    pub(super) picked_runs: Vec<u32>,
     pub(super) rays: Vec<crate::march::Ray>,
     pub(super) marched: Vec<MarchResult>,
     /// Where each camera ray met the surface.

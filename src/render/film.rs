@@ -179,16 +179,18 @@ pub(super) fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64
             && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len()),
         "a band's film and sums differ in size"
     );
-    let inv = 1.0 / n as f64;
-    for (c, s) in out.colour.iter_mut().zip(&sums.colour) {
+    // Under adaptive sampling each pixel has the samples it took.
+    let taken = |i: usize| sums.spread.get(i).map_or(n, |p| p.taken).max(1);
+    for (i, (c, s)) in out.colour.iter_mut().zip(&sums.colour).enumerate() {
+        let inv = 1.0 / taken(i) as f64;
         *c = Vec3::new(
             (s[0] * inv) as f32,
             (s[1] * inv) as f32,
             (s[2] * inv) as f32,
         );
     }
-    for (a, &h) in out.alpha.iter_mut().zip(&sums.hits) {
-        *a = h as f32 / n as f32;
+    for (i, (a, &h)) in out.alpha.iter_mut().zip(&sums.hits).enumerate() {
+        *a = h as f32 / taken(i) as f32;
     }
     out.depth.copy_from_slice(&sums.depth);
     for (e, &s) in out.evaluations.iter_mut().zip(&sums.spent) {

@@ -13,12 +13,14 @@ use crate::scene::Scene;
 use rayon::prelude::*;
 
 mod accumulation;
+pub mod adaptive;
 mod band;
 mod film;
 pub mod pick;
 mod stats;
 
 pub use accumulation::Accumulation;
+pub use adaptive::{next_wave, wave_count};
 use band::{render_band, FrameSetup, BAND_ROWS, ROW_SUMS};
 use film::finish_pixels;
 pub use film::{frame_bytes, Film, Layers};
@@ -138,7 +140,15 @@ pub fn render_samples_unless(
     stop: &(dyn Fn() -> bool + Sync),
 ) -> bool {
     let samples = acc.samples_done..until;
-    let frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
+    if scenes[0].adaptive.is_some() && acc.samples_done == 0 {
+        acc.start_spreads();
+    }
+    let mut active = Vec::new();
+    if acc.samples_done > 0 && !acc.spread.is_empty() {
+        adaptive::refining(&scenes[0], acc, &mut active);
+    }
+    let mut frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
+    frame.active = (!active.is_empty()).then_some(&active[..]);
     let stopped = std::sync::atomic::AtomicBool::new(false);
     // One band of rows per task; rayon spreads bands over threads and each
     // pixel depends only on its own samples and its band, so the result is

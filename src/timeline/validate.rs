@@ -104,9 +104,21 @@ pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
     animatable_in(s, QUALITY, &QUALITY_CHECKS)?;
     at("quality.cone_rays", counted(s.quality.cone_rays, 4096))?;
     at("samples_per_pixel", counted(s.samples_per_pixel, 4096))?;
+    if let Some(a) = &s.adaptive {
+        at("adaptive.first", counted(a.first, 4096))?;
+        at("adaptive.noise", noise(a.noise))?;
+    }
     animatable_in(s, LOOK, &LOOK_CHECKS)?;
     extra_lights(s)?;
     effects(s)
+}
+
+/// Adaptive sampling's noise: a display value's error, from 0.0001 (below
+/// that no pixel would ever stop short of its cap) to 1.
+fn noise(x: f32) -> Checked {
+    rule((1e-4..=1.0).contains(&x), || {
+        format!("must be from 0.0001 to 1 (an error in display values), got {x}")
+    })
 }
 
 /// A count from 1 to `most`.
