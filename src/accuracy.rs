@@ -64,8 +64,8 @@ pub struct Measurement {
 /// analytic estimator in f64, trusted (no membership walk, which goes
 /// through the thin parts of the set: docs/surface.md) down to hit
 /// threshold ÷ 8, fudge ≤ 0.5, no over-relaxation, every ray marched alone
-/// (no cones), 8× the steps, normal step ÷ 4 and at least 16 samples per
-/// pixel.
+/// (no cones), 8× the steps, normal step ÷ 4 and at least 16 samples in
+/// every pixel.
 pub fn reference_scene(scene: &Scene) -> Scene {
     let mut r = scene.clone();
     r.fractal.de = DeMethod::Analytic;
@@ -78,6 +78,7 @@ pub fn reference_scene(scene: &Scene) -> Scene {
     r.quality.over_relaxation = 1.0;
     r.quality.cone_rays = 1;
     r.samples_per_pixel = scene.samples_per_pixel.max(16);
+    r.adaptive = None;
     r
 }
 
@@ -173,7 +174,14 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     }
     for n in [1, 4, 9, 16] {
         add("samples_per_pixel", n.to_string(), &|s| {
-            s.samples_per_pixel = n
+            s.samples_per_pixel = n;
+            s.adaptive = None;
+        });
+    }
+    for noise in [0.04, 0.02, 0.01] {
+        add("adaptive", format!("up to 16, noise {noise}"), &|s| {
+            s.samples_per_pixel = 16;
+            s.adaptive = Some(crate::scene::Adaptive { first: 2, noise });
         });
     }
     add("perturbation", "off: f64 alone".into(), &|s| {

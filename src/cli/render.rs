@@ -104,7 +104,8 @@ pub fn render(args: RenderArgs) -> anyhow::Result<()> {
         bars.overall.inc(1);
         // Asked for, so printed even with --quiet.
         if args.stats {
-            bars.say(stats_line(frame, stats.1, &stats.0));
+            let pixels = job.plan.width as u64 * job.plan.height as u64;
+            bars.say(stats_line(frame, stats.1, &stats.0, pixels));
         } else if !args.quiet && !show_bars {
             eprintln!(
                 "frame {frame} ({}/{}) rendered in {:.2} s",
@@ -181,9 +182,9 @@ fn render_shown(
 }
 
 /// What `--stats` says of a frame.
-fn stats_line(frame: u32, seconds: f64, stats: &FrameStats) -> String {
+fn stats_line(frame: u32, seconds: f64, stats: &FrameStats, pixels: u64) -> String {
     format!(
-        "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit ({} out of steps), {} repaired",
+        "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit ({:.2} samples a pixel, {} out of steps), {} repaired",
         stats.de_evaluations,
         stats.de_evaluations as f64 / stats.samples.max(1) as f64,
         stats.max_pixel_evaluations,
@@ -195,6 +196,7 @@ fn stats_line(frame: u32, seconds: f64, stats: &FrameStats) -> String {
         stats.sun_evaluations,
         stats.hits,
         stats.samples,
+        stats.samples as f64 / pixels.max(1) as f64,
         stats.out_of_steps,
         stats.repaired_samples
     )

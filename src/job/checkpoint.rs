@@ -219,4 +219,35 @@ mod tests {
         std::fs::write(&path, &bytes).unwrap();
         assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_some());
     }
+
+    #[test]
+    fn adaptive_checkpoints_keep_each_pixels_spread_and_resume_alike() {
+        use crate::render::{next_wave, render_samples, Accumulation, Layers};
+        let dir = tempfile::tempdir().unwrap();
+        let scene = Scene {
+            samples_per_pixel: 16,
+            adaptive: Some(crate::scene::Adaptive::default()),
+            ..Scene::default()
+        };
+        let scenes = std::slice::from_ref(&scene);
+        let wave = |acc: &mut Accumulation| {
+            let until = next_wave(&scene, acc.samples_done);
+            render_samples(scenes, 0, acc, until, &|| {});
+        };
+        let mut straight = Accumulation::new(24, 16, Layers::default());
+        wave(&mut straight);
+        wave(&mut straight);
+        let path = dir.path().join(".frame_00000.ckpt");
+        write_checkpoint(&path, &straight, "h").unwrap();
+        let mut resumed = read_checkpoint(&path, "h", 24, 16, Layers::default()).unwrap();
+        assert_eq!(resumed, straight);
+        assert!(!resumed.spread.is_empty());
+        while straight.samples_done < 16 {
+            wave(&mut straight);
+            wave(&mut resumed);
+        }
+        assert_eq!(resumed, straight);
+        let taken: Vec<u32> = straight.spread.iter().map(|p| p.taken).collect();
+        assert!(taken.contains(&4) && taken.contains(&16), "{taken:?}");
+    }
 }

@@ -84,6 +84,11 @@ pub fn render_frame_into(
     on_row: &(dyn Fn() + Sync),
 ) {
     let n = scenes[0].samples_per_pixel.max(1);
+    if scenes[0].adaptive.is_some() && n > 1 {
+        // Adaptive sampling judges pixels between waves, frame-wide.
+        *film = render_in_waves(scenes, frame_index, (width, height), layers, on_row);
+        return;
+    }
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     film.prepare(width, height, layers);
     // Every band of rows renders in parallel into this thread's one-band
@@ -104,6 +109,23 @@ pub fn render_frame_into(
         })
         // `+` keeps the larger per-pixel maximum.
         .reduce(FrameStats::default, |a, b| a + b);
+}
+
+/// A frame rendered wave after wave of samples into whole-frame sums.
+pub fn render_in_waves(
+    scenes: &[Scene],
+    frame_index: u32,
+    (width, height): (u32, u32),
+    layers: Layers,
+    on_row: &(dyn Fn() + Sync),
+) -> Film {
+    let n = scenes[0].samples_per_pixel.max(1);
+    let mut acc = Accumulation::new(width, height, layers);
+    while acc.samples_done < n {
+        let until = next_wave(&scenes[0], acc.samples_done);
+        render_samples(scenes, frame_index, &mut acc, until, on_row);
+    }
+    acc.finish(n)
 }
 
 /// `v` at `n` elements: kept, with whatever values it holds, where its

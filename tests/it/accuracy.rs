@@ -39,6 +39,7 @@ fn accuracy_writes_csv_table_and_chart() {
         "max_steps",
         "normal_step",
         "samples_per_pixel",
+        "adaptive",
         "de",
     ] {
         assert!(rows.iter().any(|r| r[0] == knob), "no {knob} rows");

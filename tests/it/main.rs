@@ -19,6 +19,7 @@ mod locations;
 mod names;
 mod quality;
 mod resume;
+mod sampling;
 mod stability;
 mod surface;
 mod validation;
