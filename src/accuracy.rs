@@ -179,7 +179,7 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
         });
     }
     for noise in [0.04, 0.02, 0.01] {
-        add("adaptive", format!("up to 16, noise {noise}"), &|s| {
+        add("adaptive", format!("noise {noise} (at most 16)"), &|s| {
             s.samples_per_pixel = 16;
             s.adaptive = Some(crate::scene::Adaptive { first: 2, noise });
         });

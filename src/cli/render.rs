@@ -184,7 +184,7 @@ fn render_shown(
 /// What `--stats` says of a frame.
 fn stats_line(frame: u32, seconds: f64, stats: &FrameStats, pixels: u64) -> String {
     format!(
-        "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit ({:.2} samples a pixel, {} out of steps), {} repaired",
+        "frame {frame}: {seconds:.2} s, {} DE evaluations ({:.1} per sample, at most {} in one pixel; primary {}, normals {}, shadows {}, occlusion {}, bounces {}, sun {}), {} of {} samples hit ({} out of steps), {:.2} samples a pixel, {} repaired",
         stats.de_evaluations,
         stats.de_evaluations as f64 / stats.samples.max(1) as f64,
         stats.max_pixel_evaluations,
@@ -196,8 +196,8 @@ fn stats_line(frame: u32, seconds: f64, stats: &FrameStats, pixels: u64) -> Stri
         stats.sun_evaluations,
         stats.hits,
         stats.samples,
-        stats.samples as f64 / pixels.max(1) as f64,
         stats.out_of_steps,
+        stats.samples as f64 / pixels.max(1) as f64,
         stats.repaired_samples
     )
 }

@@ -20,7 +20,10 @@ fn adaptive_sampling_spends_samples_where_the_frame_needs_them() {
     let d = Dir::new();
     let adaptive = "samples_per_pixel: 16, adaptive: (first: 2, noise: 0.02)";
     d.write("a.ron", &with_scene(&tiny_timeline(1, 8.0), adaptive));
-    d.write("u.ron", &with_scene(&tiny_timeline(1, 8.0), "samples_per_pixel: 16"));
+    d.write(
+        "u.ron",
+        &with_scene(&tiny_timeline(1, 8.0), "samples_per_pixel: 16"),
+    );
     let taken = |timeline: &str, extra: &[&str]| {
         let mut args = vec!["render", timeline, "--stats", "--quiet"];
         args.extend_from_slice(extra);
@@ -52,7 +55,11 @@ fn adaptive_frames_are_the_same_on_any_thread_count_and_after_a_kill() {
     );
     assert!(text.contains("adaptive"));
     d.write("t.ron", &text);
-    d.same_on_one_and_two_threads("t.ron", &["--format", "exr", "--quiet"], &["frame_00000.exr"]);
+    d.same_on_one_and_two_threads(
+        "t.ron",
+        &["--format", "exr", "--quiet"],
+        &["frame_00000.exr"],
+    );
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
     let args = [
         "render",
@@ -82,7 +89,10 @@ fn bad_adaptive_settings_are_refused_at_their_place() {
             "adaptive: (noise: 0)",
             "scene.adaptive.noise: must be from 0.0001 to 1",
         ),
-        ("adaptive: (first: 0)", "scene.adaptive.first: must be 1..=4096"),
+        (
+            "adaptive: (first: 0)",
+            "scene.adaptive.first: must be 1..=4096",
+        ),
         ("adaptive: (noise: 0.01, fist: 2)", "fist"),
     ] {
         let d = Dir::new();
