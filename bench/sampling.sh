@@ -1,6 +1,6 @@
 #!/bin/sh
 # What adaptive sampling buys: renders frames of the examples with uniform
-# 4 and 16 samples a pixel and with adaptive sampling capped at 16, one after
+# 1, 4 and 16 samples a pixel and with adaptive sampling capped at 16, one after
 # another in one run, each timed, and measures each with `mandelreel quality`
 # against a 64-sample reference rendered with another seed (so that no
 # candidate shares its random numbers). Prints a markdown table.
@@ -54,10 +54,10 @@ for spec in "zoom 60..120" "julia_morph 48..96"; do
         "$bin" render "$out/${tl}_reference.ron" --frames "$frames" --out "$out/${tl}_reference" --quiet >/dev/null
         echo "$frames" >"$out/${tl}_reference/.done-$frames"
     fi
-    variant "$tl" uniform-4 "samples_per_pixel: 4,"
-    variant "$tl" uniform-16 "samples_per_pixel: 16,"
-    measure "$tl" "$frames" uniform-4
-    measure "$tl" "$frames" uniform-16
+    for n in 1 4 16; do
+        variant "$tl" "uniform-$n" "samples_per_pixel: $n,"
+        measure "$tl" "$frames" "uniform-$n"
+    done
     for noise in $noises; do
         variant "$tl" "adaptive-$noise" "samples_per_pixel: 16, adaptive: (first: 2, noise: $noise),"
         measure "$tl" "$frames" "adaptive-$noise"

@@ -12,10 +12,15 @@ impl Plan {
     /// killed with the machine short of memory.
     pub fn check_memory(&self, size_given: bool) -> anyhow::Result<()> {
         // No track animates the sample count: the base scene has it.
-        let many_samples = !self.preview && self.timeline.base.samples_per_pixel > 1;
+        let base = &self.timeline.base;
+        let sums = match (self.preview || base.samples_per_pixel <= 1, &base.adaptive) {
+            (true, _) => crate::render::Sums::None,
+            (false, None) => crate::render::Sums::Uniform,
+            (false, Some(_)) => crate::render::Sums::Adaptive,
+        };
         let exr = self.formats.contains(&Format::Exr);
         let (w, h) = (self.width, self.height);
-        let need = crate::render::frame_bytes(w, h, self.layers(), exr, many_samples);
+        let need = crate::render::frame_bytes(w, h, self.layers(), exr, sums);
         let Some((have, whose)) = memory_available() else {
             return Ok(());
         };

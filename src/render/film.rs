@@ -100,17 +100,27 @@ impl Layers {
 /// for its blocks, for a PNG its 3 bytes of sRGB codes and a byte of
 /// compressed data; and for a frame of several samples per pixel the
 /// running sums (colour in f64, hits, depth and estimates spent, 40 bytes a
-/// pixel, and the layers). What a size can be checked against before it is
-/// rendered.
-pub fn frame_bytes(width: u32, height: u32, layers: Layers, exr: bool, many_samples: bool) -> u64 {
+/// pixel, and the layers, and under adaptive sampling each pixel's spread).
+/// What a size can be checked against before it is rendered.
+pub fn frame_bytes(width: u32, height: u32, layers: Layers, exr: bool, sums: Sums) -> u64 {
     let film = 24 + layers.bytes_per_pixel();
     let encoding = if exr { film } else { 4 };
-    let sums = if many_samples {
-        40 + layers.bytes_per_pixel()
-    } else {
-        0
+    let spread = std::mem::size_of::<super::adaptive::Spread>() as u64;
+    let sums = match sums {
+        Sums::None => 0,
+        Sums::Uniform => 40 + layers.bytes_per_pixel(),
+        Sums::Adaptive => 40 + layers.bytes_per_pixel() + spread,
     };
     width as u64 * height as u64 * (film + encoding + sums)
+}
+
+/// The running sums a frame keeps while it renders (`frame_bytes`): none
+/// for one sample a pixel, rendered band by band.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sums {
+    None,
+    Uniform,
+    Adaptive,
 }
 
 /// Pixels of a film (a band, or all of them).

@@ -23,7 +23,7 @@ pub use accumulation::Accumulation;
 pub use adaptive::{next_wave, wave_count};
 use band::{render_band, FrameSetup, BAND_ROWS, ROW_SUMS};
 use film::finish_pixels;
-pub use film::{frame_bytes, Film, Layers};
+pub use film::{frame_bytes, Film, Layers, Sums};
 pub use stats::FrameStats;
 
 /// Depth written for pixels that see only background.
