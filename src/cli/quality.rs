@@ -111,7 +111,7 @@ type FrameFiles = (u32, PathBuf, Option<PathBuf>);
 /// so a long sequence is never all in memory.
 fn measure(pairs: &[FrameFiles]) -> crate::error::Result<crate::quality::SequenceQuality> {
     let mut meter = Meter::default();
-    for batch in pairs.chunks(2 * rayon::current_num_threads()) {
+    for batch in pairs.chunks(batch_size(pairs)) {
         let decoded: Vec<(FrameImage, Option<image::RgbImage>)> = batch
             .par_iter()
             .map(|(frame, path, reference)| {
@@ -131,6 +131,21 @@ fn measure(pairs: &[FrameFiles]) -> crate::error::Result<crate::quality::Sequenc
         }
     }
     meter.finish()
+}
+
+/// About the most memory the frames decoded at once may take.
+const BATCH_BYTES: u64 = 1 << 30;
+
+/// Frames decoded at once: two a thread, fewer where the frames are so
+/// large that they would pass `BATCH_BYTES` (a frame and its reference take
+/// about 16 bytes a pixel decoded and measured), at least one.
+fn batch_size(pairs: &[FrameFiles]) -> usize {
+    let pixels = pairs
+        .first()
+        .and_then(|(_, path, _)| image::image_dimensions(path).ok())
+        .map_or(0, |(w, h)| w as u64 * h as u64);
+    let fit = BATCH_BYTES / (16 * pixels).max(1);
+    (2 * rayon::current_num_threads()).min(fit as usize).max(1)
 }
 
 /// A PNG as 8-bit RGB: 16-bit ones scaled down, alpha dropped.

@@ -87,7 +87,8 @@ impl Renders {
         };
         if stage == Stage::Final {
             self.rows_done.store(0, Ordering::Relaxed);
-            self.rows_total.store(height * samples, Ordering::Relaxed);
+            let waves = crate::render::wave_count(&scenes[0]);
+            self.rows_total.store(height * waves, Ordering::Relaxed);
         }
         let on_row = || {
             if stage == Stage::Final {

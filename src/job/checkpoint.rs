@@ -169,6 +169,9 @@ pub fn read_checkpoint(
             p.grazes = u32::from_le_bytes(take(&mut file)?);
             p.sum = f64::from_le_bytes(take(&mut file)?);
             p.squares = f64::from_le_bytes(take(&mut file)?);
+            if p.taken > header.samples_done || p.grazes > p.taken {
+                return None;
+            }
         }
     }
     // Whole: nothing after the arrays.

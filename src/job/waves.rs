@@ -54,7 +54,8 @@ impl Plan {
             self.height,
             layers,
         )
-        .filter(|a| a.samples_done < n);
+        // Spreads are there exactly when the frame samples adaptively.
+        .filter(|a| a.samples_done < n && a.spread.is_empty() == scenes[0].adaptive.is_none());
         let mut acc = saved_acc
             .unwrap_or_else(|| crate::render::Accumulation::new(self.width, self.height, layers));
         if acc.samples_done > 0 {

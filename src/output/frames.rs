@@ -20,11 +20,13 @@ use std::path::{Path, PathBuf};
 /// hash of the light itself after a `~` (`~exposure=2,Filmic`), where it is
 /// not the default: an EXR, which holds the linear light, and a
 /// checkpoint are keyed on the light alone (`light_hash`), so a change of
-/// grade re-renders no EXR-only sequence and keeps checkpoints.
+/// grade re-renders no EXR-only sequence and keeps checkpoints. Not under
+/// adaptive sampling, whose samples go where the graded image is noisy:
+/// there the grade is part of the light.
 pub fn frame_hash(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> String {
     let look = &scenes[0].look;
     let plain = scenes.iter().all(|s| s.look.display_transform().is_plain());
-    if plain {
+    if plain || scenes[0].adaptive.is_some() {
         return light_digest(scenes, frame_index, width, height);
     }
     let light: Vec<Scene> = scenes

@@ -151,8 +151,8 @@ pub(super) fn progressive_subpixel(scene: &Scene, frame: u32, pixel: u64, s: u32
 
 /// The instant (of `instants`, spread over the shutter) that sample `s`
 /// sees under adaptive sampling: a stride through them that is prime to
-/// their count, near the golden section, so a pixel that stops early has
-/// still seen the whole shutter.
+/// their count, near the golden section, so that a pixel's first samples
+/// are spread over the shutter rather than bunched at its opening.
 pub(super) fn progressive_instant(s: u32, instants: usize) -> usize {
     let n = instants.max(1);
     let golden = (n as f64 * 0.618_033_988_749_895).round() as usize;

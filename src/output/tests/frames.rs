@@ -100,3 +100,19 @@ fn frame_files_ignore_temporaries_and_other_names() {
     assert_eq!(names("frame_##"), ["frame_01.png", "frame_100000.png"]);
     assert_eq!(names("shot_####"), ["shot_0003.png"]);
 }
+
+#[test]
+fn under_adaptive_sampling_the_grade_is_part_of_the_light() {
+    // Adaptive sampling judges the graded image, so a checkpoint or an EXR
+    // made under one exposure must not be taken for another's.
+    let hashed = |adaptive: bool, exposure: f32| {
+        let mut s = Scene::default();
+        s.look.exposure = exposure;
+        s.adaptive = adaptive.then(Default::default);
+        frame_hash(&[s], 0, 8, 8)
+    };
+    let light = |adaptive, exposure| light_hash(&hashed(adaptive, exposure)).to_string();
+    assert_eq!(light(false, 1.0), light(false, 2.0));
+    assert_ne!(light(true, 1.0), light(true, 2.0));
+    assert_ne!(hashed(true, 1.0), hashed(true, 2.0));
+}
