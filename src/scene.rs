@@ -101,12 +101,19 @@ impl Scene {
 }
 
 impl Scene {
+    /// The adaptive sampling that takes effect: none where the first wave
+    /// already takes every sample.
+    pub fn adapts(&self) -> Option<&Adaptive> {
+        let n = self.samples_per_pixel;
+        self.adaptive.as_ref().filter(|a| a.first.min(n) < n)
+    }
+
     /// How many samples a pixel takes, in words: `4 sample(s) per pixel`,
     /// or `adaptive: 2 to 16 samples per pixel, to noise 0.01`.
     pub fn sampling_summary(&self) -> String {
         let n = self.samples_per_pixel;
-        match &self.adaptive {
-            Some(a) if a.first.min(n) < n => format!(
+        match self.adapts() {
+            Some(a) => format!(
                 "adaptive: {} to {n} samples per pixel, to noise {}",
                 a.first, a.noise
             ),

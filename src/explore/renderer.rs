@@ -5,7 +5,7 @@
 
 use super::view::Prepared;
 use crate::output::{self, Format};
-use crate::render::{Accumulation, Film, Layers};
+use crate::render::{render_in_waves, Film, Layers};
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
 use std::sync::atomic::{AtomicU32, AtomicU64, Ordering};
@@ -95,7 +95,8 @@ impl Renders {
                 self.rows_done.fetch_add(1, Ordering::Relaxed);
             }
         };
-        let film = accumulate(&scenes, view.frame, (width, height), &on_row, &stop)?;
+        let size = (width, height);
+        let film = render_in_waves(&scenes, view.frame, size, Layers::default(), &on_row, &stop)?;
         let seconds = started.elapsed().as_secs_f64();
         if matches!(stage, Stage::Quick | Stage::Full) {
             self.pace((width * height) as f64 / seconds.max(1e-4));
@@ -126,26 +127,6 @@ fn shrunk(view: &Prepared, pixels: u64) -> (u32, u32, u32) {
     let scale = ((pixels as f64 / area as f64).sqrt()).min(1.0);
     let side = |n: u32| ((n as f64 * scale).round() as u32).max(1);
     (side(view.width), side(view.height), 1)
-}
-
-/// Every sample of `scenes`, in the waves `render` takes them, or none
-/// where `stop` says so first.
-fn accumulate(
-    scenes: &[Scene],
-    frame: u32,
-    (width, height): (u32, u32),
-    on_row: &(dyn Fn() + Sync),
-    stop: &(dyn Fn() -> bool + Sync),
-) -> Option<Film> {
-    let n = scenes[0].samples_per_pixel.max(1);
-    let mut acc = Accumulation::new(width, height, Layers::default());
-    while acc.samples_done < n {
-        let until = crate::render::next_wave(&scenes[0], acc.samples_done);
-        if !crate::render::render_samples_unless(scenes, frame, &mut acc, until, on_row, stop) {
-            return None;
-        }
-    }
-    Some(acc.finish(n))
 }
 
 /// `film` as `render` writes it into a PNG file.
@@ -190,10 +171,11 @@ pub fn estimate(timeline: &crate::timeline::Timeline, view: &Prepared) -> Estima
     for i in 0..count {
         let last = (timeline.frame_count - 1) as u64;
         let frame = (i as u64 * last / (count.max(2) - 1) as u64) as u32;
-        accumulate(
+        render_in_waves(
             &sampled.scenes_for_frame(frame),
             frame,
             (w, h),
+            Layers::default(),
             &|| {},
             &|| false,
         );

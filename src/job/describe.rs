@@ -76,8 +76,8 @@ pub fn plan_lines(base: &Scene) -> Vec<String> {
             lens.aperture_radius, lens.focus_distance, crate::scene::LENS_SAMPLES
         ));
     }
-    lines.push(match &base.adaptive {
-        Some(a) if a.first.min(base.samples_per_pixel) < base.samples_per_pixel => format!(
+    lines.push(match base.adapts() {
+        Some(a) => format!(
             "          {}: {}x the per-sample work in every pixel, up to {}x where a pixel's error says so",
             base.sampling_summary(), a.first, base.samples_per_pixel
         ),

@@ -12,7 +12,7 @@
 use super::Accumulation;
 use crate::color::SrgbCurve;
 use crate::math::{Real, Vec3};
-use crate::scene::Scene;
+use crate::scene::{Adaptive, Scene};
 use rayon::prelude::*;
 
 /// What adaptive sampling keeps of a pixel besides its sums: the samples
@@ -91,32 +91,30 @@ pub fn wave_count(scene: &Scene) -> u32 {
     waves
 }
 
-/// Which pixels of `acc` take the next wave: all of them before the
-/// first; after it, those still refining (`Spread` and the module's rules).
-pub(super) fn refining(scene: &Scene, acc: &Accumulation, out: &mut Vec<bool>) {
-    out.clear();
-    let Some(adaptive) = &scene.adaptive else {
-        out.resize(acc.colour.len(), true);
-        return;
-    };
+/// Which pixels of `acc`, a wave or more in, take the next wave: those
+/// still refining (`Spread` and the module's rules).
+pub(super) fn refining(adaptive: &Adaptive, acc: &Accumulation, out: &mut Vec<bool>) {
     let done = acc.samples_done;
-    if done == 0 {
-        out.resize(acc.colour.len(), true);
-        return;
-    }
+    debug_assert!(done > 0 && acc.spread.len() == acc.colour.len());
     let (w, h) = (acc.width as usize, acc.height as usize);
     let noise = adaptive.noise as f64;
     let spread = &acc.spread;
-    // Each pixel's decision reads only the finished wave: any split of
-    // the pixels over threads decides alike.
+    // Each pixel's error once, then each pixel's decision from the finished
+    // wave alone: any split of the pixels over threads decides alike.
+    let mut noisy = Vec::new();
+    noisy.par_extend(
+        spread
+            .par_iter()
+            .map(|p| p.taken >= done && p.error() > noise),
+    );
+    out.clear();
     out.par_extend((0..w * h).into_par_iter().map(|i| {
         let p = &spread[i];
         if p.taken < done {
             return false; // stopped by an earlier wave
         }
-        let noisy = |j: usize| spread[j].taken >= done && spread[j].error() > noise;
         p.grazes > 0
-            || neighbours(i, w, h).any(noisy)
+            || neighbours(i, w, h).any(|j| noisy[j])
             || stands_out(spread, i, w, h, noise * CONTRAST_NOISES)
     }));
 }

@@ -101,6 +101,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
     // and freeing them per band made the allocator hand pages
     // back and fault them in again, flushing the other cores' TLBs.
     let mut scratch = ROW_SCRATCH.take();
+    scratch.picked_valid = false; // another band's pixels
     scratch.marched.resize(rows * w, MarchResult::default());
     for s in frame.samples.clone() {
         let k = match scenes[0].adaptive {
@@ -264,8 +265,13 @@ impl RowScratch {
         if self.laid_out != Some(layout) {
             crate::march::cone_blocks(w, rows, layout.2, &mut self.order, &mut self.runs);
             self.laid_out = Some(layout);
+            self.picked_valid = false;
         }
-        self.pick(frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]));
+        // The same pixels take every sample of a wave.
+        if !self.picked_valid {
+            self.pick(frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]));
+            self.picked_valid = true;
+        }
         self.rays.clear();
         self.rays.extend(self.picked.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
@@ -407,6 +413,8 @@ pub(super) struct RowScratch {
     /// The pixels of `order` that take this sample, and their blocks' sizes.
     pub(super) picked: Vec<usize>,
     pub(super) picked_runs: Vec<u32>,
+    /// Whether `picked` holds this band's pixels for this layout.
+    pub(super) picked_valid: bool,
     pub(super) rays: Vec<crate::march::Ray>,
     pub(super) marched: Vec<MarchResult>,
     /// Where each camera ray met the surface.

@@ -86,7 +86,9 @@ pub fn render_frame_into(
     let n = scenes[0].samples_per_pixel.max(1);
     if scenes[0].adaptive.is_some() && n > 1 {
         // Adaptive sampling judges pixels between waves, frame-wide.
-        *film = render_in_waves(scenes, frame_index, (width, height), layers, on_row);
+        let never = || false;
+        *film = render_in_waves(scenes, frame_index, (width, height), layers, on_row, &never)
+            .expect("a render that is never stopped finishes");
         return;
     }
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
@@ -111,21 +113,25 @@ pub fn render_frame_into(
         .reduce(FrameStats::default, |a, b| a + b);
 }
 
-/// A frame rendered wave after wave of samples into whole-frame sums.
+/// A frame rendered wave after wave of samples into whole-frame sums, as
+/// `render` takes them; none where `stop` says so first.
 pub fn render_in_waves(
     scenes: &[Scene],
     frame_index: u32,
     (width, height): (u32, u32),
     layers: Layers,
     on_row: &(dyn Fn() + Sync),
-) -> Film {
+    stop: &(dyn Fn() -> bool + Sync),
+) -> Option<Film> {
     let n = scenes[0].samples_per_pixel.max(1);
     let mut acc = Accumulation::new(width, height, layers);
     while acc.samples_done < n {
         let until = next_wave(&scenes[0], acc.samples_done);
-        render_samples(scenes, frame_index, &mut acc, until, on_row);
+        if !render_samples_unless(scenes, frame_index, &mut acc, until, on_row, stop) {
+            return None;
+        }
     }
-    acc.finish(n)
+    Some(acc.finish(n))
 }
 
 /// `v` at `n` elements: kept, with whatever values it holds, where its
@@ -166,8 +172,8 @@ pub fn render_samples_unless(
         acc.start_spreads();
     }
     let mut active = Vec::new();
-    if acc.samples_done > 0 && !acc.spread.is_empty() {
-        adaptive::refining(&scenes[0], acc, &mut active);
+    if let (Some(a), true) = (&scenes[0].adaptive, acc.samples_done > 0) {
+        adaptive::refining(a, acc, &mut active);
     }
     let mut frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
     frame.active = (!active.is_empty()).then_some(&active[..]);

@@ -1,7 +1,9 @@
 //! Resume: complete frames are skipped, stale or partial ones re-rendered, and a
 //! render killed mid-way leaves no damaged frame and finishes identically.
 
-use crate::util::{long_frames, says, stderr, tiny_timeline, with_scene, Dir};
+use crate::util::{
+    long_frames, render_until_a_checkpoint, says, stderr, tiny_timeline, with_scene, Dir,
+};
 use std::time::{Duration, Instant};
 
 fn mtimes(d: &Dir, sub: &str) -> Vec<std::time::SystemTime> {
@@ -226,21 +228,6 @@ fn killed_render_resumes_to_identical_frames() {
             "frame {f} differs"
         );
     }
-}
-
-/// Starts rendering `t.ron` into out/t on one thread, saving a checkpoint
-/// after every wave, and returns once the first is saved: mid-frame.
-fn render_until_a_checkpoint(d: &Dir) -> std::process::Child {
-    let args = [
-        "render",
-        "t.ron",
-        "--checkpoint-seconds",
-        "0",
-        "--threads",
-        "1",
-        "--quiet",
-    ];
-    d.spawn_until(&args, "out/t", ".ckpt")
 }
 
 #[test]

@@ -2,7 +2,9 @@
 //! flat, `--samples` as its cap, the same bytes on any thread count and
 //! after a kill, and its settings checked with their place.
 
-use crate::util::{long_frames, says, stderr, stdout, tiny_timeline, with_scene, Dir};
+use crate::util::{
+    long_frames, render_until_a_checkpoint, says, stderr, stdout, tiny_timeline, with_scene, Dir,
+};
 
 /// The samples a pixel each frame took, from `render --stats`.
 fn samples_a_pixel(out: &std::process::Output) -> Vec<f64> {
@@ -61,16 +63,7 @@ fn adaptive_frames_are_the_same_on_any_thread_count_and_after_a_kill() {
         &["frame_00000.exr"],
     );
     d.ok(&["render", "t.ron", "--out", "clean", "--quiet"]);
-    let args = [
-        "render",
-        "t.ron",
-        "--checkpoint-seconds",
-        "0",
-        "--threads",
-        "1",
-        "--quiet",
-    ];
-    let mut child = d.spawn_until(&args, "out/t", ".ckpt");
+    let mut child = render_until_a_checkpoint(&d);
     child.kill().unwrap();
     child.wait().unwrap();
     assert!(!d.files("out/t").contains(&"frame_00000.png".to_string()));

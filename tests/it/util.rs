@@ -297,3 +297,18 @@ pub fn tool(program: &str, probe: &str) -> bool {
     }
     found
 }
+
+/// Starts rendering `t.ron` into out/t on one thread, saving a checkpoint
+/// after every wave, and returns once the first is saved: mid-frame.
+pub fn render_until_a_checkpoint(d: &Dir) -> std::process::Child {
+    let args = [
+        "render",
+        "t.ron",
+        "--checkpoint-seconds",
+        "0",
+        "--threads",
+        "1",
+        "--quiet",
+    ];
+    d.spawn_until(&args, "out/t", ".ckpt")
+}

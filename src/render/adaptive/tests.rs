@@ -117,7 +117,7 @@ fn count(out: &[bool]) -> usize {
 
 #[test]
 fn pixels_go_on_while_they_or_a_neighbour_are_noisy_grazed_or_stand_out() {
-    let scene = adaptive(2, 16); // noise 0.02
+    let scene = adaptive(2, 16).adaptive.expect("adaptive"); // noise 0.02
     let flat = samples(&[0.5, 0.5]);
     let mut out = Vec::new();
     // A flat frame stops everywhere after the first wave.
