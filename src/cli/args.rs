@@ -199,8 +199,10 @@ pub struct RenderArgs {
 
 #[derive(Debug, clap::Args)]
 pub struct StatusArgs {
-    /// An output folder (uses what it records), or a timeline (with the same
-    /// --out, --size, --format, --aov, --samples, --frames and --preview as its render).
+    /// An output folder (uses what it records; --frames and --format pick a part),
+    /// or a timeline (with the same --out, --size, --format, --aov, --samples,
+    /// --frames and --preview as its render). Every frame of the film counts
+    /// unless --frames names some.
     pub target: PathBuf,
     #[command(flatten)]
     pub sequence: SequenceArgs,

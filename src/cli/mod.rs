@@ -90,7 +90,8 @@ pub enum Command {
     /// Tile rendered PNG frames from a folder into one contact-sheet image.
     Sheet(SheetArgs),
     /// Which frames of a sequence are complete, stale, missing or in progress; exit
-    /// status 0 only when every frame is complete and current (4 otherwise).
+    /// status 0 only when every frame of the film (or of --frames) is complete and
+    /// current (4 otherwise).
     Status(StatusArgs),
     /// Measure what accuracy costs: sweep every quality knob, distance estimator and
     /// precision on one frame against a reference; write accuracy.csv, .md and .png.

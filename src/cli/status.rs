@@ -21,7 +21,7 @@ pub fn status(args: StatusArgs) -> anyhow::Result<()> {
     let report = if args.json {
         print_json(&s, &formats, video_command.as_deref())
     } else {
-        print_text(&s, &formats, video_command.as_deref(), &args)
+        print_text(&s, &formats, video_command.as_deref())
     };
     unless_output_closed(report)?;
     let (complete, total) = (s.complete, s.total);
@@ -93,7 +93,6 @@ fn print_text(
     s: &Scan,
     formats: &BTreeMap<&str, FormatStatus<'_>>,
     video_command: Option<&str>,
-    args: &StatusArgs,
 ) -> anyhow::Result<()> {
     let plan = &s.plan;
     out!(
@@ -139,15 +138,8 @@ fn print_text(
     let all = plan.timeline.frame_count;
     if plan.range != (0..all) {
         out!(
-            "  note: {} has {all} frames; these are the ones counted{}",
+            "  note: {} has {all} frames; --frames counts only these (status is 0 when they are complete)",
             plan.timeline.source.display(),
-            if args.target.is_dir() && args.sequence.frames.is_none() {
-                format!(
-                    " (the ranges rendered into this folder; --frames 0..{all} counts them all)"
-                )
-            } else {
-                String::new()
-            }
         );
     }
     if s.changed {

@@ -8,6 +8,7 @@ use crate::job::plan::Plan;
 use crate::job::request::Sequence;
 use crate::output;
 use crate::output::names::FrameName;
+use crate::output::Format;
 use serde::Serialize;
 use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::path::{Path, PathBuf};
@@ -122,7 +123,6 @@ fn folder_plans(
     let given = [
         ("--out", s.out.is_some()),
         ("--size", s.size.is_some()),
-        ("--format", !s.formats.is_empty()),
         ("--aov", !s.aovs.is_empty()),
         ("--preview", s.preview),
         ("--samples", s.samples.is_some()),
@@ -133,20 +133,41 @@ fn folder_plans(
         return Err(Error::usage(
             option,
             format!(
-                "{} is an output folder, which records its own size, samples, formats, layers, \
+                "{} is an output folder, which records its own size, samples, layers, \
                  frame names and EXR compression: give the timeline instead (status TIMELINE {option} …) or leave {option} out",
                 target.display()
             ),
         )
         .into());
     }
-    let (mut parts, job) = Plan::from_folder(target)?;
+    let (parts, job) = Plan::from_folder(target)?;
+    let mut parts = formats_asked(target, parts, &s.formats)?;
+    // The whole film unless --frames asks about a part: a folder holding
+    // some of a film's frames is not a finished film.
     for part in &mut parts {
-        if let Some(frames) = &s.frames {
-            part.range = parse_frames(frames, part.timeline.frame_count)?;
-        }
+        part.range = match &s.frames {
+            Some(frames) => parse_frames(frames, part.timeline.frame_count)?,
+            None => 0..part.timeline.frame_count,
+        };
     }
     Ok((parts, Some(job)))
+}
+
+/// The parts of `parts` in the formats `asked` (all where none is), or
+/// an error naming a format the folder holds no frames of.
+fn formats_asked(target: &Path, parts: Vec<Plan>, asked: &[Format]) -> anyhow::Result<Vec<Plan>> {
+    let held: Vec<&str> = parts.iter().map(|p| p.formats[0].name()).collect();
+    if let Some(missing) = asked.iter().find(|f| !held.contains(&f.name())) {
+        let message = format!(
+            "{} holds no {} frames (it holds {})",
+            target.display(),
+            missing.name(),
+            held.join(", ")
+        );
+        return Err(Error::usage("--format", message).into());
+    }
+    let wanted = |p: &Plan| asked.is_empty() || asked.contains(&p.formats[0]);
+    Ok(parts.into_iter().filter(wanted).collect())
 }
 
 /// Every frame of `plan`'s range by state over the formats of `parts`,

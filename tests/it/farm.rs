@@ -137,29 +137,53 @@ fn status_reports_complete_stale_missing_and_in_progress() {
 }
 
 #[test]
-fn status_of_a_folder_counts_every_range_rendered_into_it() {
-    // Renders in pieces: the folder's record covers 0..6, so the gap shows.
+fn status_of_a_folder_counts_the_whole_film() {
+    // A folder holding 3 of a film's 8 frames is not a finished film: a
+    // script waiting on `status OUTDIR` must not stop early.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(8, 6.0));
+    d.ok(&["render", "t.ron", "--frames", "0..3", "--quiet"]);
+    let out = d.run(&["status", "out/t"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stdout(&out));
+    assert!(
+        stdout(&out).contains("3 of 8 frames complete"),
+        "{}",
+        stdout(&out)
+    );
+    // --frames asks about a part, and says that it does.
+    let part = d.ok(&["status", "out/t", "--frames", "0..3"]);
+    assert!(
+        stdout(&part).contains("3 of 3 frames complete"),
+        "{}",
+        stdout(&part)
+    );
+    assert!(
+        stdout(&part).contains("t.ron has 8 frames"),
+        "{}",
+        stdout(&part)
+    );
+    // Renders in pieces show their gaps, and the frames never rendered.
+    d.ok(&["render", "t.ron", "--frames", "5..7", "--quiet"]);
+    let (code, v) = d.status_json(&["out/t"]);
+    assert_eq!(code, Some(4), "{v}");
+    assert_eq!(v["frames"], serde_json::json!([0, 8]));
+    assert_eq!(v["states"]["missing"], serde_json::json!([3, 4, 7]));
+    assert_eq!(v["timeline_frames"], 8);
+    d.ok(&["render", "t.ron", "--quiet"]);
+    assert!(stdout(&d.ok(&["status", "out/t"])).contains("8 of 8 frames complete"));
+}
+
+#[test]
+fn status_of_a_folder_refuses_what_the_folder_records() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(8, 6.0));
     d.ok(&["render", "t.ron", "--frames", "0..2", "--quiet"]);
     d.ok(&["render", "t.ron", "--frames", "4..6", "--quiet"]);
-    let (code, v) = d.status_json(&["out/t"]);
-    assert_eq!(code, Some(4), "{v}");
-    assert_eq!(v["frames"], serde_json::json!([0, 6]));
-    assert_eq!(v["states"]["missing"], serde_json::json!([2, 3]));
-    assert_eq!(v["timeline_frames"], 8);
-    // The text says the timeline has more, and how to count them all.
-    let text = stdout(&d.run(&["status", "out/t"]));
-    assert!(
-        text.contains("t.ron has 8 frames") && text.contains("--frames 0..8 counts them all"),
-        "{text}"
-    );
     // --frames narrows a folder's range; what the folder records is not
     // overridden from the command line.
     assert!(stdout(&d.ok(&["status", "out/t", "--frames", "4..6"])).contains("2 of 2"));
     for option in [
         &["--size", "8x6"][..],
-        &["--format", "exr"],
         &["--out", "x"],
         &["--preview"],
         &["--samples", "4"],
@@ -185,31 +209,39 @@ fn status_of_a_folder_counts_every_range_rendered_into_it() {
 #[test]
 fn status_of_a_folder_reports_each_format_it_holds() {
     // A few EXR frames, with their own samples, rendered into a folder of
-    // complete PNGs: neither hides the other (the folder's status used to
-    // count the last render's format, range and samples alone).
+    // complete PNGs: each format counts over the whole film, on its own
+    // line, and --format asks about one.
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(6, 6.0));
     d.ok(&["render", "t.ron", "--quiet"]);
     let exr = ["--format", "exr", "--frames", "0..3", "--samples", "2"];
     d.ok(&[&["render", "t.ron", "--quiet"][..], &exr].concat());
-    let out = d.ok(&["status", "out/t"]);
+    let out = d.run(&["status", "out/t"]);
+    assert_eq!(out.status.code(), Some(4), "{}", stdout(&out));
     let text = stdout(&out);
-    assert!(text.contains("6 of 6 frames complete"), "{text}");
+    assert!(text.contains("3 of 6 frames complete"), "{text}");
     assert!(
-        text.contains("exr: 3 of 3 complete and current (frames 0..3)")
+        text.contains("exr: 3 of 6 complete and current (frames 0..6); missing 3-5")
             && text.contains("png: 6 of 6 complete and current (frames 0..6)"),
         "{text}"
     );
+    let png = stdout(&d.ok(&["status", "out/t", "--format", "png"]));
+    assert!(png.contains("6 of 6 frames complete"), "{png}");
+    let exr_part = stdout(&d.ok(&["status", "out/t", "--format", "exr", "--frames", "0..3"]));
+    assert!(exr_part.contains("3 of 3 frames complete"), "{exr_part}");
+    let out = d.run(&["status", "out/t", "--format", "png16"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+    says(&out, "holds no png16 frames");
     std::fs::remove_file(d.path().join("out/t/frame_00001.exr")).unwrap();
     let (code, v) = d.status_json(&["out/t"]);
     assert_eq!(code, Some(4), "{v}");
-    assert_eq!(v["states"]["missing"], serde_json::json!([1]), "{v}");
-    assert_eq!(v["formats"]["png"]["complete"], 6, "{v}");
-    assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([0, 3]));
     assert_eq!(
-        v["formats"]["exr"]["states"]["missing"],
-        serde_json::json!([1])
+        v["states"]["missing"],
+        serde_json::json!([1, 3, 4, 5]),
+        "{v}"
     );
+    assert_eq!(v["formats"]["png"]["complete"], 6, "{v}");
+    assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([0, 6]));
     // The timeline's status counts what its options name, format by format.
     let text = stdout(&d.run(&[&["status", "t.ron"][..], &exr].concat()));
     assert!(text.contains("2 of 3 frames complete"), "{text}");
