@@ -262,6 +262,10 @@ pub struct PickArgs {
     /// Image size the pixel refers to [default: the timeline's].
     #[arg(long, value_name = "WxH")]
     pub size: Option<String>,
+    /// Write the point (the hit, or the re-centred target) into TIMELINE as
+    /// its `camera.target`, keeping the rest of the file as written.
+    #[arg(long, conflicts_with = "json")]
+    pub aim: bool,
     /// Print one JSON object instead of text.
     #[arg(long)]
     pub json: bool,

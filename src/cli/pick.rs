@@ -56,18 +56,36 @@ pub fn pick(args: PickArgs) -> anyhow::Result<()> {
             out!("distance:  {distance:.6e} along the ray from the camera");
             out!("normal:    ({:.4}, {:.4}, {:.4})", n[0], n[1], n[2]);
             out!("footprint: {footprint:.3e} (one pixel's width there)");
-            match report.point_digits.as_ref().filter(|_| report.deep) {
-                Some(d) => out!("As a zoom target:  target: {}", as_ron(d)),
-                None => out!(
-                    "As a zoom target:  target: ({:.12}, {:.12}, {:.12})",
-                    point[0],
-                    point[1],
-                    point[2]
-                ),
+            let target = match report.point_digits.as_ref().filter(|_| report.deep) {
+                Some(d) => as_ron(d),
+                None => format!("({:.12}, {:.12}, {:.12})", point[0], point[1], point[2]),
+            };
+            out!("As a zoom target:  target: {target}");
+            if args.aim {
+                aim(&args.timeline, &target)?;
             }
         }
+        None if args.aim => anyhow::bail!(
+            "pixel ({x}, {y}) of frame {} misses the fractal: nothing to aim at",
+            args.frame
+        ),
         None => out!("miss: the ray leaves the bounding sphere without meeting the fractal"),
     }
+    Ok(())
+}
+
+/// `--aim`: `target` written into the timeline as its `camera.target`.
+fn aim(path: &std::path::Path, target: &str) -> anyhow::Result<()> {
+    let text = crate::timeline::read_text(path)?;
+    let edited = crate::timeline::edit::set_target(&text, target)
+        .map_err(|problem| anyhow::anyhow!("{}: cannot aim: {problem}", path.display()))?;
+    crate::output::atomic::write_atomic(path, |writer, temp| {
+        use std::io::Write as _;
+        writer
+            .write_all(edited.as_bytes())
+            .map_err(|e| crate::error::Error::io(temp, e))
+    })?;
+    out!("Aimed: {} now has target: {target}", path.display());
     Ok(())
 }
 
@@ -100,5 +118,8 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         args.frame,
         as_ron(&refined.target)
     );
+    if args.aim {
+        aim(&args.timeline, &as_ron(&refined.target))?;
+    }
     Ok(())
 }

@@ -41,18 +41,40 @@ const WHOLE_NUMBERS: [&str; 2] = ["fractal.iterations", "quality.max_steps"];
 /// `text` with `edit` made, or what stops it. A file whose lines all end
 /// in CR LF keeps them so: it is edited with LF and turned back.
 pub fn apply(text: &str, edit: &Edit) -> Result<String, String> {
-    let crlf = text.contains("\r\n") && text.matches('\n').count() == text.matches("\r\n").count();
-    if crlf {
-        let edited = apply_lf(&text.replace("\r\n", "\n"), edit)?;
-        return Ok(edited.replace('\n', "\r\n"));
-    }
-    apply_lf(text, edit)
+    edited(text, |value| apply_to_value(value, edit))
 }
 
-/// The edit made after RON's inner attributes (`#![enable(…)]`), if any.
-fn apply_lf(text: &str, edit: &Edit) -> Result<String, String> {
-    let (attributes, value) = text.split_at(attributes_end(text));
-    Ok(format!("{attributes}{}", apply_to_value(value, edit)?))
+/// `text` with `scene.camera.target` written as `target`, RON text as
+/// `pick` prints it (digit strings for deep targets), where no track sets it.
+pub fn set_target(text: &str, target: &str) -> Result<String, String> {
+    edited(text, |value| {
+        spans::block_at(value, &[]).ok_or("the text is not a timeline in RON: `( … )`")?;
+        if keys(value, "camera.target")?.is_some() {
+            return Err(
+                "a \"camera.target\" track sets the target: change its keys instead".into(),
+            );
+        }
+        let path = ["scene", "camera", "target"].map(|f| Step::Field(f.into()));
+        set_field(value, &path, target)
+    })
+}
+
+/// `edit` made to the document's value, after RON's inner attributes
+/// (`#![enable(…)]`) if any, keeping CR LF line ends where all are.
+fn edited(text: &str, edit: impl Fn(&str) -> Result<String, String>) -> Result<String, String> {
+    let crlf = text.contains("\r\n") && text.matches('\n').count() == text.matches("\r\n").count();
+    let lf = if crlf {
+        text.replace("\r\n", "\n")
+    } else {
+        text.to_string()
+    };
+    let (attributes, value) = lf.split_at(attributes_end(&lf));
+    let done = format!("{attributes}{}", edit(value)?);
+    Ok(if crlf {
+        done.replace('\n', "\r\n")
+    } else {
+        done
+    })
 }
 
 /// Where RON's inner attributes before the document's value end.

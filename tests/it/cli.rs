@@ -700,3 +700,37 @@ fn a_membership_walk_renders_deeper_and_the_same_on_any_thread_count() {
     );
     assert!(both.iter().filter(|(a, b)| b > a).count() > both.len() / 2);
 }
+
+#[test]
+fn pick_aim_writes_the_hit_as_the_target_and_refine_moves_it_onto_the_surface() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 8.0));
+    let before = std::fs::read_to_string(d.path().join("t.ron")).unwrap();
+    let out = stdout(&d.ok(&["pick", "t.ron", "--pixel", "24,13", "--aim"]));
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("As a zoom target:"))
+        .unwrap();
+    let target = line.rsplit("target: ").next().unwrap();
+    let after = std::fs::read_to_string(d.path().join("t.ron")).unwrap();
+    assert!(after.contains(&format!("target: {target}")), "{after}");
+    assert_eq!(after.replace(&format!(", target: {target}"), ""), before);
+    // The timeline with its new target: the centre pixel hits it.
+    let again = stdout(&d.ok(&["pick", "t.ron", "--pixel", "24,13", "--json"]));
+    let v: serde_json::Value = serde_json::from_str(&again).unwrap();
+    assert_eq!(v["hit"], true);
+    // A miss writes nothing and says why.
+    let miss = d.run(&["pick", "t.ron", "--pixel", "0,0", "--aim"]);
+    assert_eq!(miss.status.code(), Some(1));
+    says(&miss, "nothing to aim at");
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("t.ron")).unwrap(),
+        after
+    );
+    // --refine --aim writes the re-centred target's digits.
+    let refined = stdout(&d.ok(&["pick", "t.ron", "--frame", "1", "--refine", "--aim"]));
+    assert!(
+        refined.contains("Aimed: t.ron now has target: (\""),
+        "{refined}"
+    );
+}

@@ -548,3 +548,28 @@ fn inner_attributes_before_the_timeline_are_kept() {
     assert_eq!(result, text.replace("power: 8", "power: 5"));
     assert_eq!(parsed(&result, Path::new("t.ron")).base.fractal.power, 5.0);
 }
+
+#[test]
+fn a_target_is_set_in_place_with_its_digits_and_comments_kept() {
+    let text = "(\n    fps: 10,\n    frames: 11,\n    size: (8, 6),\n    scene: (\n        camera: (\n            // on the bud\n            target: (0.5, 0.4, 0.3),\n        ),\n    ),\n)\n";
+    let digits = "(\"0.503044367725\", \"0.44\", \"-0.3975664467990001\")";
+    let result = set_target(text, digits).unwrap();
+    assert_eq!(result, text.replace("(0.5, 0.4, 0.3)", digits));
+    let target = parsed(&result, Path::new("t.ron")).base.camera.target;
+    assert_eq!(target.z, -0.3975664467990001);
+    // No camera block: one is written.
+    let bare = "(fps: 10, frames: 11, size: (8, 6))";
+    let result = set_target(bare, "(1, 2, 3)").unwrap();
+    assert_eq!(
+        parsed(&result, Path::new("t.ron")).base.camera.target.y,
+        2.0
+    );
+}
+
+#[test]
+fn a_target_set_by_a_track_is_not_overwritten() {
+    let text =
+        "(fps: 10, frames: 11, tracks: {\"camera.target\": (keys: [(time: 0, value: (1, 2, 3))])})";
+    let problem = set_target(text, "(0, 0, 0)").unwrap_err();
+    assert!(problem.contains("\"camera.target\" track"), "{problem}");
+}
