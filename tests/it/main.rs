@@ -18,6 +18,7 @@ mod limits;
 mod locations;
 mod names;
 mod quality;
+mod recipes;
 mod resume;
 mod sampling;
 mod stability;
