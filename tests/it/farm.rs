@@ -298,16 +298,114 @@ fn shards_split_frames_by_index_and_from_the_scheduler() {
 /// but `env` (whatever the environment the tests run in).
 fn render_shard(d: &Dir, shard: &str, out: &str, env: &[(&str, &str)]) -> std::process::Output {
     let mut command = d.command(&["render", "t.ron", "--shard", shard, "--out", out, "--quiet"]);
-    for var in [
-        "SLURM_ARRAY_TASK_ID",
-        "SLURM_ARRAY_TASK_MIN",
-        "SLURM_ARRAY_TASK_COUNT",
-        "JOB_COMPLETION_INDEX",
-        "MANDELREEL_SHARD_COUNT",
-    ] {
+    for var in SCHEDULER_VARS {
         command.env_remove(var);
     }
     command.envs(env.iter().copied()).output().unwrap()
+}
+
+/// What `--shard auto` reads.
+const SCHEDULER_VARS: [&str; 5] = [
+    "SLURM_ARRAY_TASK_ID",
+    "SLURM_ARRAY_TASK_MIN",
+    "SLURM_ARRAY_TASK_COUNT",
+    "JOB_COMPLETION_INDEX",
+    "MANDELREEL_SHARD_COUNT",
+];
+
+/// The parts of examples/k8s/indexed-job.yaml that decide what its pods run.
+struct IndexedJob {
+    completions: usize,
+    command: Vec<String>,
+    env: Vec<(String, String)>,
+}
+
+/// Reads the example by indentation, as it is written (block lists of
+/// scalars): one YAML file does not warrant a YAML crate.
+fn indexed_job() -> IndexedJob {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/examples/k8s/indexed-job.yaml");
+    let text = std::fs::read_to_string(path).unwrap();
+    let lines: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        .collect();
+    let scalar = |s: &str| s.trim().trim_matches('"').to_string();
+    let indent = |l: &str| l.len() - l.trim_start().len();
+    let only = |key: &str| {
+        let found: Vec<usize> = (0..lines.len())
+            .filter(|&i| lines[i].trim_start().starts_with(&format!("{key}:")))
+            .collect();
+        assert_eq!(found.len(), 1, "one {key}: in {path}");
+        found[0]
+    };
+    let value = |key: &str| scalar(lines[only(key)].split_once(':').unwrap().1);
+    let block = |key: &str| -> Vec<&str> {
+        let at = only(key);
+        lines[at + 1..]
+            .iter()
+            .take_while(|l| indent(l) > indent(lines[at]))
+            .map(|l| l.trim().trim_start_matches("- "))
+            .collect()
+    };
+    let env = block("env");
+    let env = env
+        .chunks(2)
+        .map(|pair| match pair {
+            [name, value] => (
+                scalar(name.strip_prefix("name:").unwrap()),
+                scalar(value.strip_prefix("value:").unwrap()),
+            ),
+            _ => panic!("env entries are name, value pairs: {pair:?}"),
+        })
+        .collect();
+    IndexedJob {
+        completions: value("completions").parse().unwrap(),
+        command: block("command").into_iter().map(scalar).collect(),
+        env,
+    }
+}
+
+#[test]
+fn the_kubernetes_indexed_job_runs_every_frame_once_across_its_pods() {
+    let job = indexed_job();
+    let d = Dir::new();
+    assert_eq!(job.command[0], "mandelreel", "{:?}", job.command);
+    // The container's absolute paths, under the test's folder.
+    let args: Vec<String> = job.command[1..]
+        .iter()
+        .map(|a| match a.strip_prefix('/') {
+            Some(inside) => d.path().join(inside).display().to_string(),
+            None => a.clone(),
+        })
+        .collect();
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    let timeline = std::path::Path::new(args[1]);
+    std::fs::create_dir_all(timeline.parent().unwrap()).unwrap();
+    std::fs::write(timeline, tiny_timeline(12, 6.0)).unwrap();
+    // Kubernetes gives each pod its index, never the count.
+    let count = job.env.iter().find(|(n, _)| n == "MANDELREEL_SHARD_COUNT");
+    assert_eq!(
+        count.map(|(_, v)| v.parse().unwrap()),
+        Some(job.completions)
+    );
+    for index in 0..job.completions {
+        let mut pod = d.command(&args);
+        for var in SCHEDULER_VARS {
+            pod.env_remove(var);
+        }
+        pod.envs(job.env.iter().map(|(n, v)| (n, v)));
+        let out = pod
+            .env("JOB_COMPLETION_INDEX", index.to_string())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "pod {index}: {}", stderr(&out));
+        let log = format!("{}{}", stdout(&out), stderr(&out));
+        let share: Vec<u32> = (index as u32..12).step_by(job.completions).collect();
+        assert_eq!(rendered_frames(&log), share, "pod {index}: {log}");
+    }
+    let outdir = args[args.iter().position(|a| *a == "--out").unwrap() + 1];
+    let status = d.run(&["status", outdir]);
+    assert_eq!(status.status.code(), Some(0), "{}", stdout(&status));
 }
 
 #[test]
