@@ -2,7 +2,7 @@
 //! scene and tracks validated in turn, every error placed at the line and
 //! column of what it blames.
 
-use super::limits::{check_scene_count, TooMany, FRAMES_HINT, MAX_FRAMES, MAX_KEYS};
+use super::limits::{check_scene_count, TooMany, FRAMES_HINT, MAX_FRAMES, MAX_KEYS, MAX_SIDE};
 use super::messages::{invalid_value, syntax_message, Shown};
 use super::parameters::{self, PARAMETERS, ZOOM_TRACK};
 use super::schema::TimelineFile;
@@ -18,9 +18,6 @@ use std::path::Path;
 /// Past a thousand frames a second no player or encoder keeps up (ffmpeg's
 /// -framerate among them).
 const MAX_FPS: Real = 1000.0;
-
-/// The widest and tallest frame.
-const MAX_SIDE: u32 = 32_768;
 
 /// The timeline's text and file, which errors point into.
 struct Source<'a> {

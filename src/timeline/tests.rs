@@ -220,10 +220,16 @@ fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
         "{e}"
     );
     let e = error_of("(fps: 24, frames: 3, size: (8, -6))");
-    assert!(e.contains("`size[1]`: must be 0 or more"), "{e}");
+    assert!(
+        e.ends_with("`size[1]`: width and height must be 1..=32768, got -6"),
+        "{e}"
+    );
     let e = error_of("(fps: 24, frames: 99999999999, size: (8, 6))");
     assert!(
-        e.ends_with("`frames`: too large: at most 4294967295"),
+        e.ends_with(
+            "`frames`: at most 1000000, got 99999999999: split a longer film into \
+             timelines of its parts"
+        ),
         "{e}"
     );
     let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: \"8\")))");
@@ -244,6 +250,112 @@ fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
         "{e}"
     );
     assert!(error_of("").contains("for the timeline"));
+}
+
+/// Every whole-number field of a timeline and the limit docs/timeline.md
+/// gives it.
+const COUNTED: [(&str, &str); 12] = [
+    ("frames", "at most 1000000"),
+    ("size[0]", "1..=32768"),
+    ("size[1]", "1..=32768"),
+    ("scene.samples_per_pixel", "1..=4096"),
+    ("scene.adaptive.first", "1..=4096"),
+    ("scene.fractal.iterations", "1..=10000"),
+    ("scene.quality.max_steps", "1..=1000000"),
+    ("scene.quality.cone_rays", "1..=4096"),
+    ("scene.effects.shadows.max_steps", "1..=100000"),
+    ("scene.effects.ambient_occlusion.samples", "1..=64"),
+    ("scene.effects.path_tracing.max_bounces", "1..=1024"),
+    ("scene.seed", "at most 18446744073709551615"),
+];
+
+/// A timeline with `value` written at `field` (`scene.a.b` or one of the
+/// film's fields), and every block on the way to it.
+fn with_value(field: &str, value: &str) -> String {
+    let (frames, size) = match field {
+        "frames" => (value, "(8, 6)".to_string()),
+        "size[0]" => ("3", format!("({value}, 6)")),
+        "size[1]" => ("3", format!("(8, {value})")),
+        _ => ("3", "(8, 6)".to_string()),
+    };
+    let scene = match field.strip_prefix("scene.") {
+        Some(path) => {
+            let names: Vec<&str> = path.split('.').collect();
+            let opened: String = names.iter().map(|n| format!("{n}: (")).collect();
+            let inner = opened.trim_end_matches('(').to_string() + value;
+            format!(", scene: ({inner}{})", ")".repeat(names.len() - 1))
+        }
+        None => String::new(),
+    };
+    format!("(fps: 24, frames: {frames}, size: {size}{scene})")
+}
+
+#[test]
+fn a_count_too_large_or_negative_for_its_type_is_told_the_fields_own_limit() {
+    for (field, limit) in COUNTED {
+        for written in ["99999999999999999999999", "-5"] {
+            if field == "scene.seed" && written == "-5" {
+                continue;
+            }
+            let e = error_of(&with_value(field, written));
+            assert!(
+                e.contains(&format!("`{field}`: ")) && e.contains(&format!("got {written}")),
+                "{field} = {written}: {e}"
+            );
+            if written != "-5" || !field.starts_with("frames") {
+                assert!(e.contains(limit), "{field} = {written}: {e}");
+            }
+            assert!(!e.contains("4294967295"), "{field} = {written}: {e}");
+        }
+    }
+    for (field, says) in [
+        ("frames", "`frames`: must be at least 1, got -5"),
+        ("scene.seed", "`scene.seed`: must be 0 or more, got -5"),
+    ] {
+        let e = error_of(&with_value(field, "-5"));
+        assert!(e.ends_with(says), "{e}");
+    }
+    // Placed at the number, not at the field's name or the space before it.
+    let e = error_of("(fps: 24, size: (8, 6),\n frames:   5000000000)");
+    assert!(
+        e.starts_with("test.ron:2:12: `frames`: at most 1000000"),
+        "{e}"
+    );
+}
+
+/// The paths of the whole numbers in `value`, a scene as JSON.
+fn whole_numbers(value: &serde_json::Value, path: &str, found: &mut Vec<String>) {
+    match value {
+        serde_json::Value::Object(fields) => {
+            for (name, v) in fields {
+                whole_numbers(v, &format!("{path}.{name}"), found);
+            }
+        }
+        serde_json::Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                whole_numbers(v, &format!("{path}[{i}]"), found);
+            }
+        }
+        serde_json::Value::Number(n) if !n.is_f64() => found.push(path.to_string()),
+        _ => {}
+    }
+}
+
+#[test]
+fn every_whole_number_field_of_a_scene_has_its_limit_told() {
+    // Every optional block given, so its fields are serialised.
+    let every = "(adaptive: (), look: (extra_lights: [(direction: (0, 1, 0))]),
+        effects: (shadows: (), ambient_occlusion: (), specular: (), fog: (), glow: (),
+        motion_blur: (), path_tracing: ()))";
+    let options =
+        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let scene: Scene = options.from_str(every).unwrap();
+    let mut found = Vec::new();
+    whole_numbers(&serde_json::to_value(&scene).unwrap(), "scene", &mut found);
+    assert!(found.len() >= 9, "{found:?}");
+    for field in found {
+        assert!(COUNTED.iter().any(|(f, _)| *f == field), "{field}");
+    }
 }
 
 #[test]
