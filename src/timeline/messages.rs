@@ -100,9 +100,11 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
     use ron::error::Error as Ron;
     let (line, column) = (e.span.start.line, e.span.start.col);
     let row = |line: usize| text.lines().nth(line.wrapping_sub(1)).unwrap_or("");
-    // Where the text is RON (a value of the wrong shape, a field too many or
-    // missing), the field the error is in and the value at fault.
-    let typed = spans::path_at(text, line, column);
+    // The field the error is in and the value at fault: as RON reads the
+    // text where it can (a value of the wrong shape, a field too many or
+    // missing), else from the brackets and names before the error.
+    let typed =
+        spans::path_at(text, line, column).or_else(|| super::scan::path_at(text, line, column));
     let shown = typed
         .as_ref()
         .map_or((line, column), |(_, at)| (at.line, at.column));
@@ -134,7 +136,7 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
             ),
             _ => format!("{in_field}expected a whole number here, got {number}"),
         };
-        return ((line, column), message);
+        return (shown, message);
     }
     let code = code_columns(text);
     match &e.code {
@@ -176,7 +178,7 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
                     format!("too large: at most {}", u32::MAX)
                 }
             });
-            ((line, column), format!("{in_field}{message}"))
+            (shown, format!("{in_field}{message}"))
         }
         Ron::SuggestRawIdentifier(found) => (
             (line, column),

@@ -13,6 +13,7 @@ mod limits;
 mod messages;
 pub mod parameters;
 mod parse;
+mod scan;
 mod schema;
 mod tracks;
 mod validate;

@@ -359,6 +359,67 @@ fn every_whole_number_field_of_a_scene_has_its_limit_told() {
 }
 
 #[test]
+fn a_value_ron_cannot_read_is_named_by_its_field_at_its_first_character() {
+    let e = error_of("(\n    size: (8, 6),\n    fps: 2.4.0,\n    frames: 3,\n)");
+    assert_eq!(e, "test.ron:3:10: `fps`: Expected float");
+    for (text, at) in [
+        (
+            "(fps: 24, frames: 3, size: (8, 6),\n scene: (camera: (fov_degrees:  4.5.6)))",
+            "test.ron:2:33: `scene.camera.fov_degrees`: ",
+        ),
+        (
+            &with_track("\"camera.position\": (keys: [(time: 0, value: (1, 2.3.4, 3))])"),
+            "test.ron:1:95: `tracks[\"camera.position\"].keys[0].value[1]`: ",
+        ),
+        (
+            "(fps: 24, frames: /* many */ 3.0.0, size: (8, 6))",
+            "test.ron:1:30: `frames`: ",
+        ),
+    ] {
+        let e = error_of(text);
+        assert!(e.starts_with(at), "{e}");
+    }
+}
+
+#[test]
+fn deep_nesting_names_the_field_its_shallow_cousin_names() {
+    let deep = |open: &str, close: &str, depth: usize, inner: &str| {
+        format!(
+            "(fps: 24, frames: 3, size: (8, 6), scene: (camera: (fov_degrees: {}{inner}{})))",
+            open.repeat(depth),
+            close.repeat(depth)
+        )
+    };
+    for (open, close, inner, field) in [
+        ("(", ")", "", "`scene.camera.fov_degrees`: "),
+        ("Some(", ")", "\"x\"", "`scene.camera.fov_degrees`: "),
+        ("Some(", ")", "1.2.3", "`scene.camera.fov_degrees`: "),
+        ("[", "]", "1", "`scene.camera.fov_degrees`: "),
+    ] {
+        let shallow = error_of(&deep(open, close, 3, inner));
+        let deeper = error_of(&deep(open, close, 400, inner));
+        assert!(shallow.contains(field), "{shallow}");
+        assert!(deeper.contains(field), "{deeper}");
+    }
+    let scene = |depth: usize| {
+        let parens = format!("{}{}", "(".repeat(depth), ")".repeat(depth));
+        format!("(fps: 24, frames: 3, size: (8, 6), scene: ({parens}))")
+    };
+    assert_eq!(error_of(&scene(400)), error_of(&scene(3)));
+    assert!(error_of(&scene(400)).contains("`scene[0]`: "));
+    // Tracks given as a list, of tracks by name or of pairs.
+    for list in [
+        "[\"fractal.power\": (keys: [(time: 0, value: 8)])]",
+        "[(\"fractal.power\", (keys: [(time: 0, value: 8)]))]",
+    ] {
+        let e = error_of(&format!(
+            "(fps: 24, frames: 3, size: (8, 6), tracks: {list})"
+        ));
+        assert!(e.starts_with("test.ron:1:44: `tracks`: "), "{e}");
+    }
+}
+
+#[test]
 fn a_key_of_the_wrong_shape_says_what_shapes_there_are() {
     for (value, says) in [
         (
@@ -835,13 +896,14 @@ fn a_camera_track_onto_the_target_is_refused_at_its_line() {
 
 #[test]
 fn messages_name_fractions_and_show_extreme_numbers_readably() {
-    // A fraction where a count is wanted: RON alone says "Expected comma".
+    // A fraction where a count is wanted: RON alone says "Expected comma",
+    // at the point; the number is shown from its start.
     let e = parse("(fps: 10, frames: 2,\n size: (320.5, 180))")
         .unwrap_err()
         .to_string();
     assert_eq!(
         e,
-        "test.ron:2:12: `size[0]`: expected a whole number here, got 320.5"
+        "test.ron:2:9: `size[0]`: expected a whole number here, got 320.5"
     );
     let e = parse("(fps: 10, frames: 2.5, size: (8, 6))")
         .unwrap_err()
