@@ -323,6 +323,21 @@ fn a_count_too_large_or_negative_for_its_type_is_told_the_fields_own_limit() {
     );
 }
 
+#[test]
+fn a_count_tracks_key_past_the_counts_type_is_shown_as_written() {
+    for (value, got) in [("99999999999", "got 9.9999999999e10"), ("-7", "got -7")] {
+        let e = error_of(&with_track(&format!(
+            "\"fractal.iterations\": (keys: [(time: 0, value: {value})])"
+        )));
+        assert!(
+            e.ends_with(&format!(
+                "tracks[\"fractal.iterations\"].keys[0].value: must be 1..=10000, {got}"
+            )),
+            "{e}"
+        );
+    }
+}
+
 /// The paths of the whole numbers in `value`, a scene as JSON.
 fn whole_numbers(value: &serde_json::Value, path: &str, found: &mut Vec<String>) {
     match value {
