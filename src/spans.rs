@@ -303,7 +303,8 @@ fn block_comment_len(text: &str) -> usize {
     text.len()
 }
 
-fn place(text: &str, offset: usize) -> Place {
+/// The place of byte `offset` in `text`.
+pub fn place(text: &str, offset: usize) -> Place {
     let before = &text[..offset];
     let line_start = before.rfind('\n').map_or(0, |i| i + 1);
     Place {
@@ -312,7 +313,8 @@ fn place(text: &str, offset: usize) -> Place {
     }
 }
 
-fn offset_of(text: &str, line: usize, column: usize) -> Option<usize> {
+/// The byte offset of `line`:`column` (1-based) in `text`.
+pub fn offset_of(text: &str, line: usize, column: usize) -> Option<usize> {
     let line_start = if line <= 1 {
         0
     } else {

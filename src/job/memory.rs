@@ -28,16 +28,17 @@ impl Plan {
             return Ok(());
         }
         let gib = |bytes: u64| bytes as f64 / (1u64 << 30) as f64;
-        let option = if size_given { "--size" } else { "size" };
-        Err(Error::usage(
-            option,
-            format!(
-                "{w}x{h} needs about {:.1} GiB for a frame's buffers, and {whose} {:.1} GiB \
-                 to give: render it smaller, or with more memory",
-                gib(need),
-                gib(have)
-            ),
-        )
+        let message = format!(
+            "{w}x{h} needs about {:.1} GiB for a frame's buffers, and {whose} {:.1} GiB \
+             to give: render it smaller, or with more memory",
+            gib(need),
+            gib(have)
+        );
+        // The timeline's own size is the timeline's fault (exit 3), at its line.
+        Err(match size_given {
+            true => Error::usage("--size", message),
+            false => self.timeline.field_error("size", message),
+        }
         .into())
     }
 }

@@ -13,6 +13,11 @@ use std::path::{Path, PathBuf};
 /// leftover one is never taken for a final file and `remove_stale_partials`
 /// knows whose it is), which is flushed, synced and renamed over `path`. On
 /// any error the temporary file is deleted. Files are readable by all.
+///
+/// Every error names `path`, and `write` is given `path` to name in its
+/// own: the temporary is gone by the time the error is read, and the user
+/// knows the file by its final name (`out/zoom/frame_00007.exr: No space
+/// left on device`).
 pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&File>, &Path) -> Result<()>,
@@ -38,23 +43,22 @@ pub fn write_atomic(
     // every temporary file and none is renamed into place after it.
     let (temp, _removed_on_interrupt) = {
         let mut held = crate::interrupt::hold();
-        let temp = builder.tempfile_in(dir).map_err(|e| Error::io(dir, e))?;
+        let temp = builder.tempfile_in(dir).map_err(|e| Error::io(path, e))?;
         let temp_path = temp.path().to_path_buf();
         let removal = held.on_interrupt(move || {
             let _ = std::fs::remove_file(temp_path);
         });
         (temp, removal)
     };
-    let temp_path = temp.path().to_path_buf();
     // Written through the plain file: the temporary file's own writer
     // would add its path to every error, which `Error::io` names already.
     let mut writer = BufWriter::new(temp.as_file());
-    write(&mut writer, &temp_path)?;
+    write(&mut writer, path)?;
     writer
         .into_inner()
-        .map_err(|e| Error::io(&temp_path, e.into_error()))?
+        .map_err(|e| Error::io(path, e.into_error()))?
         .sync_all()
-        .map_err(|e| Error::io(&temp_path, e))?;
+        .map_err(|e| Error::io(path, e))?;
     let held = crate::interrupt::hold();
     temp.persist(path).map_err(|e| Error::io(path, e.error))?;
     drop(held);

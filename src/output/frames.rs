@@ -157,17 +157,16 @@ pub fn write_frame(
     aovs: &[Aov],
     encoding: &Encoding,
 ) -> Result<()> {
-    let image_error = |temp: &Path, message: String| Error::Image {
-        path: temp.to_path_buf(),
+    let image_error = |named: &Path, message: String| Error::Image {
+        path: named.to_path_buf(),
         message,
     };
     let key = stored_key(format, hash, aovs, encoding.exr_compression);
-    write_atomic(path, |writer, temp| match format {
-        Format::Exr => {
-            super::exr::encode(writer, film, &key, aovs, encoding).map_err(|m| image_error(temp, m))
-        }
+    write_atomic(path, |writer, named| match format {
+        Format::Exr => super::exr::encode(writer, film, &key, aovs, encoding)
+            .map_err(|m| image_error(named, m)),
         _ => super::png::encode(writer, film, &key, format, encoding)
-            .map_err(|m| image_error(temp, m)),
+            .map_err(|m| image_error(named, m)),
     })
 }
 

@@ -103,11 +103,11 @@ pub fn write_contact_sheet(
             (cy * (thumb_height + gap)) as i64,
         );
     }
-    write_atomic(out, |w, temp| {
+    write_atomic(out, |w, named| {
         sheet
             .write_to(w, image::ImageFormat::Png)
             .map_err(|e| Error::Image {
-                path: temp.to_path_buf(),
+                path: named.to_path_buf(),
                 message: e.to_string(),
             })
     })

@@ -11,6 +11,63 @@ pub const MAX_FRAMES: u32 = 1_000_000;
 /// What the frame limit's messages suggest.
 pub(super) const FRAMES_HINT: &str = "split a longer film into timelines of its parts";
 
+/// The widest and tallest frame.
+pub(super) const MAX_SIDE: u32 = 32_768;
+
+// The most each whole-number field of a scene may hold (the least is 1):
+// past these a frame takes days, or an effect no longer changes the image.
+pub(super) const MAX_SAMPLES: u32 = 4096;
+pub(super) const MAX_CONE_RAYS: u32 = 4096;
+pub(super) const MAX_ITERATIONS: u32 = 10_000;
+pub(super) const MAX_MARCH_STEPS: u32 = 1_000_000;
+pub(super) const MAX_SHADOW_STEPS: u32 = 100_000;
+pub(super) const MAX_OCCLUSION_SAMPLES: u32 = 64;
+pub(super) const MAX_BOUNCES: u32 = 1024;
+
+/// Every whole-number field of a timeline with its limit, by its path in
+/// the file: a number too large for the field's type, or negative, is
+/// told the limit the field has rather than the type's. `scene.seed` may
+/// be any u64: its 0 stands for no limit of its own.
+const COUNTS: [(&str, u32); 12] = [
+    ("frames", MAX_FRAMES),
+    ("size[0]", MAX_SIDE),
+    ("size[1]", MAX_SIDE),
+    ("scene.samples_per_pixel", MAX_SAMPLES),
+    ("scene.adaptive.first", MAX_SAMPLES),
+    ("scene.fractal.iterations", MAX_ITERATIONS),
+    ("scene.quality.max_steps", MAX_MARCH_STEPS),
+    ("scene.quality.cone_rays", MAX_CONE_RAYS),
+    ("scene.effects.shadows.max_steps", MAX_SHADOW_STEPS),
+    (
+        "scene.effects.ambient_occlusion.samples",
+        MAX_OCCLUSION_SAMPLES,
+    ),
+    ("scene.effects.path_tracing.max_bounces", MAX_BOUNCES),
+    ("scene.seed", 0),
+];
+
+/// What a count outside 1..=`most` is told: `got` as written or held.
+pub(super) fn count_outside(most: u32, got: impl std::fmt::Display) -> String {
+    format!("must be 1..={most}, got {got}")
+}
+
+/// What whole-number field `field` given `written` (a number its type
+/// cannot hold: negative, or too large) is told, where `field` is one of
+/// the timeline's: the same as a number its type holds but its limit
+/// does not.
+pub(super) fn count_message(field: &str, written: &str) -> Option<String> {
+    let (_, most) = COUNTS.iter().find(|(name, _)| *name == field)?;
+    let negative = written.starts_with('-');
+    Some(match field {
+        "scene.seed" if negative => format!("must be 0 or more, got {written}"),
+        "scene.seed" => format!("must be at most {}, got {written}", u64::MAX),
+        "frames" if negative => format!("must be at least 1, got {written}"),
+        "frames" => format!("at most {MAX_FRAMES}, got {written}: {FRAMES_HINT}"),
+        "size[0]" | "size[1]" => format!("width and height must be 1..={MAX_SIDE}, got {written}"),
+        _ => count_outside(*most, written),
+    })
+}
+
 /// The most instants a timeline's frames may show: with motion blur each
 /// sample of a frame sees the timeline at its own instant. Every one's scene
 /// is checked before a frame renders (`Timeline::invalid_instant`), a

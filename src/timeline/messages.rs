@@ -2,6 +2,7 @@
 //! (the field, the missing comma's line, a fraction where a count belongs),
 //! values shown readably, and an invalid value placed at its line.
 
+use super::limits::count_message;
 use super::schema::KeyValue;
 use crate::error::Error;
 use crate::math::{DVec3, Real, Vec3};
@@ -26,6 +27,23 @@ fn fraction_at(text: &str, line: usize, column: usize) -> Option<String> {
     let sign = if digits.ends_with('-') { "-" } else { "" };
     let rest: String = after.chars().take_while(|&c| number(c)).collect();
     Some(format!("{sign}{whole}{rest}"))
+}
+
+/// The number written around `column` (1-based) of `row`, sign and all,
+/// as written: `-6`, `5_000_000_000`, `0xFFFFFFFFFF`.
+fn number_around(row: &str, column: usize) -> String {
+    let chars: Vec<char> = row.chars().collect();
+    let part = |c: char| c.is_ascii_alphanumeric() || "_+-".contains(c);
+    let at = column.saturating_sub(1).min(chars.len());
+    let start = chars[..at]
+        .iter()
+        .rposition(|&c| !part(c))
+        .map_or(0, |i| i + 1);
+    let end = chars[at..]
+        .iter()
+        .position(|&c| !part(c))
+        .map_or(chars.len(), |i| at + i);
+    chars[start..end].iter().collect()
 }
 
 /// For each line of `text`, the columns (1-based, in characters) of its
@@ -82,19 +100,16 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
     use ron::error::Error as Ron;
     let (line, column) = (e.span.start.line, e.span.start.col);
     let row = |line: usize| text.lines().nth(line.wrapping_sub(1)).unwrap_or("");
-    let before = |line: usize, column: usize| -> String {
-        row(line).chars().take(column.saturating_sub(1)).collect()
-    };
-    // Where the text is RON (a value of the wrong shape, a field too many or
-    // missing), the field the error is in and the value at fault.
-    let typed = spans::path_at(text, line, column);
+    // The field the error is in and the value at fault: as RON reads the
+    // text where it can (a value of the wrong shape, a field too many or
+    // missing), else from the brackets and names before the error.
+    let typed =
+        spans::path_at(text, line, column).or_else(|| super::scan::path_at(text, line, column));
     let shown = typed
         .as_ref()
         .map_or((line, column), |(_, at)| (at.line, at.column));
-    let field = typed
-        .map(|(path, _)| path)
-        .filter(|path| !path.is_empty())
-        .map(|path| format!("`{path}`: "));
+    let path = typed.map(|(path, _)| path).filter(|path| !path.is_empty());
+    let field = path.as_ref().map(|path| format!("`{path}`: "));
     let in_field = field.clone().unwrap_or_default();
     let named = |message: String| {
         // Our types as a timeline's author knows them.
@@ -121,7 +136,7 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
             ),
             _ => format!("{in_field}expected a whole number here, got {number}"),
         };
-        return ((line, column), message);
+        return (shown, message);
     }
     let code = code_columns(text);
     match &e.code {
@@ -154,21 +169,16 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
             )
         }
         Ron::IntegerOutOfBounds => {
-            let head = before(line, column + 1);
-            let most = if in_field.ends_with("seed`: ") {
-                u64::MAX.to_string()
-            } else {
-                u32::MAX.to_string()
-            };
-            let message = if head
-                .trim_end_matches(|c: char| c.is_ascii_digit())
-                .ends_with('-')
-            {
-                format!("{in_field}must be 0 or more: counts, sizes and seeds are never negative")
-            } else {
-                format!("{in_field}too large: at most {most}")
-            };
-            ((line, column), message)
+            let written = number_around(row(line), column);
+            let limit = path.as_deref().and_then(|p| count_message(p, &written));
+            let message = limit.unwrap_or_else(|| {
+                if written.starts_with('-') {
+                    "must be 0 or more: counts, sizes and seeds are never negative".into()
+                } else {
+                    format!("too large: at most {}", u32::MAX)
+                }
+            });
+            (shown, format!("{in_field}{message}"))
         }
         Ron::SuggestRawIdentifier(found) => (
             (line, column),

@@ -13,6 +13,7 @@ mod limits;
 mod messages;
 pub mod parameters;
 mod parse;
+mod scan;
 mod schema;
 mod tracks;
 mod validate;
@@ -134,6 +135,14 @@ impl Timeline {
                 .collect(),
             ..*self
         }
+    }
+
+    /// The error of this timeline's value at `field`, a path into its file,
+    /// found by a check made after loading (the memory its frames need): at
+    /// the value's line and column, the file read again for them.
+    pub fn field_error(&self, field: &str, message: String) -> Error {
+        let text = read_text(&self.source).unwrap_or_default();
+        messages::invalid_value(&text, &self.source, field, message)
     }
 
     /// Reads, parses and validates a timeline file.

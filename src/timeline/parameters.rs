@@ -3,6 +3,7 @@
 //! names, `Track`'s setter, `validate_scene`'s range checks of these fields
 //! and the docs' table of parameters all come from `GROUPS`.
 
+use super::limits::{MAX_ITERATIONS, MAX_MARCH_STEPS};
 use super::messages::Shown;
 use super::validate::{colour, counted, non_negative, positive, rule, Checked};
 use crate::math::{DVec3, Real, Vec3};
@@ -308,7 +309,7 @@ pub(super) const FRACTAL: &[Parameter] = &[
         name: "fractal.iterations",
         shape: Number,
         doc: "number, rounded to a whole count",
-        check: |s| counted(s.fractal.iterations, 10_000),
+        check: |s| counted(s.fractal.iterations, MAX_ITERATIONS),
         set: |s, v| s.fractal.iterations = count(v),
     },
     Parameter {
@@ -388,7 +389,7 @@ pub(super) const QUALITY: &[Parameter] = &[
         name: "quality.max_steps",
         shape: Number,
         doc: "number, rounded",
-        check: |s| counted(s.quality.max_steps, 1_000_000),
+        check: |s| counted(s.quality.max_steps, MAX_MARCH_STEPS),
         set: |s, v| s.quality.max_steps = count(v),
     },
     Parameter {

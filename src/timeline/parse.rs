@@ -2,7 +2,7 @@
 //! scene and tracks validated in turn, every error placed at the line and
 //! column of what it blames.
 
-use super::limits::{check_scene_count, TooMany, FRAMES_HINT, MAX_FRAMES, MAX_KEYS};
+use super::limits::{check_scene_count, TooMany, FRAMES_HINT, MAX_FRAMES, MAX_KEYS, MAX_SIDE};
 use super::messages::{invalid_value, syntax_message, Shown};
 use super::parameters::{self, PARAMETERS, ZOOM_TRACK};
 use super::schema::TimelineFile;
@@ -18,9 +18,6 @@ use std::path::Path;
 /// Past a thousand frames a second no player or encoder keeps up (ffmpeg's
 /// -framerate among them).
 const MAX_FPS: Real = 1000.0;
-
-/// The widest and tallest frame.
-const MAX_SIDE: u32 = 32_768;
 
 /// The timeline's text and file, which errors point into.
 struct Source<'a> {
@@ -289,7 +286,7 @@ impl Source<'_> {
         });
         if let Some((track, k, message)) = bad_key {
             let key = format!("tracks[{:?}].keys[{k}].value", track.name);
-            return self.value(&key, message);
+            return self.value(&key, as_written(message, track, k));
         }
         let animated: Vec<String> = culprits.iter().map(|t| format!("{:?}", t.name)).collect();
         let track_place = |name: &String| spans::place_of(self.text, &format!("tracks[{name}]"));
@@ -305,5 +302,22 @@ impl Source<'_> {
                 }
             ),
         )
+    }
+}
+
+/// `message` about key `k` of `track`, with the key's value as written
+/// where a count field could not hold it: a key of 1e11 iterations is
+/// held as 4294967295 and a negative one as 0, the u32's range, which the
+/// message would otherwise show.
+fn as_written(message: String, track: &Track, k: usize) -> String {
+    let value = match track.sample(track.key_times[k])[..] {
+        [v] => v,
+        _ => return message,
+    };
+    let held = value.round().clamp(0.0, u32::MAX as Real);
+    let held_as = format!(", got {held}");
+    match message.strip_suffix(&held_as) {
+        Some(head) if held != value.round() => format!("{head}, got {}", value.shown()),
+        _ => message,
     }
 }

@@ -220,10 +220,16 @@ fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
         "{e}"
     );
     let e = error_of("(fps: 24, frames: 3, size: (8, -6))");
-    assert!(e.contains("`size[1]`: must be 0 or more"), "{e}");
+    assert!(
+        e.ends_with("`size[1]`: width and height must be 1..=32768, got -6"),
+        "{e}"
+    );
     let e = error_of("(fps: 24, frames: 99999999999, size: (8, 6))");
     assert!(
-        e.ends_with("`frames`: too large: at most 4294967295"),
+        e.ends_with(
+            "`frames`: at most 1000000, got 99999999999: split a longer film into \
+             timelines of its parts"
+        ),
         "{e}"
     );
     let e = error_of("(fps: 24, frames: 3, size: (8, 6), scene: (fractal: (power: \"8\")))");
@@ -244,6 +250,188 @@ fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
         "{e}"
     );
     assert!(error_of("").contains("for the timeline"));
+}
+
+/// Every whole-number field of a timeline and the limit docs/timeline.md
+/// gives it.
+const COUNTED: [(&str, &str); 12] = [
+    ("frames", "at most 1000000"),
+    ("size[0]", "1..=32768"),
+    ("size[1]", "1..=32768"),
+    ("scene.samples_per_pixel", "1..=4096"),
+    ("scene.adaptive.first", "1..=4096"),
+    ("scene.fractal.iterations", "1..=10000"),
+    ("scene.quality.max_steps", "1..=1000000"),
+    ("scene.quality.cone_rays", "1..=4096"),
+    ("scene.effects.shadows.max_steps", "1..=100000"),
+    ("scene.effects.ambient_occlusion.samples", "1..=64"),
+    ("scene.effects.path_tracing.max_bounces", "1..=1024"),
+    ("scene.seed", "at most 18446744073709551615"),
+];
+
+/// A timeline with `value` written at `field` (`scene.a.b` or one of the
+/// film's fields), and every block on the way to it.
+fn with_value(field: &str, value: &str) -> String {
+    let (frames, size) = match field {
+        "frames" => (value, "(8, 6)".to_string()),
+        "size[0]" => ("3", format!("({value}, 6)")),
+        "size[1]" => ("3", format!("(8, {value})")),
+        _ => ("3", "(8, 6)".to_string()),
+    };
+    let scene = match field.strip_prefix("scene.") {
+        Some(path) => {
+            let names: Vec<&str> = path.split('.').collect();
+            let opened: String = names.iter().map(|n| format!("{n}: (")).collect();
+            let inner = opened.trim_end_matches('(').to_string() + value;
+            format!(", scene: ({inner}{})", ")".repeat(names.len() - 1))
+        }
+        None => String::new(),
+    };
+    format!("(fps: 24, frames: {frames}, size: {size}{scene})")
+}
+
+#[test]
+fn a_count_too_large_or_negative_for_its_type_is_told_the_fields_own_limit() {
+    for (field, limit) in COUNTED {
+        for written in ["99999999999999999999999", "-5"] {
+            if field == "scene.seed" && written == "-5" {
+                continue;
+            }
+            let e = error_of(&with_value(field, written));
+            assert!(
+                e.contains(&format!("`{field}`: ")) && e.contains(&format!("got {written}")),
+                "{field} = {written}: {e}"
+            );
+            if written != "-5" || !field.starts_with("frames") {
+                assert!(e.contains(limit), "{field} = {written}: {e}");
+            }
+            assert!(!e.contains("4294967295"), "{field} = {written}: {e}");
+        }
+    }
+    for (field, says) in [
+        ("frames", "`frames`: must be at least 1, got -5"),
+        ("scene.seed", "`scene.seed`: must be 0 or more, got -5"),
+    ] {
+        let e = error_of(&with_value(field, "-5"));
+        assert!(e.ends_with(says), "{e}");
+    }
+    // Placed at the number, not at the field's name or the space before it.
+    let e = error_of("(fps: 24, size: (8, 6),\n frames:   5000000000)");
+    assert!(
+        e.starts_with("test.ron:2:12: `frames`: at most 1000000"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_count_tracks_key_past_the_counts_type_is_shown_as_written() {
+    for (value, got) in [("99999999999", "got 9.9999999999e10"), ("-7", "got -7")] {
+        let e = error_of(&with_track(&format!(
+            "\"fractal.iterations\": (keys: [(time: 0, value: {value})])"
+        )));
+        assert!(
+            e.ends_with(&format!(
+                "tracks[\"fractal.iterations\"].keys[0].value: must be 1..=10000, {got}"
+            )),
+            "{e}"
+        );
+    }
+}
+
+/// The paths of the whole numbers in `value`, a scene as JSON.
+fn whole_numbers(value: &serde_json::Value, path: &str, found: &mut Vec<String>) {
+    match value {
+        serde_json::Value::Object(fields) => {
+            for (name, v) in fields {
+                whole_numbers(v, &format!("{path}.{name}"), found);
+            }
+        }
+        serde_json::Value::Array(items) => {
+            for (i, v) in items.iter().enumerate() {
+                whole_numbers(v, &format!("{path}[{i}]"), found);
+            }
+        }
+        serde_json::Value::Number(n) if !n.is_f64() => found.push(path.to_string()),
+        _ => {}
+    }
+}
+
+#[test]
+fn every_whole_number_field_of_a_scene_has_its_limit_told() {
+    // Every optional block given, so its fields are serialised.
+    let every = "(adaptive: (), look: (extra_lights: [(direction: (0, 1, 0))]),
+        effects: (shadows: (), ambient_occlusion: (), specular: (), fog: (), glow: (),
+        motion_blur: (), path_tracing: ()))";
+    let options =
+        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
+    let scene: Scene = options.from_str(every).unwrap();
+    let mut found = Vec::new();
+    whole_numbers(&serde_json::to_value(&scene).unwrap(), "scene", &mut found);
+    assert!(found.len() >= 9, "{found:?}");
+    for field in found {
+        assert!(COUNTED.iter().any(|(f, _)| *f == field), "{field}");
+    }
+}
+
+#[test]
+fn a_value_ron_cannot_read_is_named_by_its_field_at_its_first_character() {
+    let e = error_of("(\n    size: (8, 6),\n    fps: 2.4.0,\n    frames: 3,\n)");
+    assert_eq!(e, "test.ron:3:10: `fps`: Expected float");
+    for (text, at) in [
+        (
+            "(fps: 24, frames: 3, size: (8, 6),\n scene: (camera: (fov_degrees:  4.5.6)))",
+            "test.ron:2:33: `scene.camera.fov_degrees`: ",
+        ),
+        (
+            &with_track("\"camera.position\": (keys: [(time: 0, value: (1, 2.3.4, 3))])"),
+            "test.ron:1:95: `tracks[\"camera.position\"].keys[0].value[1]`: ",
+        ),
+        (
+            "(fps: 24, frames: /* many */ 3.0.0, size: (8, 6))",
+            "test.ron:1:30: `frames`: ",
+        ),
+    ] {
+        let e = error_of(text);
+        assert!(e.starts_with(at), "{e}");
+    }
+}
+
+#[test]
+fn deep_nesting_names_the_field_its_shallow_cousin_names() {
+    let deep = |open: &str, close: &str, depth: usize, inner: &str| {
+        format!(
+            "(fps: 24, frames: 3, size: (8, 6), scene: (camera: (fov_degrees: {}{inner}{})))",
+            open.repeat(depth),
+            close.repeat(depth)
+        )
+    };
+    for (open, close, inner, field) in [
+        ("(", ")", "", "`scene.camera.fov_degrees`: "),
+        ("Some(", ")", "\"x\"", "`scene.camera.fov_degrees`: "),
+        ("Some(", ")", "1.2.3", "`scene.camera.fov_degrees`: "),
+        ("[", "]", "1", "`scene.camera.fov_degrees`: "),
+    ] {
+        let shallow = error_of(&deep(open, close, 3, inner));
+        let deeper = error_of(&deep(open, close, 400, inner));
+        assert!(shallow.contains(field), "{shallow}");
+        assert!(deeper.contains(field), "{deeper}");
+    }
+    let scene = |depth: usize| {
+        let parens = format!("{}{}", "(".repeat(depth), ")".repeat(depth));
+        format!("(fps: 24, frames: 3, size: (8, 6), scene: ({parens}))")
+    };
+    assert_eq!(error_of(&scene(400)), error_of(&scene(3)));
+    assert!(error_of(&scene(400)).contains("`scene[0]`: "));
+    // Tracks given as a list, of tracks by name or of pairs.
+    for list in [
+        "[\"fractal.power\": (keys: [(time: 0, value: 8)])]",
+        "[(\"fractal.power\", (keys: [(time: 0, value: 8)]))]",
+    ] {
+        let e = error_of(&format!(
+            "(fps: 24, frames: 3, size: (8, 6), tracks: {list})"
+        ));
+        assert!(e.starts_with("test.ron:1:44: `tracks`: "), "{e}");
+    }
 }
 
 #[test]
@@ -723,13 +911,14 @@ fn a_camera_track_onto_the_target_is_refused_at_its_line() {
 
 #[test]
 fn messages_name_fractions_and_show_extreme_numbers_readably() {
-    // A fraction where a count is wanted: RON alone says "Expected comma".
+    // A fraction where a count is wanted: RON alone says "Expected comma",
+    // at the point; the number is shown from its start.
     let e = parse("(fps: 10, frames: 2,\n size: (320.5, 180))")
         .unwrap_err()
         .to_string();
     assert_eq!(
         e,
-        "test.ron:2:12: `size[0]`: expected a whole number here, got 320.5"
+        "test.ron:2:9: `size[0]`: expected a whole number here, got 320.5"
     );
     let e = parse("(fps: 10, frames: 2.5, size: (8, 6))")
         .unwrap_err()

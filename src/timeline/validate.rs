@@ -3,6 +3,9 @@
 //! and fields that depend on one another consistent (a view direction, path
 //! tracing without the effects it replaces).
 
+use super::limits::{
+    count_outside, MAX_BOUNCES, MAX_CONE_RAYS, MAX_OCCLUSION_SAMPLES, MAX_SAMPLES, MAX_SHADOW_STEPS,
+};
 use super::messages::Shown;
 use super::parameters::Parameter;
 use super::parameters::{
@@ -102,10 +105,16 @@ pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
     view(s)?;
     animatable(s, FRACTAL)?;
     animatable_in(s, QUALITY, &QUALITY_CHECKS)?;
-    at("quality.cone_rays", counted(s.quality.cone_rays, 4096))?;
-    at("samples_per_pixel", counted(s.samples_per_pixel, 4096))?;
+    at(
+        "quality.cone_rays",
+        counted(s.quality.cone_rays, MAX_CONE_RAYS),
+    )?;
+    at(
+        "samples_per_pixel",
+        counted(s.samples_per_pixel, MAX_SAMPLES),
+    )?;
     if let Some(a) = &s.adaptive {
-        at("adaptive.first", counted(a.first, 4096))?;
+        at("adaptive.first", counted(a.first, MAX_SAMPLES))?;
         at("adaptive.noise", noise(a.noise))?;
     }
     animatable_in(s, LOOK, &LOOK_CHECKS)?;
@@ -123,9 +132,7 @@ fn noise(x: f32) -> Checked {
 
 /// A count from 1 to `most`.
 pub(super) fn counted(n: u32, most: u32) -> Checked {
-    rule((1..=most).contains(&n), || {
-        format!("must be 1..={most}, got {n}")
-    })
+    rule((1..=most).contains(&n), || count_outside(most, n))
 }
 
 /// The view direction the camera's position, target and up give.
@@ -198,10 +205,16 @@ fn effects(s: &Scene) -> Result<(), Invalid> {
     let e = &s.effects;
     animatable(s, SHADOWS)?;
     if let Some(sh) = &e.shadows {
-        at("effects.shadows.max_steps", counted(sh.max_steps, 100_000))?;
+        at(
+            "effects.shadows.max_steps",
+            counted(sh.max_steps, MAX_SHADOW_STEPS),
+        )?;
     }
     if let Some(ao) = &e.ambient_occlusion {
-        at("effects.ambient_occlusion.samples", counted(ao.samples, 64))?;
+        at(
+            "effects.ambient_occlusion.samples",
+            counted(ao.samples, MAX_OCCLUSION_SAMPLES),
+        )?;
     }
     animatable(s, AMBIENT_OCCLUSION)?;
     animatable(s, SPECULAR)?;
@@ -234,7 +247,7 @@ fn path_tracing(pt: &PathTracing, e: &Effects) -> Result<(), Invalid> {
     at("effects.path_tracing", alone)?;
     at(
         "effects.path_tracing.max_bounces",
-        counted(pt.max_bounces, 1024),
+        counted(pt.max_bounces, MAX_BOUNCES),
     )?;
     let sun = pt.sun_angle_degrees;
     let sun_angle = rule(sun.is_finite() && (0.0..=30.0).contains(&sun), || {

@@ -25,3 +25,4 @@ mod stability;
 mod surface;
 mod validation;
 mod video;
+mod write_errors;

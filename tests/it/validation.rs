@@ -151,6 +151,33 @@ fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
 }
 
 #[test]
+fn a_timelines_own_size_past_the_memory_to_hand_is_an_invalid_timeline() {
+    // The size written in the timeline, not given on the command line:
+    // the timeline is at fault (exit 3), at its line, and nothing is made.
+    if !std::path::Path::new("/proc/self/limits").exists() {
+        return; // only Linux tells the limit
+    }
+    let d = Dir::new();
+    let text = tiny_timeline(1, 6.0).replace("size: (48, 27)", "size: (10000, 10000)");
+    d.write("t.ron", &text);
+    let out = std::process::Command::new("sh")
+        .current_dir(d.path())
+        .arg("-c")
+        .arg("ulimit -v 2000000 && exec \"$0\" render t.ron -q")
+        .arg(env!("CARGO_BIN_EXE_mandelreel"))
+        .output()
+        .unwrap();
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(3), "{err}");
+    assert!(
+        err.contains("t.ron:4:11: size: 10000x10000 needs about"),
+        "{err}"
+    );
+    assert!(err.contains("this process may map"), "{err}");
+    assert!(!d.path().join("out").exists());
+}
+
+#[test]
 fn frame_rates_past_a_thousand_are_refused() {
     for fps in ["1e300", "4294967296", "1000.5"] {
         let text = tiny_timeline(2, 6.0).replace("fps: 24", &format!("fps: {fps}"));

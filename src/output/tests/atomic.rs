@@ -1,20 +1,43 @@
 use crate::host::writer_tag;
 use crate::output::atomic::{remove_stale_partials, write_atomic};
 
+/// The names of the files in `dir`.
+fn names_in(dir: &std::path::Path) -> Vec<String> {
+    let entries = std::fs::read_dir(dir).unwrap();
+    entries
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect()
+}
+
 #[test]
 fn temporaries_are_hidden_beside_the_final_file() {
     // While it is written, a file is a hidden temporary beside the final one.
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("frame_00042.png");
-    write_atomic(&path, |_, t| {
-        let name = t.file_name().unwrap().to_string_lossy().into_owned();
-        assert_eq!(t.parent(), Some(dir.path()));
-        assert!(name.starts_with(&format!(".frame_00042.png.{}", writer_tag())));
-        assert!(name.ends_with(".partial"));
+    write_atomic(&path, |_, named| {
+        assert_eq!(named, path);
+        let names = names_in(dir.path());
+        assert_eq!(names.len(), 1, "{names:?}");
+        assert!(names[0].starts_with(&format!(".frame_00042.png.{}", writer_tag())));
+        assert!(names[0].ends_with(".partial"));
         Ok(())
     })
     .unwrap();
     assert!(path.exists());
+}
+
+#[test]
+fn a_failed_write_names_the_final_file_and_leaves_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("frame_00007.exr");
+    let full = || std::io::Error::from_raw_os_error(28);
+    let e = write_atomic(&path, |_, named| {
+        Err(crate::error::Error::io(named, full()))
+    });
+    let e = e.unwrap_err().to_string();
+    let expected = format!("{}: No space left on device", path.display());
+    assert!(e.starts_with(&expected), "{e}");
+    assert!(names_in(dir.path()).is_empty());
 }
 
 #[test]
