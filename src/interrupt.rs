@@ -83,6 +83,17 @@ impl Drop for Registered {
     }
 }
 
+/// A write past the file-size limit (`ulimit -f`) fails with EFBIG, which
+/// the writer reports and cleans up after, instead of SIGXFSZ killing the
+/// process with its temporary files, lock and run record left behind.
+pub fn survive_file_size_limit() {
+    #[cfg(unix)]
+    {
+        let seen = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let _ = signal_hook::flag::register(signal_hook::consts::SIGXFSZ, seen);
+    }
+}
+
 /// From now on, SIGINT and SIGTERM run the registered actions and end the
 /// process by that signal (module doc). Elsewhere than Unix, a no-op.
 pub fn install() -> std::io::Result<()> {

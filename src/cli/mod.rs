@@ -126,6 +126,7 @@ pub fn exit_code(error: &anyhow::Error) -> u8 {
 }
 
 pub fn run(cli: Cli) -> anyhow::Result<()> {
+    crate::interrupt::survive_file_size_limit();
     let result = match cli.command {
         Command::Render(args) => render::render(args),
         Command::Info { timeline } => info::info(&timeline),

@@ -4,9 +4,9 @@
 //!
 //! A full disk needs a mount (farm.rs's `a_full_disk_fails_clearly…`);
 //! here a file-size limit (`ulimit -f`) makes every write past it fail
-//! with EFBIG on any machine, root or not, without one. SIGXFSZ, which
-//! would kill the process instead, is ignored by the shell, and an ignored
-//! signal stays ignored across `exec`.
+//! with EFBIG on any machine, root or not, without one. The program itself
+//! keeps SIGXFSZ from killing it (`interrupt::survive_file_size_limit`): the
+//! shell here leaves the signal's default action in place.
 
 use crate::util::{stderr, Dir};
 use std::process::Command;
@@ -33,7 +33,7 @@ fn render_with_small_files(d: &Dir, args: &[&str]) -> std::process::Output {
     Command::new("sh")
         .current_dir(d.path())
         .arg("-c")
-        .arg("trap '' XFSZ; ulimit -f 16 && exec \"$0\" \"$@\"")
+        .arg("ulimit -f 16 && exec \"$0\" \"$@\"")
         .arg(env!("CARGO_BIN_EXE_mandelreel"))
         .args(args)
         .output()
