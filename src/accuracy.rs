@@ -607,6 +607,47 @@ pub fn mark_pareto(rows: &mut [Measurement]) {
     }
 }
 
+/// The share of pixels whose overshoot earns a variant a warning: one in
+/// a thousand (15 pixels of a 160×90 frame). The scene's own settings
+/// overshoot on 2 pixels at zoom frame 60, the analytic estimator at finer
+/// hit thresholds on 6, the membership walk on 3% and more.
+pub const OVERSHOOT_FLAG: f64 = 0.001;
+/// PSNR differences under this many dB are taken as not worth paying for
+/// (a convention, not a measurement of what shows).
+pub const VISIBLE_PSNR_DB: f64 = 0.5;
+
+/// Marched through the surface on at least `OVERSHOOT_FLAG` of the pixels.
+/// Hit/miss differences do not count: they grow with samples per pixel
+/// (a pixel hits where any sample does) and with the reference's finer
+/// threshold, on every setting of a scene alike (2.6–3.9% on S1).
+pub fn flagged(r: &Measurement) -> bool {
+    r.overshoot >= OVERSHOOT_FLAG
+}
+
+/// The setting to use: of the variants not `flagged`, the cheapest whose
+/// image is within `VISIBLE_PSNR_DB` of the best of them. Of those within
+/// `TIMING_NOISE` of the cheapest, the scene's own settings win, then
+/// fewer DE evaluations. `None` when every variant is flagged.
+pub fn recommended(rows: &[Measurement]) -> Option<usize> {
+    let candidates = || {
+        rows.iter()
+            .enumerate()
+            .filter(|(_, r)| r.knob != "reference" && !flagged(r) && !r.psnr_db.is_nan())
+    };
+    let best = candidates().map(|(_, r)| r.psnr_db).reduce(f64::max)?;
+    let good = || candidates().filter(|(_, r)| r.psnr_db >= best - VISIBLE_PSNR_DB);
+    let cheapest = good().map(|(_, r)| r.seconds).reduce(f64::min)?;
+    good()
+        .filter(|(_, r)| r.seconds <= cheapest * TIMING_NOISE)
+        .min_by(|(_, a), (_, b)| {
+            (b.knob == "scene")
+                .cmp(&(a.knob == "scene"))
+                .then(a.de_evaluations.cmp(&b.de_evaluations))
+                .then(a.seconds.total_cmp(&b.seconds))
+        })
+        .map(|(i, _)| i)
+}
+
 /// How the times were taken and the front drawn, for the Markdown.
 pub fn front_rule_text() -> String {
     format!(
@@ -708,6 +749,45 @@ mod tests {
             psnr_db: psnr(rmse),
             pareto: false,
         }
+    }
+
+    #[test]
+    fn a_flag_needs_overshoot_on_one_pixel_in_a_thousand() {
+        let mut r = row("fudge", 1.0, 0.1);
+        // Two pixels of a 160×90 frame: the scene's own settings at zoom frame 60.
+        r.overshoot = 2.0 / 14400.0;
+        assert!(!flagged(&r));
+        r.overshoot = 0.0011;
+        assert!(flagged(&r));
+        // Hit/miss differences alone, as on every variant of S1: no flag.
+        r.overshoot = 0.0;
+        r.hit_mismatch = 0.03;
+        assert!(!flagged(&r));
+    }
+
+    #[test]
+    fn recommended_is_the_cheapest_within_sight_of_the_best_image() {
+        let mut rows = vec![
+            row("reference", 50.0, 0.0),
+            row("scene", 1.0, 0.12),
+            row("fast", 0.5, 0.2),
+            row("best", 3.0, 0.09),
+            // 0.4 dB worse than the best, cheaper: recommended.
+            row("close", 2.0, 0.09 * 10f64.powf(0.4 / 20.0)),
+            // 0.6 dB worse: too far.
+            row("near", 1.5, 0.09 * 10f64.powf(0.6 / 20.0)),
+            // Better and cheaper than all, but marches through the surface.
+            row("broken", 0.8, 0.01),
+        ];
+        rows[6].overshoot = 0.05;
+        assert_eq!(recommended(&rows), Some(4));
+        // Within timing noise of the cheapest, the scene's own settings win.
+        rows[1] = row("scene", 2.05, 0.09);
+        assert_eq!(recommended(&rows), Some(1));
+        for r in &mut rows {
+            r.overshoot = 0.5;
+        }
+        assert_eq!(recommended(&rows), None);
     }
 
     #[test]

@@ -1,100 +1,62 @@
 //! The accuracy chart: error against cost on log axes, one panel for mean
-//! depth error and one for image RMSE. Every variant is numbered beside its
-//! point and named in a key below the panels; the scene's own settings are
-//! ringed; variants that overshoot or disagree with the reference on
-//! hit/miss are outlined in red; each panel draws its Pareto front
-//! (`front_of`, median time) as a step line. The reference is the
-//! yardstick and is not plotted.
+//! depth error and one for image RMSE, drawn to answer "which setting
+//! should I use". Each panel draws its Pareto front (`front_of`, median
+//! time) as a step line and names those points beside them; the other
+//! variants are small grey dots, left to the table. The scene's own
+//! settings are ringed, the `recommended` setting starred, and variants
+//! `flagged` for overshoot ringed in red. A key of
+//! four lines says so. The reference is the yardstick and is not plotted.
 
-use super::{front_of, Measurement, TIMING_NOISE};
+mod axis;
+mod place;
+
+use super::{
+    flagged, front_of, recommended, Measurement, OVERSHOOT_FLAG, TIMING_NOISE, VISIBLE_PSNR_DB,
+};
 use crate::error::{Error, Result};
+use axis::{decade_values, log_range, log_ticks, step_path, tick_label, MANTISSAS};
+use place::{place_labels, Rect, LABEL_GAP};
+use plotters::coord::combinators::{LogCoord, WithKeyPoints};
 use plotters::prelude::*;
 use std::path::Path;
 
 /// The PNG's size in pixels.
-pub const CHART_SIZE: (u32, u32) = (1600, 1000);
+pub const CHART_SIZE: (u32, u32) = (1600, 900);
 /// Height of the title and the two panels; the key fills the rest below.
-const PANELS_HEIGHT: u32 = 640;
+const PANELS_HEIGHT: u32 = 796;
 /// Errors below these are drawn at them: a zero has no place on a log axis.
 pub const DEPTH_FLOOR_PX: f64 = 0.01;
 pub const RMSE_FLOOR: f64 = 1e-4;
-/// A share of pixels changing hit/miss worth a red outline (0.1%).
-const MISMATCH_NOTE: f64 = 0.001;
-const POINT_RADIUS: i32 = 5;
-const KEY_LINE: i32 = 17;
-/// One colour per knob, in the order knobs first appear; red marks flags.
-const KNOB_COLOURS: [RGBColor; 12] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-    RGBColor(57, 59, 121),
-    RGBColor(0, 100, 0),
-    RGBColor(205, 133, 63),
-];
+/// Text sizes in pixels. Even, because plotters 0.3.7 puts each glyph at
+/// `(size / 2 + top) as i32`, which at odd sizes rounds short glyphs up
+/// and tall ones down: the decimal point floats a pixel above the digits.
+const TITLE_SIZE: u32 = 22;
+const CAPTION_SIZE: u32 = 18;
+const TEXT_SIZE: u32 = 14;
+const KEY_LINE: i32 = 24;
+/// Marks: a front point, a dominated one, the scene's ring, the star.
+const FRONT_RADIUS: i32 = 5;
+const DOMINATED_RADIUS: i32 = 3;
+const SCENE_RADIUS: i32 = 12;
+const STAR_RADIUS: i32 = 14;
+const FRONT: RGBColor = RGBColor(31, 119, 180);
+const DOMINATED: RGBColor = RGBColor(175, 175, 175);
+const STAR: RGBColor = RGBColor(0, 160, 70);
+const STAR_TEXT: RGBColor = RGBColor(0, 110, 45);
 const FLAG: RGBColor = RGBColor(220, 0, 0);
-
-/// A pixel rectangle, `[x0, x1) × [y0, y1)`.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-struct Rect {
-    x0: i32,
-    y0: i32,
-    x1: i32,
-    y1: i32,
-}
-
-impl Rect {
-    fn sized(x0: i32, y0: i32, w: i32, h: i32) -> Rect {
-        Rect {
-            x0,
-            y0,
-            x1: x0 + w,
-            y1: y0 + h,
-        }
-    }
-    fn around((x, y): (i32, i32), r: i32) -> Rect {
-        Rect::sized(x - r, y - r, 2 * r + 1, 2 * r + 1)
-    }
-    fn contains(&self, o: &Rect) -> bool {
-        o.x0 >= self.x0 && o.y0 >= self.y0 && o.x1 <= self.x1 && o.y1 <= self.y1
-    }
-    #[cfg(test)]
-    fn contains_point(&self, (x, y): (i32, i32)) -> bool {
-        x >= self.x0 && x < self.x1 && y >= self.y0 && y < self.y1
-    }
-    fn overlaps(&self, o: &Rect) -> bool {
-        self.x0 < o.x1 && o.x0 < self.x1 && self.y0 < o.y1 && o.y0 < self.y1
-    }
-    /// `o` moved the least distance to lie inside (its top-left corner
-    /// inside where `o` is larger).
-    fn clamp(&self, o: Rect) -> Rect {
-        let (w, h) = (o.x1 - o.x0, o.y1 - o.y0);
-        let x0 = o.x0.min(self.x1 - w).max(self.x0);
-        let y0 = o.y0.min(self.y1 - h).max(self.y0);
-        Rect::sized(x0, y0, w, h)
-    }
-    /// The point of the rectangle nearest to `p`.
-    fn nearest(&self, (x, y): (i32, i32)) -> (i32, i32) {
-        (x.clamp(self.x0, self.x1 - 1), y.clamp(self.y0, self.y1 - 1))
-    }
-}
 
 /// Where things landed, for the tests.
 #[derive(Debug, Default)]
 #[cfg_attr(not(test), allow(dead_code))]
 struct Geometry {
-    /// Each panel's plotting area, its points and its point labels.
+    /// Each panel's plotting area, its points (every variant, in `rows`
+    /// order less the reference) and its labels with their rows' indices.
     plots: Vec<Rect>,
     points: Vec<Vec<(i32, i32)>>,
-    labels: Vec<Vec<Rect>>,
-    /// The key below the panels and each of its entries.
+    labels: Vec<Vec<(usize, Rect)>>,
+    /// The key below the panels and each of its lines.
     key: Rect,
-    key_entries: Vec<Rect>,
+    key_lines: Vec<Rect>,
 }
 
 /// One panel: which error against cost.
@@ -120,157 +82,65 @@ const PANELS: [Panel; 2] = [
     },
 ];
 
-/// Worth a red outline: marched through the surface, or disagrees with the
-/// reference on hit/miss for a noticeable share of pixels.
-fn flagged(r: &Measurement) -> bool {
-    r.overshoot > 0.0 || r.hit_mismatch >= MISMATCH_NOTE
+/// What a variant is to the chart, which decides its mark and label.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Role {
+    Recommended,
+    Scene,
+    Front,
+    Dominated,
 }
 
-/// The range of a log axis holding every value with a margin, at least
-/// half a decade wide.
-fn log_range(values: &[f64]) -> (f64, f64) {
-    let positive = values.iter().copied().filter(|v| v.is_finite() && *v > 0.0);
-    let lo = positive.clone().fold(f64::INFINITY, f64::min);
-    let hi = positive.fold(0.0, f64::max);
-    if !lo.is_finite() || hi <= 0.0 {
-        return (1e-3, 1.0);
+impl Role {
+    fn radius(self) -> i32 {
+        match self {
+            Role::Recommended => STAR_RADIUS,
+            Role::Scene => SCENE_RADIUS,
+            Role::Front => FRONT_RADIUS,
+            Role::Dominated => DOMINATED_RADIUS,
+        }
     }
-    let (lo, hi) = (lo / 1.6, hi * 1.6);
-    let mid = (lo * hi).sqrt();
-    let half = 3f64.sqrt();
-    (lo.min(mid / half), hi.max(mid * half))
 }
 
-/// Mantissas of log-axis ticks, from coarse to fine.
-const MANTISSAS: [&[f64]; 5] = [
-    &[1.0],
-    &[1.0, 3.0],
-    &[1.0, 2.0, 5.0],
-    &[1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0],
-    &[
-        1.0, 1.2, 1.4, 1.6, 1.8, 2.0, 2.5, 3.0, 3.5, 4.0, 4.5, 5.0, 6.0, 7.0, 8.0, 9.0,
-    ],
-];
+/// How far a variant's mark reaches from its point, its red ring included.
+fn mark_radius(role: Role, r: &Measurement) -> i32 {
+    let ring = match role {
+        Role::Front | Role::Dominated if flagged(r) => 2 + 1,
+        _ => 0,
+    };
+    role.radius() + ring
+}
 
-/// Values m × 10^k in `[lo, hi]` for the mantissas `m`, ascending.
-fn decade_values(lo: f64, hi: f64, mantissas: &[f64]) -> Vec<f64> {
-    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
-    (k0..=k1)
-        .flat_map(|k| mantissas.iter().map(move |m| m * 10f64.powi(k)))
-        .filter(|&v| v >= lo * (1.0 - 1e-9) && v <= hi * (1.0 + 1e-9))
+/// Each row's role in a panel whose front is `on_front`: the recommended
+/// setting and the scene's own are named wherever they fall.
+fn roles(rows: &[Measurement], on_front: &[bool], pick: Option<usize>) -> Vec<Role> {
+    rows.iter()
+        .enumerate()
+        .map(|(i, r)| {
+            if Some(i) == pick {
+                Role::Recommended
+            } else if r.knob == "scene" {
+                Role::Scene
+            } else if on_front[i] {
+                Role::Front
+            } else {
+                Role::Dominated
+            }
+        })
         .collect()
 }
 
-/// Labelled ticks of a log axis over `[lo, hi]`: the coarsest of 1, 1-3,
-/// 1-2-5, 1…9 per decade that gives at least five, thinned to `most`.
-fn log_ticks(lo: f64, hi: f64, most: usize) -> Vec<f64> {
-    let mut ticks = Vec::new();
-    for mantissas in MANTISSAS {
-        ticks = decade_values(lo, hi, mantissas);
-        if ticks.len() >= 5 {
-            break;
-        }
+/// A variant's name on the chart: its knob and setting, without the
+/// setting's note in brackets, which the table keeps.
+fn label_text(r: &Measurement) -> String {
+    if r.knob == "scene" {
+        return "scene's own settings".into();
     }
-    let step = ticks.len().div_ceil(most.max(1)).max(1);
-    ticks.into_iter().step_by(step).collect()
-}
-
-/// A tick value in few characters: `0.002`, `1.5`, `20`, `1e-4`.
-fn tick_label(v: f64) -> String {
-    let a = v.abs();
-    if a == 0.0 {
-        return "0".into();
-    }
-    let trim = |s: String| {
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
+    let setting = match r.setting.split_once(" (") {
+        Some((head, _)) => head,
+        None => &r.setting,
     };
-    if (1e-3..1e5).contains(&a) {
-        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
-        trim(format!("{v:.decimals$}"))
-    } else {
-        let s = format!("{v:.2e}");
-        let (mantissa, exponent) = s.split_once('e').expect("{:e} writes an exponent");
-        format!("{}e{exponent}", trim(mantissa.to_string()))
-    }
-}
-
-/// The staircase through a front's points: from each point along to the
-/// next one's cost, then down to its error.
-fn step_path(front: &[(f64, f64)]) -> Vec<(f64, f64)> {
-    let mut points = front.to_vec();
-    points.sort_by(|a, b| a.0.total_cmp(&b.0));
-    let mut path = Vec::with_capacity(2 * points.len());
-    for (i, &(x, y)) in points.iter().enumerate() {
-        if i > 0 {
-            path.push((x, path.last().map_or(y, |p: &(f64, f64)| p.1)));
-        }
-        path.push((x, y));
-    }
-    path
-}
-
-/// Places a label of each size beside its point inside `plot`: the first
-/// spot, in rings of eight directions further and further out, that
-/// covers no point and no label placed before it; failing that, the spot
-/// with the fewest clashes.
-fn place_labels(points: &[(i32, i32)], sizes: &[(i32, i32)], plot: Rect) -> Vec<Rect> {
-    let disks: Vec<Rect> = points
-        .iter()
-        .map(|&p| Rect::around(p, POINT_RADIUS))
-        .collect();
-    let mut placed: Vec<Rect> = Vec::with_capacity(points.len());
-    for (&(x, y), &(w, h)) in points.iter().zip(sizes) {
-        let mut best: Option<(usize, Rect)> = None;
-        'search: for ring in 0..10 {
-            let gap = POINT_RADIUS + 2 + 8 * ring;
-            for (dx, dy) in [
-                (1, 0),
-                (-1, 0),
-                (0, -1),
-                (0, 1),
-                (1, -1),
-                (-1, -1),
-                (1, 1),
-                (-1, 1),
-            ] {
-                let x0 = match dx {
-                    1 => x + gap,
-                    -1 => x - gap - w,
-                    _ => x - w / 2,
-                };
-                let y0 = match dy {
-                    -1 => y - gap - h,
-                    1 => y + gap,
-                    _ => y - h / 2,
-                };
-                let spot = Rect::sized(x0, y0, w, h);
-                if !plot.contains(&spot) {
-                    continue;
-                }
-                let clashes = placed
-                    .iter()
-                    .chain(&disks)
-                    .filter(|r| r.overlaps(&spot))
-                    .count();
-                if best.is_none_or(|(c, _)| clashes < c) {
-                    best = Some((clashes, spot));
-                }
-                if clashes == 0 {
-                    break 'search;
-                }
-            }
-        }
-        let spot = best.map_or_else(
-            || plot.clamp(Rect::sized(x + POINT_RADIUS + 2, y - h / 2, w, h)),
-            |(_, spot)| spot,
-        );
-        placed.push(spot);
-    }
-    placed
+    format!("{} {setting}", r.knob)
 }
 
 /// Draws the chart (see the module's comment) and writes it as a PNG of
@@ -290,76 +160,64 @@ pub fn write_chart(rows: &[Measurement], title: &str, path: &Path) -> Result<()>
     })
 }
 
-/// A variant's marker: a dot in its knob's colour, a red outline when
-/// `flag`ged, a big ring for the scene's own settings.
-fn marker(p: (i32, i32), fill: RGBColor, flag: bool, scene: bool) -> Vec<Circle<(i32, i32), i32>> {
-    let mut circles = vec![Circle::new(p, POINT_RADIUS, fill.filled())];
-    if flag {
-        circles.push(Circle::new(p, POINT_RADIUS + 2, FLAG.stroke_width(2)));
-    }
-    if scene {
-        circles.push(Circle::new(p, 2 * POINT_RADIUS + 2, BLACK.stroke_width(2)));
-    }
-    circles
-}
-
 fn text<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-/// Renders the chart into an RGB buffer of `CHART_SIZE`.
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
 
-/// What every part of the chart draws a variant with: the variants plotted
-/// (every row but the reference, with its row index), their colours and labels.
-struct Variants<'r> {
-    rows: &'r [Measurement],
-    plotted: Vec<(usize, &'r Measurement)>,
-    colours: Vec<RGBColor>,
-    labels: Vec<String>,
+fn font(size: u32) -> TextStyle<'static> {
+    (crate::output::font::FAMILY, size)
+        .into_font()
+        .color(&BLACK)
 }
 
-impl<'r> Variants<'r> {
-    fn of(rows: &'r [Measurement]) -> Variants<'r> {
-        let plotted: Vec<(usize, &Measurement)> = rows
-            .iter()
-            .enumerate()
-            .filter(|(_, r)| r.knob != "reference")
-            .collect();
-        let mut knobs: Vec<&str> = Vec::new();
-        for (_, r) in &plotted {
-            if r.knob != "scene" && !knobs.contains(&r.knob) {
-                knobs.push(r.knob);
-            }
-        }
-        let colours = plotted
-            .iter()
-            .map(|(_, r)| {
-                knobs
-                    .iter()
-                    .position(|k| *k == r.knob)
-                    .map_or(BLACK, |i| KNOB_COLOURS[i % KNOB_COLOURS.len()])
-            })
-            .collect();
-        // Numbered from 1 in table order (the scene is first).
-        let labels = plotted
-            .iter()
-            .enumerate()
-            .map(|(n, (_, r))| {
-                if r.knob == "scene" {
-                    format!("{} scene", n + 1)
-                } else {
-                    (n + 1).to_string()
-                }
-            })
-            .collect();
-        Variants {
-            rows,
-            plotted,
-            colours,
-            labels,
-        }
+/// The points of a five-pointed star of outer radius `r` around `(x, y)`.
+fn star_points((x, y): (i32, i32), r: i32) -> Vec<(i32, i32)> {
+    (0..10)
+        .map(|k| {
+            let radius = if k % 2 == 0 {
+                r as f64
+            } else {
+                0.45 * r as f64
+            };
+            let angle = std::f64::consts::PI * (k as f64 / 5.0 - 0.5);
+            (
+                x + (radius * angle.cos()).round() as i32,
+                y + (radius * angle.sin()).round() as i32,
+            )
+        })
+        .collect()
+}
+
+/// A variant's mark: a star under the recommended one, a ring round the
+/// scene's, a dot (grey and small when dominated), a red ring when flagged.
+fn draw_marker(
+    root: &Area,
+    p: (i32, i32),
+    role: Role,
+    flag: bool,
+) -> std::result::Result<(), String> {
+    match role {
+        Role::Recommended => root
+            .draw(&Polygon::new(star_points(p, STAR_RADIUS), STAR.filled()))
+            .map_err(text)?,
+        Role::Scene => root
+            .draw(&Circle::new(p, SCENE_RADIUS, BLACK.stroke_width(2)))
+            .map_err(text)?,
+        Role::Front | Role::Dominated => {}
     }
+    let (radius, fill) = match role {
+        Role::Dominated => (DOMINATED_RADIUS, DOMINATED),
+        _ => (FRONT_RADIUS, FRONT),
+    };
+    root.draw(&Circle::new(p, radius, fill.filled()))
+        .map_err(text)?;
+    if flag {
+        root.draw(&Circle::new(p, radius + 2, FLAG.stroke_width(2)))
+            .map_err(text)?;
+    }
+    Ok(())
 }
 
 fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geometry), String> {
@@ -367,17 +225,17 @@ fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geom
     let (w, h) = CHART_SIZE;
     let mut pixels = vec![255u8; (w * h * 3) as usize];
     let mut geometry = Geometry::default();
-    let variants = Variants::of(rows);
+    let pick = recommended(rows);
     {
         let root = BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area();
         root.fill(&WHITE).map_err(text)?;
         let (top, _) = root.split_vertically(PANELS_HEIGHT);
-        let top = top.titled(title, ("sans-serif", 22)).map_err(text)?;
+        let top = top.titled(title, font(TITLE_SIZE)).map_err(text)?;
         for (area, panel) in top.split_evenly((1, 2)).iter().zip(&PANELS) {
-            let (plot, points, spots) = draw_panel(&root, area, panel, &variants)?;
+            let (plot, points, labels) = draw_panel(&root, area, panel, rows, pick)?;
             geometry.plots.push(plot);
             geometry.points.push(points);
-            geometry.labels.push(spots);
+            geometry.labels.push(labels);
         }
         geometry.key = Rect::sized(
             0,
@@ -385,32 +243,120 @@ fn draw(rows: &[Measurement], title: &str) -> std::result::Result<(Vec<u8>, Geom
             w as i32,
             (h - PANELS_HEIGHT) as i32,
         );
-        geometry.key_entries = draw_key(&root, geometry.key, &variants)?;
+        geometry.key_lines = draw_key(&root, geometry.key, rows, pick)?;
         root.present().map_err(text)?;
     }
     Ok((pixels, geometry))
 }
 
 /// One panel: its axes, the Pareto front as a step line, the points and
-/// their labels; returns the plotting area, the points and the labels' spots.
+/// the labels of the front, the scene and the recommended setting; returns
+/// the plotting area, the points and the labels with their rows.
 #[allow(clippy::type_complexity)]
 fn draw_panel(
     root: &Area,
     area: &Area,
     panel: &Panel,
-    variants: &Variants,
-) -> std::result::Result<(Rect, Vec<(i32, i32)>, Vec<Rect>), String> {
-    let plotted = &variants.plotted;
-    let xs: Vec<f64> = plotted.iter().map(|(_, r)| r.seconds).collect();
-    let ys: Vec<f64> = plotted
-        .iter()
-        .map(|(_, r)| (panel.error)(r).max(panel.floor))
+    rows: &[Measurement],
+    pick: Option<usize>,
+) -> std::result::Result<(Rect, Vec<(i32, i32)>, Vec<(usize, Rect)>), String> {
+    let plotted: Vec<usize> = (0..rows.len())
+        .filter(|&i| rows[i].knob != "reference")
         .collect();
-    let (x0, x1) = log_range(&xs);
-    let (y0, y1) = log_range(&ys);
+    let at = |i: usize| (rows[i].seconds, (panel.error)(&rows[i]).max(panel.floor));
+    let (xs, ys): (Vec<f64>, Vec<f64>) = plotted.iter().map(|&i| at(i)).unzip();
+    let chart = draw_axes(area, panel, &xs, &ys)?;
+    let (xr, yr) = chart.plotting_area().get_pixel_range();
+    let plot = Rect {
+        x0: xr.start,
+        y0: yr.start,
+        x1: xr.end,
+        y1: yr.end,
+    };
+    // Every row's pixel, the reference's too (never drawn), so rows index it.
+    let pixels: Vec<(i32, i32)> = (0..rows.len())
+        .map(|i| chart.backend_coord(&at(i)))
+        .collect();
+    let points: Vec<(i32, i32)> = plotted.iter().map(|&i| pixels[i]).collect();
+    let on_front = front_of(rows, panel.error);
+    let front: Vec<(f64, f64)> = plotted
+        .iter()
+        .filter(|&&i| on_front[i])
+        .map(|&i| at(i))
+        .collect();
+    let path: Vec<(i32, i32)> = step_path(&front)
+        .iter()
+        .map(|p| chart.backend_coord(p))
+        .collect();
+    let marks = Marks {
+        rows,
+        plotted: &plotted,
+        pixels: &pixels,
+        role: roles(rows, &on_front, pick),
+    };
+    let labels = draw_marks(root, &marks, path, plot)?;
+    Ok((plot, points, labels))
+}
+
+/// A panel's variants as drawn: every row's pixel and role, and which rows
+/// are plotted.
+struct Marks<'a> {
+    rows: &'a [Measurement],
+    plotted: &'a [usize],
+    pixels: &'a [(i32, i32)],
+    role: Vec<Role>,
+}
+
+/// The front's step line `path`, every plotted variant's mark, and the
+/// labels of the named ones; returns the labels with their rows.
+fn draw_marks(
+    root: &Area,
+    marks: &Marks,
+    path: Vec<(i32, i32)>,
+    plot: Rect,
+) -> std::result::Result<Vec<(usize, Rect)>, String> {
+    let Marks {
+        rows,
+        plotted,
+        pixels,
+        role,
+    } = marks;
+    // Dominated points first, so the named ones are drawn over them, and
+    // red rings over the plain dots of their kind.
+    let mut order = plotted.to_vec();
+    order.sort_by_key(|&i| (role[i] != Role::Dominated, flagged(&rows[i])));
+    let mut obstacles: Vec<Rect> = path
+        .windows(2)
+        .map(|s| Rect::spanning(s[0], s[1], 1))
+        .collect();
+    root.draw(&PathElement::new(path, BLACK.stroke_width(2)))
+        .map_err(text)?;
+    for i in order {
+        draw_marker(root, pixels[i], role[i], flagged(&rows[i]))?;
+        obstacles.push(Rect::around(pixels[i], mark_radius(role[i], &rows[i])));
+    }
+    let named: Vec<(usize, (i32, i32))> = named_in_order(rows, plotted, role)
+        .into_iter()
+        .map(|i| (i, pixels[i]))
+        .collect();
+    draw_labels(root, rows, &named, role, &obstacles, plot)
+}
+
+/// The panel's two log axes over every value, with their grid and labels.
+type LogAxes = Cartesian2d<WithKeyPoints<LogCoord<f64>>, WithKeyPoints<LogCoord<f64>>>;
+
+/// Draws a panel's caption, axes, grid and tick labels around `xs`, `ys`.
+fn draw_axes<'a, 'b>(
+    area: &'a Area<'b>,
+    panel: &Panel,
+    xs: &[f64],
+    ys: &[f64],
+) -> std::result::Result<ChartContext<'a, BitMapBackend<'b>, LogAxes>, String> {
+    let (x0, x1) = log_range(xs);
+    let (y0, y1) = log_range(ys);
     let light = |lo, hi| decade_values(lo, hi, MANTISSAS[3]);
     let mut chart = ChartBuilder::on(area)
-        .caption(panel.title, ("sans-serif", 17))
+        .caption(panel.title, font(CAPTION_SIZE))
         .margin(10)
         .margin_right(28)
         .x_label_area_size(48)
@@ -432,270 +378,230 @@ fn draw_panel(
         .y_desc(panel.axis)
         .x_label_formatter(&|v| tick_label(*v))
         .y_label_formatter(&|v| tick_label(*v))
-        .label_style(("sans-serif", 13))
-        .axis_desc_style(("sans-serif", 14))
+        .label_style(font(TEXT_SIZE))
+        .axis_desc_style(font(TEXT_SIZE))
         .bold_line_style(BLACK.mix(0.2))
         .light_line_style(BLACK.mix(0.07))
         .draw()
         .map_err(text)?;
-    let (xr, yr) = chart.plotting_area().get_pixel_range();
-    let plot = Rect {
-        x0: xr.start,
-        y0: yr.start,
-        x1: xr.end,
-        y1: yr.end,
-    };
-    let points: Vec<(i32, i32)> = xs
-        .iter()
-        .zip(&ys)
-        .map(|(&x, &y)| chart.backend_coord(&(x, y)))
-        .collect();
-
-    // The front under the points.
-    let on_front = front_of(variants.rows, panel.error);
-    let front: Vec<(f64, f64)> = plotted
-        .iter()
-        .zip(xs.iter().zip(&ys))
-        .filter(|((i, _), _)| on_front[*i])
-        .map(|(_, (&x, &y))| (x, y))
-        .collect();
-    let path: Vec<(i32, i32)> = step_path(&front)
-        .iter()
-        .map(|p| chart.backend_coord(p))
-        .collect();
-    root.draw(&PathElement::new(path, BLACK.stroke_width(2)))
-        .map_err(text)?;
-    for (((_, r), &p), &fill) in plotted.iter().zip(&points).zip(&variants.colours) {
-        for c in marker(p, fill, flagged(r), r.knob == "scene") {
-            root.draw(&c).map_err(text)?;
-        }
-    }
-    let spots = draw_labels(root, &points, &variants.labels, plot)?;
-    Ok((plot, points, spots))
+    Ok(chart)
 }
 
-/// Each point's label beside it, where it overlaps nothing, with a leader
-/// line where it had to move away; returns where the labels went.
+/// The rows a panel names, in the order their labels are placed: the
+/// recommended setting, the scene's own, then the front from cheap to dear.
+fn named_in_order(rows: &[Measurement], plotted: &[usize], role: &[Role]) -> Vec<usize> {
+    let mut named: Vec<usize> = plotted
+        .iter()
+        .copied()
+        .filter(|&i| role[i] != Role::Dominated)
+        .collect();
+    named.sort_by(|&a, &b| {
+        let rank = |i: usize| match role[i] {
+            Role::Recommended => 0,
+            Role::Scene => 1,
+            _ => 2,
+        };
+        rank(a)
+            .cmp(&rank(b))
+            .then(rows[a].seconds.total_cmp(&rows[b].seconds))
+    });
+    named
+}
+
+/// Each named row's label on a white ground beside its point, or where
+/// `place_labels` found room, with a leader line back to the point;
+/// returns where the labels went.
 fn draw_labels(
     root: &Area,
-    points: &[(i32, i32)],
-    labels: &[String],
+    rows: &[Measurement],
+    named: &[(usize, (i32, i32))],
+    role: &[Role],
+    obstacles: &[Rect],
     plot: Rect,
-) -> std::result::Result<Vec<Rect>, String> {
-    let label_font = ("sans-serif", 12).into_font().color(&BLACK);
-    let sizes = labels
+) -> std::result::Result<Vec<(usize, Rect)>, String> {
+    let words: Vec<String> = named
         .iter()
-        .map(|l| {
-            let (w, h) = root.estimate_text_size(l, &label_font).map_err(text)?;
-            Ok((w as i32 + 1, h as i32))
+        .map(|&(i, _)| match role[i] {
+            Role::Recommended => format!("recommended: {}", label_text(&rows[i])),
+            _ => label_text(&rows[i]),
+        })
+        .collect();
+    let sizes = words
+        .iter()
+        .map(|w| {
+            let (width, _) = root.estimate_text_size(w, &font(TEXT_SIZE)).map_err(text)?;
+            Ok((width as i32 + 4, TEXT_SIZE as i32))
         })
         .collect::<std::result::Result<Vec<_>, String>>()?;
-    let spots = place_labels(points, &sizes, plot);
-    for ((label, spot), &p) in labels.iter().zip(&spots).zip(points) {
-        if !Rect::around(p, POINT_RADIUS + 3).overlaps(spot) {
-            let leader = vec![p, spot.nearest(p)];
-            root.draw(&PathElement::new(leader, BLACK.mix(0.35)))
+    let anchors: Vec<((i32, i32), i32)> = named
+        .iter()
+        .map(|&(i, p)| (p, mark_radius(role[i], &rows[i])))
+        .collect();
+    let spots = place_labels(&anchors, &sizes, obstacles, plot);
+    let mut placed = Vec::new();
+    for ((&(i, p), words), spot) in named.iter().zip(words).zip(spots) {
+        let Some(spot) = spot else { continue };
+        if spot.nearest(p) != p
+            && !Rect::around(p, mark_radius(role[i], &rows[i]) + LABEL_GAP + 2).overlaps(&spot)
+        {
+            root.draw(&PathElement::new(vec![p, spot.nearest(p)], BLACK.mix(0.4)))
                 .map_err(text)?;
         }
-        root.draw(&Text::new(
-            label.clone(),
-            (spot.x0, spot.y0),
-            label_font.clone(),
+        root.draw(&Rectangle::new(
+            [(spot.x0, spot.y0), (spot.x1 - 1, spot.y1 - 1)],
+            WHITE.mix(0.85).filled(),
         ))
         .map_err(text)?;
-    }
-    Ok(spots)
-}
-
-/// The key below both panels: what the marks mean, then every variant by
-/// number; returns where each variant's entry went.
-fn draw_key(root: &Area, key: Rect, variants: &Variants) -> std::result::Result<Vec<Rect>, String> {
-    let key_font = ("sans-serif", 13).into_font().color(&BLACK);
-    let mut y = key.y0 + 8;
-    let mut x = 20;
-    let legend = [
-        (
-            "colour: knob; number: the list below",
-            KNOB_COLOURS[0],
-            false,
-            false,
-        ),
-        ("big ring: the scene's own settings", BLACK, false, true),
-        (
-            "red outline: overshoot > 0 or hit/miss differs on >= 0.1% of pixels",
-            KNOB_COLOURS[0],
-            true,
-            false,
-        ),
-    ];
-    for (words, fill, flag, scene) in legend {
-        for c in marker((x + 12, y + 8), fill, flag, scene) {
-            root.draw(&c).map_err(text)?;
-        }
-        root.draw(&Text::new(words, (x + 30, y), key_font.clone()))
-            .map_err(text)?;
-        x += 50 + root.estimate_text_size(words, &key_font).map_err(text)?.0 as i32;
-    }
-    y += 22;
-    root.draw(&PathElement::new(
-        vec![(20, y + 8), (44, y + 8), (44, y + 2)],
-        BLACK.stroke_width(2),
-    ))
-    .map_err(text)?;
-    let note = format!(
-        "step line: Pareto front of median time against that panel's error (times within {:.0}% are one cost); \
-         0 errors drawn at the floor; the reference is not plotted",
-        100.0 * (TIMING_NOISE - 1.0)
-    );
-    root.draw(&Text::new(note, (50, y), key_font.clone()))
+        let colour = if role[i] == Role::Recommended {
+            STAR_TEXT
+        } else {
+            BLACK
+        };
+        // The font's ink starts two pixels above where its text is put.
+        root.draw(&Text::new(
+            words,
+            (spot.x0 + 2, spot.y0 + 3),
+            font(TEXT_SIZE).color(&colour),
+        ))
         .map_err(text)?;
-    y += 30;
-    draw_key_entries(root, key, y, variants, &key_font)
+        placed.push((i, spot));
+    }
+    Ok(placed)
 }
 
-/// The numbered list of variants, in columns from `top` to the key's foot.
-fn draw_key_entries(
+/// What a key entry shows before its words.
+#[derive(Clone, Copy)]
+enum KeyMark {
+    Point(Role, bool),
+    Step,
+    Nothing,
+}
+
+/// The key's lines: the recommendation, then what each mark means.
+fn key_lines(rows: &[Measurement], pick: Option<usize>) -> Vec<Vec<(KeyMark, String)>> {
+    let scene = rows.iter().find(|r| r.knob == "scene");
+    let advice = match (pick, scene) {
+        (Some(i), Some(s)) if rows[i].knob == "scene" => format!(
+            "recommended: the scene's own settings ({:.3} s, PSNR {:.1} dB)",
+            s.seconds, s.psnr_db
+        ),
+        (Some(i), Some(s)) => format!(
+            "recommended: {} ({:.3} s, {:.2}x the scene's time; PSNR {:.1} dB, the scene's {:.1} dB)",
+            label_text(&rows[i]),
+            rows[i].seconds,
+            rows[i].seconds / s.seconds.max(1e-9),
+            rows[i].psnr_db,
+            s.psnr_db
+        ),
+        (Some(i), None) => format!("recommended: {}", label_text(&rows[i])),
+        (None, _) => "no recommendation: every variant has a red ring".into(),
+    };
+    let percent = |share: f64| format!("{}%", tick_label(100.0 * share));
+    vec![
+        vec![(KeyMark::Point(Role::Recommended, false), advice)],
+        vec![(
+            KeyMark::Nothing,
+            format!(
+                "the star: of the variants without a red ring, the cheapest whose image is within {VISIBLE_PSNR_DB} dB PSNR of the best"
+            ),
+        )],
+        vec![
+            (KeyMark::Step, format!("Pareto front, named: the cheapest setting for its error (times within {} are one cost)", percent(TIMING_NOISE - 1.0))),
+            (KeyMark::Point(Role::Dominated, false), "grey: matched or beaten at no more cost (in the table)".into()),
+        ],
+        vec![
+            (KeyMark::Point(Role::Scene, false), "the scene's own settings".into()),
+            (
+                KeyMark::Point(Role::Front, true),
+                format!("red ring: overshoot on {} of pixels or more", percent(OVERSHOOT_FLAG)),
+            ),
+            (KeyMark::Nothing, "errors of 0 drawn at the floor; reference not plotted".into()),
+        ],
+    ]
+}
+
+/// Draws the key's lines below the panels; returns where each went.
+fn draw_key(
     root: &Area,
     key: Rect,
-    top: i32,
-    variants: &Variants,
-    key_font: &TextStyle,
+    rows: &[Measurement],
+    pick: Option<usize>,
 ) -> std::result::Result<Vec<Rect>, String> {
-    let plotted = &variants.plotted;
-    let rows_per_column = ((key.y1 - 6 - top) / KEY_LINE).max(1) as usize;
-    let columns = plotted.len().div_ceil(rows_per_column).max(4);
-    let column_width = (key.x1 - key.x0 - 20) / columns as i32;
-    let char_width = root
-        .estimate_text_size("0000000000", key_font)
-        .map_err(text)?
-        .0 as i32
-        / 10;
-    let fits = ((column_width - 28) / char_width.max(1)).max(4) as usize;
-    let mut entries = Vec::new();
-    for (n, ((_, r), &fill)) in plotted.iter().zip(&variants.colours).enumerate() {
-        let (cx, cy) = (
-            10 + (n / rows_per_column) as i32 * column_width,
-            top + (n % rows_per_column) as i32 * KEY_LINE,
-        );
-        for c in marker((cx + 10, cy + 8), fill, flagged(r), false) {
-            root.draw(&c).map_err(text)?;
+    let style = font(TEXT_SIZE);
+    let mut placed = Vec::new();
+    for (n, line) in key_lines(rows, pick).into_iter().enumerate() {
+        let y = key.y0 + 4 + n as i32 * KEY_LINE;
+        let mut x = key.x0 + 20;
+        for (mark, words) in line {
+            let centre = (x + STAR_RADIUS, y + KEY_LINE / 2);
+            match mark {
+                KeyMark::Point(role, flag) => draw_marker(root, centre, role, flag)?,
+                KeyMark::Step => root
+                    .draw(&PathElement::new(
+                        vec![
+                            (x, centre.1 - 6),
+                            (x + 14, centre.1 - 6),
+                            (x + 14, centre.1 + 6),
+                            (x + 28, centre.1 + 6),
+                        ],
+                        BLACK.stroke_width(2),
+                    ))
+                    .map_err(text)?,
+                KeyMark::Nothing => {}
+            }
+            let indent = match mark {
+                KeyMark::Nothing => 0,
+                _ => 2 * STAR_RADIUS + 8,
+            };
+            let colour = match mark {
+                KeyMark::Point(Role::Recommended, _) => STAR_TEXT,
+                _ => BLACK,
+            };
+            let (width, _) = root.estimate_text_size(&words, &style).map_err(text)?;
+            root.draw(&Text::new(words, (x + indent, y + 7), style.color(&colour)))
+                .map_err(text)?;
+            x += indent + width as i32 + 36;
         }
-        let mut words = format!("{:>2} {} {}", n + 1, r.knob, r.setting);
-        if flagged(r) {
-            words += &format!(
-                " (over {:.2}%, hit/miss {:.2}%)",
-                100.0 * r.overshoot,
-                100.0 * r.hit_mismatch
-            );
-        }
-        if words.chars().count() > fits {
-            words = words.chars().take(fits - 1).collect::<String>() + "~";
-        }
-        let style = if flagged(r) {
-            key_font.clone().color(&FLAG)
-        } else {
-            key_font.clone()
-        };
-        let size = root.estimate_text_size(&words, &style).map_err(text)?;
-        root.draw(&Text::new(words, (cx + 22, cy), style))
-            .map_err(text)?;
-        entries.push(Rect::sized(
-            cx,
-            cy,
-            22 + size.0 as i32,
-            KEY_LINE.max(size.1 as i32),
-        ));
+        placed.push(Rect::sized(key.x0 + 20, y, x - 36 - key.x0 - 20, KEY_LINE));
     }
-    Ok(entries)
+    Ok(placed)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn labels(ticks: &[f64]) -> Vec<String> {
-        ticks.iter().map(|&v| tick_label(v)).collect()
+    /// The lowest row of dark ink of `words` drawn at `size`.
+    fn ink_bottom(words: &str, size: u32) -> i32 {
+        crate::output::font::register().unwrap();
+        let (w, h) = (60usize, 60usize);
+        let mut pixels = vec![255u8; w * h * 3];
+        {
+            let root =
+                BitMapBackend::with_buffer(&mut pixels, (w as u32, h as u32)).into_drawing_area();
+            root.draw(&Text::new(words, (5, 20), font(size))).unwrap();
+        }
+        let dark = |x: usize, y: usize| pixels[3 * (y * w + x)] < 128;
+        (0..h)
+            .filter(|&y| (0..w).any(|x| dark(x, y)))
+            .max()
+            .unwrap() as i32
     }
 
     #[test]
-    fn log_ticks_give_several_labels_per_axis() {
-        // Two decades: 1-2-5 is the coarsest set with at least five.
-        assert_eq!(
-            labels(&log_ticks(0.002, 0.09, 9)),
-            ["0.002", "0.005", "0.01", "0.02", "0.05"]
-        );
-        // Under a decade: every integer mantissa.
-        assert_eq!(
-            labels(&log_ticks(0.0031, 0.0095, 9)),
-            ["0.004", "0.005", "0.006", "0.007", "0.008", "0.009"]
-        );
-        // Sixteen decades: one per decade, thinned to the limit, still spanning.
-        let wide = log_ticks(1e-8, 1e8, 6);
-        assert!((4..=6).contains(&wide.len()), "{wide:?}");
-        assert_eq!(tick_label(wide[0]), "1e-8");
-        assert!(wide.last().is_some_and(|&v| v >= 1e6));
-        for ticks in [log_ticks(0.002, 0.09, 9), wide] {
-            assert!(ticks.windows(2).all(|w| w[0] < w[1]));
+    fn the_decimal_point_sits_on_the_baseline() {
+        // '1' stands flat on the baseline, as '.' does.
+        for size in [TITLE_SIZE, CAPTION_SIZE, TEXT_SIZE] {
+            assert_eq!(ink_bottom(".", size), ink_bottom("1", size), "size {size}");
         }
     }
 
     #[test]
-    fn log_range_holds_every_value_and_half_a_decade() {
-        let (lo, hi) = log_range(&[0.004, 0.0041]);
-        assert!(lo < 0.004 && hi > 0.0041 && hi / lo >= 3.0 - 1e-9);
-        let (lo, hi) = log_range(&[1e-4, 0.3, 0.0]);
-        assert!(lo < 1e-4 && hi > 0.3);
-    }
-
-    #[test]
-    fn tick_labels_are_short() {
-        let cases = [
-            (0.002, "0.002"),
-            (0.0015, "0.0015"),
-            (1.5, "1.5"),
-            (20.0, "20"),
-            (0.1 + 0.2, "0.3"),
-            (1e-4, "1e-4"),
-            (2.5e-5, "2.5e-5"),
-            (1e5, "1e5"),
-        ];
-        for (v, label) in cases {
-            assert_eq!(tick_label(v), label, "{v}");
-        }
-    }
-
-    #[test]
-    fn step_path_goes_along_then_down() {
-        assert_eq!(
-            step_path(&[(2.0, 0.5), (1.0, 1.0), (4.0, 0.1)]),
-            [(1.0, 1.0), (2.0, 1.0), (2.0, 0.5), (4.0, 0.5), (4.0, 0.1)]
-        );
-    }
-
-    #[test]
-    fn labels_stay_inside_the_plot_and_apart() {
-        let plot = Rect::sized(100, 50, 400, 300);
-        // Spread points, one in a corner: each label touches its own point's
-        // neighbourhood and no other label or point.
-        let spread = [(110, 55), (300, 200), (340, 200), (495, 345)];
-        let spots = place_labels(&spread, &[(14, 12); 4], plot);
-        for (spot, &p) in spots.iter().zip(&spread) {
-            assert!(plot.contains(spot), "{spot:?}");
-            assert!(
-                Rect::around(p, POINT_RADIUS + 4).overlaps(spot),
-                "{spot:?} far from {p:?}"
-            );
-            for &q in &spread {
-                assert!(!Rect::around(q, POINT_RADIUS).overlaps(spot));
-            }
-        }
-        // A pile of 24 points on one pixel: every label still inside, none on another.
-        let pile = [(300, 200); 24];
-        let spots = place_labels(&pile, &[(14, 12); 24], plot);
-        for (i, a) in spots.iter().enumerate() {
-            assert!(plot.contains(a));
-            assert!(!spots[i + 1..].iter().any(|b| b.overlaps(a)), "{a:?}");
-        }
+    fn labels_drop_the_settings_note() {
+        let r = row("adaptive", "noise 0.04 (at most 16 spp)", 1.0, 1.0, 0.1);
+        assert_eq!(label_text(&r), "adaptive noise 0.04");
+        let r = row("hit_threshold", "0.125", 1.0, 1.0, 0.1);
+        assert_eq!(label_text(&r), "hit_threshold 0.125");
     }
 
     fn row(knob: &'static str, setting: &str, seconds: f64, depth: f64, rmse: f64) -> Measurement {
@@ -709,7 +615,7 @@ mod tests {
             hit_mismatch: 0.0,
             overshoot: 0.0,
             image_rmse: rmse,
-            psnr_db: 0.0,
+            psnr_db: -20.0 * rmse.log10(),
             pareto: false,
         }
     }
@@ -726,8 +632,8 @@ mod tests {
                 "fudge",
                 &format!("0.{i}"),
                 0.004 + 1e-5 * i as f64,
-                33.0,
-                0.16,
+                33.0 - 0.1 * i as f64,
+                0.16 + 0.001 * i as f64,
             ));
         }
         rows.push(row("samples_per_pixel", "16", 0.065, 0.0, 0.0));
@@ -766,7 +672,7 @@ mod tests {
         assert!(!g.plots[0].overlaps(&g.plots[1]));
         for (panel, plot) in g.plots.iter().enumerate() {
             assert!(
-                plot.x1 - plot.x0 > 500 && plot.y1 - plot.y0 > 400,
+                plot.x1 - plot.x0 > 500 && plot.y1 - plot.y0 > 500,
                 "{plot:?}"
             );
             // Every candidate, the zero-error one included; not the reference.
@@ -777,24 +683,54 @@ mod tests {
                     "panel {panel}: {p:?} outside {plot:?}"
                 );
             }
-            for spot in &g.labels[panel] {
+            for (i, (_, spot)) in g.labels[panel].iter().enumerate() {
                 assert!(plot.contains(spot), "panel {panel}: label {spot:?}");
+                assert!(!g.labels[panel][i + 1..]
+                    .iter()
+                    .any(|(_, s)| s.overlaps(spot)));
             }
             assert!(!g.key.overlaps(plot));
         }
         assert!(image.contains(&g.key));
-        assert_eq!(g.key_entries.len(), rows.len() - 1);
-        for (i, e) in g.key_entries.iter().enumerate() {
-            assert!(g.key.contains(e), "{e:?}");
-            assert!(!g.key_entries[i + 1..].iter().any(|f| f.overlaps(e)));
-        }
-        // The overshooting variant is outlined in red in both panels; without it, no red.
+        // The overshooting variant is ringed in red in both panels; without it, no red.
         for plot in &g.plots {
             assert!(flag_pixels(&pixels, plot) > 20);
         }
         let (clean, g) = draw(&sweep(false), "test").unwrap();
         for plot in &g.plots {
             assert_eq!(flag_pixels(&clean, plot), 0);
+        }
+    }
+
+    #[test]
+    fn only_the_front_the_scene_and_the_recommended_are_named() {
+        let rows = sweep(false);
+        let pick = recommended(&rows).expect("nothing is flagged");
+        // The zero-error variant: the best image by far.
+        assert_eq!(rows[pick].knob, "samples_per_pixel");
+        let (_, g) = draw(&rows, "test").unwrap();
+        for (panel, labels) in PANELS.iter().zip(&g.labels) {
+            let on_front = front_of(&rows, panel.error);
+            let mut named: Vec<usize> = labels.iter().map(|&(i, _)| i).collect();
+            named.sort();
+            let expected: Vec<usize> = (0..rows.len())
+                .filter(|&i| on_front[i] || rows[i].knob == "scene" || i == pick)
+                .collect();
+            assert_eq!(named, expected, "{}", panel.title);
+            // Far fewer than the variants: the pile is one front point at most.
+            assert!(named.len() < rows.len() / 2, "{named:?}");
+        }
+    }
+
+    #[test]
+    fn the_key_is_four_lines_whatever_the_variants() {
+        for rows in [sweep(false), sweep(false)[..3].to_vec()] {
+            let (_, g) = draw(&rows, "test").unwrap();
+            assert_eq!(g.key_lines.len(), 4);
+            for (i, line) in g.key_lines.iter().enumerate() {
+                assert!(g.key.contains(line), "{line:?} outside {:?}", g.key);
+                assert!(!g.key_lines[i + 1..].iter().any(|l| l.overlaps(line)));
+            }
         }
     }
 }
