@@ -712,6 +712,12 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
     }
     // After the table, so the reference paragraph above stays as it is.
     out += &format!("\n{}\n", front_rule_text());
+    out += &format!(
+        "\n{} ({}; a red ring marks overshoot on {:.1}% of pixels or more).\n",
+        chart::advice(rows, recommended(rows)),
+        chart::star_rule(),
+        100.0 * OVERSHOOT_FLAG
+    );
     out
 }
 
@@ -928,6 +934,8 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("within 3% of the fastest of them"));
+        // Which setting to use, in words, as the chart's star says.
+        assert!(md.contains("recommended: "), "{md}");
     }
 
     #[test]

@@ -479,8 +479,30 @@ enum KeyMark {
 
 /// The key's lines: the recommendation, then what each mark means.
 fn key_lines(rows: &[Measurement], pick: Option<usize>) -> Vec<Vec<(KeyMark, String)>> {
+    let percent = |share: f64| format!("{}%", tick_label(100.0 * share));
+    vec![
+        vec![(KeyMark::Point(Role::Recommended, false), advice(rows, pick))],
+        vec![(KeyMark::Nothing, star_rule())],
+        vec![
+            (KeyMark::Step, format!("Pareto front, named: the cheapest setting for its error (times within {} are one cost)", percent(TIMING_NOISE - 1.0))),
+            (KeyMark::Point(Role::Dominated, false), "grey: matched or beaten at no more cost (in the table)".into()),
+        ],
+        vec![
+            (KeyMark::Point(Role::Scene, false), "the scene's own settings".into()),
+            (
+                KeyMark::Point(Role::Front, true),
+                format!("red ring: overshoot on {} of pixels or more", percent(OVERSHOOT_FLAG)),
+            ),
+            (KeyMark::Nothing, "errors of 0 drawn at the floor; reference not plotted".into()),
+        ],
+    ]
+}
+
+/// The recommended setting `pick` (`recommended`) against the scene's own,
+/// in words, as the key and the table's report give it.
+pub fn advice(rows: &[Measurement], pick: Option<usize>) -> String {
     let scene = rows.iter().find(|r| r.knob == "scene");
-    let advice = match (pick, scene) {
+    match (pick, scene) {
         (Some(i), Some(s)) if rows[i].knob == "scene" => format!(
             "recommended: the scene's own settings ({:.3} s, PSNR {:.1} dB)",
             s.seconds, s.psnr_db
@@ -495,29 +517,14 @@ fn key_lines(rows: &[Measurement], pick: Option<usize>) -> Vec<Vec<(KeyMark, Str
         ),
         (Some(i), None) => format!("recommended: {}", label_text(&rows[i])),
         (None, _) => "no recommendation: every variant has a red ring".into(),
-    };
-    let percent = |share: f64| format!("{}%", tick_label(100.0 * share));
-    vec![
-        vec![(KeyMark::Point(Role::Recommended, false), advice)],
-        vec![(
-            KeyMark::Nothing,
-            format!(
-                "the star: of the variants without a red ring, the cheapest whose image is within {VISIBLE_PSNR_DB} dB PSNR of the best"
-            ),
-        )],
-        vec![
-            (KeyMark::Step, format!("Pareto front, named: the cheapest setting for its error (times within {} are one cost)", percent(TIMING_NOISE - 1.0))),
-            (KeyMark::Point(Role::Dominated, false), "grey: matched or beaten at no more cost (in the table)".into()),
-        ],
-        vec![
-            (KeyMark::Point(Role::Scene, false), "the scene's own settings".into()),
-            (
-                KeyMark::Point(Role::Front, true),
-                format!("red ring: overshoot on {} of pixels or more", percent(OVERSHOOT_FLAG)),
-            ),
-            (KeyMark::Nothing, "errors of 0 drawn at the floor; reference not plotted".into()),
-        ],
-    ]
+    }
+}
+
+/// How the star is chosen, in words.
+pub fn star_rule() -> String {
+    format!(
+        "the star: of the variants without a red ring, the cheapest whose image is within {VISIBLE_PSNR_DB} dB PSNR of the best"
+    )
 }
 
 /// Draws the key's lines below the panels; returns where each went.
