@@ -142,13 +142,20 @@ fn folder_plans(
     }
     let (parts, job) = Plan::from_folder(target)?;
     let mut parts = formats_asked(target, parts, &s.formats)?;
-    // The whole film unless --frames asks about a part: a folder holding
-    // some of a film's frames is not a finished film.
-    for part in &mut parts {
-        part.range = match &s.frames {
-            Some(frames) => parse_frames(frames, part.timeline.frame_count)?,
-            None => 0..part.timeline.frame_count,
-        };
+    // The film is the format its video is made from, over all its frames
+    // unless --frames asks about a part: a folder holding some of a film's
+    // frames is not a finished film. Other formats count the frames
+    // rendered in them (a few EXRs beside the PNGs).
+    let film = parts
+        .iter()
+        .position(|p| p.formats[0].is_png())
+        .unwrap_or(0);
+    for (i, part) in parts.iter_mut().enumerate() {
+        if let Some(frames) = &s.frames {
+            part.range = parse_frames(frames, part.timeline.frame_count)?;
+        } else if i == film {
+            part.range = 0..part.timeline.frame_count;
+        }
     }
     Ok((parts, Some(job)))
 }
