@@ -79,12 +79,9 @@ fn aim(path: &std::path::Path, target: &str) -> anyhow::Result<()> {
     let text = crate::timeline::read_text(path)?;
     let edited = crate::timeline::edit::set_target(&text, target)
         .map_err(|problem| anyhow::anyhow!("{}: cannot aim: {problem}", path.display()))?;
-    crate::output::atomic::write_atomic(path, |writer, temp| {
-        use std::io::Write as _;
-        writer
-            .write_all(edited.as_bytes())
-            .map_err(|e| crate::error::Error::io(temp, e))
-    })?;
+    // Written only as a timeline render would read.
+    Timeline::parse(&edited, path)?;
+    crate::output::atomic::replace_text(path, &edited)?;
     out!("Aimed: {} now has target: {target}", path.display());
     Ok(())
 }

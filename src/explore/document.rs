@@ -264,11 +264,5 @@ fn checked(text: String, shown: &Path) -> Result<(String, Timeline), String> {
 
 /// `text` written over `path` whole, through a temporary file.
 fn write(path: &Path, text: &str) -> Result<(), String> {
-    crate::output::atomic::write_atomic(path, |writer, temp| {
-        use std::io::Write as _;
-        writer
-            .write_all(text.as_bytes())
-            .map_err(|e| crate::error::Error::io(temp, e))
-    })
-    .map_err(|e| format!("{e:#}"))
+    crate::output::atomic::write_text(path, text).map_err(|e| format!("{e:#}"))
 }

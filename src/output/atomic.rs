@@ -65,6 +65,25 @@ pub fn write_atomic(
     Ok(())
 }
 
+/// `text` written over `path` whole, through a temporary file.
+pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    write_atomic(path, |writer, file| {
+        use std::io::Write as _;
+        writer
+            .write_all(text.as_bytes())
+            .map_err(|e| Error::io(file, e))
+    })
+}
+
+/// `text` written whole over the file `path` names, through any link to
+/// it (the link stays a link), keeping the file's permissions.
+pub fn replace_text(path: &Path, text: &str) -> Result<()> {
+    let real = std::fs::canonicalize(path).map_err(|e| Error::io(path, e))?;
+    let mode = std::fs::metadata(&real).map_err(|e| Error::io(&real, e))?;
+    write_text(&real, text)?;
+    std::fs::set_permissions(&real, mode.permissions()).map_err(|e| Error::io(&real, e))
+}
+
 /// How old a temporary `.partial` file must be to count as left behind by a
 /// killed render. A writer holds one only while encoding a finished frame
 /// (seconds), so anything this old belongs to no live process.
