@@ -91,23 +91,39 @@ fn as_ron(d: &[String; 3]) -> String {
     format!("(\"{}\", \"{}\", \"{}\")", d[0], d[1], d[2])
 }
 
-/// `pick --refine`: re-centres the frame's target and prints it.
+/// Rounds of `--refine` at most: each walks in from a thousandth of the
+/// target's size, so a target moved by one round may meet, on the next
+/// round's way in, a surface the camera would fly through.
+const MAX_ROUNDS: usize = 8;
+
+/// A round that moves the target by less than this share of one of frame
+/// F's pixels has settled it.
+const SETTLED_PIXELS: f64 = 0.5;
+
+/// `pick --refine`: re-centres the frame's target, in rounds until it stays
+/// put (`refine_rounds`), and prints it.
 fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
-    let scene = t.scene_at(args.frame);
-    let refined = crate::render::pick::refine(&scene, size).map_err(|problem| {
-        anyhow::anyhow!(
-            "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
-        )
-    })?;
+    let (refined, rounds, moved) = refine_rounds(t, args, size)?;
     if args.json {
-        out!("{}", serde_json::to_string(&refined)?);
+        #[derive(serde::Serialize)]
+        struct Report<'a> {
+            #[serde(flatten)]
+            refined: &'a crate::render::pick::Refined,
+            rounds: usize,
+            last_move_pixels: f64,
+        }
+        let report = Report {
+            refined: &refined,
+            rounds,
+            last_move_pixels: moved,
+        };
+        out!("{}", serde_json::to_string(&report)?);
         return Ok(());
     }
-    for step in &refined.steps {
+    if moved >= SETTLED_PIXELS {
         out!(
-            "camera {:.3e} away: surface {:+.3e} beyond the target",
-            step.camera_distance,
-            step.beyond_target
+            "note: after {rounds} rounds the target still moves by {moved:.1} pixels a round: \
+             aim at another point, or approach from another side (camera.position)"
         );
     }
     out!(
@@ -119,4 +135,61 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         aim(&args.timeline, &as_ron(&refined.target))?;
     }
     Ok(())
+}
+
+/// Refines the target in rounds, each from the target the last one found,
+/// until a round moves it by less than `SETTLED_PIXELS` of frame F's
+/// pixels, or `MAX_ROUNDS`; returns the last target, the rounds, and the
+/// last round's move in pixels.
+fn refine_rounds(
+    t: &Timeline,
+    args: &PickArgs,
+    size: [u32; 2],
+) -> anyhow::Result<(crate::render::pick::Refined, usize, f64)> {
+    let text = crate::timeline::read_text(&args.timeline)?;
+    let mut scene = t.scene_at(args.frame);
+    let pixel_angle = 2.0 * (scene.camera.fov_degrees.to_radians() / 2.0).tan() / size[1] as f64;
+    let pixel = pixel_angle * scene.camera.relative_position().length();
+    let mut round = 0;
+    loop {
+        round += 1;
+        let refined = crate::render::pick::refine(&scene, size).map_err(|problem| {
+            anyhow::anyhow!(
+                "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
+            )
+        })?;
+        for step in refined.steps.iter().filter(|_| !args.json) {
+            out!(
+                "camera {:.3e} away: surface {:+.3e} beyond the target",
+                step.camera_distance,
+                step.beyond_target
+            );
+        }
+        // A target a track sets cannot be tried again: one round.
+        let Ok(moved) = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)) else {
+            return Ok((refined, round, 0.0));
+        };
+        let next = Timeline::parse(&moved, &args.timeline)?.scene_at(args.frame);
+        let shift = distance(&scene.camera, &next.camera) / pixel;
+        if !args.json {
+            out!(
+                "round {round}: the target moved {shift:.3} pixels of frame {}",
+                args.frame
+            );
+        }
+        if shift < SETTLED_PIXELS || round == MAX_ROUNDS {
+            return Ok((refined, round, shift));
+        }
+        scene = next;
+    }
+}
+
+/// How far apart two cameras' targets are, from their digits where a deep
+/// target has them (f64 would lose the difference).
+fn distance(a: &crate::camera::Camera, b: &crate::camera::Camera) -> f64 {
+    let bits = 64 + crate::exact::MAX_DIGITS * 4;
+    let p = crate::exact::big_point(a.target, a.target_digits.as_ref(), bits);
+    let q = crate::exact::big_point(b.target, b.target_digits.as_ref(), bits);
+    let d = [0, 1, 2].map(|i| (&p[i] - &q[i]).to_f64().value());
+    glam::DVec3::from_array(d).length()
 }

@@ -755,3 +755,21 @@ fn pick_aim_writes_through_a_link_and_keeps_the_files_permissions() {
     let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
     assert_eq!(mode, 0o600);
 }
+
+#[test]
+fn pick_refine_settles_the_target_in_one_command() {
+    // The README's tutorial: a bud picked on the still, refined at the
+    // last frame. One round moves the target far along the view, where
+    // the next walk in meets another surface: the command goes round
+    // until the target stays put, so a second refine finds nothing to do.
+    let d = Dir::new();
+    let zoom = std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/timelines/zoom.ron"));
+    d.write("z.ron", &zoom.unwrap());
+    d.ok(&["pick", "z.ron", "--pixel", "100,60", "--aim"]);
+    let first = stdout(&d.ok(&["pick", "z.ron", "--frame", "119", "--refine", "--aim"]));
+    assert!(first.contains("round 2:"), "{first}");
+    let again = stdout(&d.ok(&["pick", "z.ron", "--frame", "119", "--refine", "--json"]));
+    let v: serde_json::Value = serde_json::from_str(&again).unwrap();
+    assert_eq!(v["rounds"], 1, "{v}");
+    assert!(v["last_move_pixels"].as_f64().unwrap() < 0.5, "{v}");
+}
