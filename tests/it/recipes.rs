@@ -12,7 +12,7 @@
 //! block after a `<!-- recipe: not run: REASON -->` line, which must say
 //! why and where it is run instead.
 
-use crate::util::{stderr, stdout, tool};
+use crate::util::tool;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
@@ -75,25 +75,35 @@ fn script(block: &str) -> String {
         .join("\n")
 }
 
-/// One command line as the test runs it (see the module's comment).
+/// One command line as the test runs it (see the module's comment). A
+/// `mandelreel` line must be one plain command, so that what is changed
+/// is that command's size and nothing else.
 fn rewrite(line: &str) -> String {
-    let (command, comment) = match line.find(" #") {
+    let line = line.replacen("cargo run --release --", "mandelreel", 1);
+    let (command, _comment) = match line.find(" #") {
         Some(at) => line.split_at(at),
-        None => (line, ""),
+        None => (line.as_str(), ""),
     };
-    let command = command
-        .trim_start()
-        .replacen("cargo run --release --", "mandelreel", 1);
     let mut words: Vec<String> = command.split_whitespace().map(String::from).collect();
     match words.first().map(String::as_str) {
         Some("cargo") => return format!(": not run here: {}", command.trim()),
         Some("ffplay") => {
             let file = words.last().cloned().unwrap_or_default();
-            return format!("test -s {file} # {command}");
+            return format!("test -s {file} # {}", command.trim());
         }
         Some("mandelreel") => {}
-        _ => return format!("{command}{comment}"),
+        _ => {
+            assert!(
+                !words.iter().skip(1).any(|w| w == "mandelreel"),
+                "{line:?}: start the line with mandelreel, so its size can be set"
+            );
+            return line;
+        }
     }
+    assert!(
+        !command.contains(['|', ';', '&', '\'', '"', '`', '$', '<', '>']),
+        "{line:?}: a mandelreel line in a recipe is one plain command"
+    );
     let timeline = words.get(2).is_some_and(|w| w.ends_with(".ron"));
     let sized = match words.get(1).map(String::as_str) {
         _ if words.iter().any(|w| w == "--help") => false,
@@ -135,8 +145,10 @@ fn workspace(repo: &Path) -> tempfile::TempDir {
 }
 
 /// Runs `script` in `dir` with the test build first on PATH; the output,
-/// or what went wrong.
+/// or what went wrong. Its output is read as it comes (a full pipe would
+/// stall it), and a block past `BLOCK_LIMIT` is killed with all it started.
 fn run(dir: &Path, script: &str) -> Result<String, String> {
+    use std::os::unix::process::CommandExt as _;
     let path = format!(
         "{}:{}",
         dir.join(".bin").display(),
@@ -146,22 +158,40 @@ fn run(dir: &Path, script: &str) -> Result<String, String> {
         .args(["-euo", "pipefail", "-c", script])
         .current_dir(dir)
         .env("PATH", path)
+        .stdin(std::process::Stdio::null())
         .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::piped())
+        .process_group(0)
         .spawn()
         .expect("run bash");
+    let read = |pipe: Option<Box<dyn std::io::Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut text = Vec::new();
+            if let Some(mut pipe) = pipe {
+                let _ = pipe.read_to_end(&mut text);
+            }
+            String::from_utf8_lossy(&text).into_owned()
+        })
+    };
+    let out = read(child.stdout.take().map(|p| Box::new(p) as _));
+    let err = read(child.stderr.take().map(|p| Box::new(p) as _));
     let started = Instant::now();
-    while child.try_wait().expect("wait for bash").is_none() {
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait for bash") {
+            break status;
+        }
         if started.elapsed() > BLOCK_LIMIT {
-            let _ = child.kill();
+            let group = nix::unistd::Pid::from_raw(child.id() as i32);
+            let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+            let _ = child.wait();
             return Err(format!("still running after {BLOCK_LIMIT:?}"));
         }
         std::thread::sleep(Duration::from_millis(50));
-    }
-    let out = child.wait_with_output().expect("bash's output");
-    match out.status.success() {
-        true => Ok(stdout(&out)),
-        false => Err(format!("{}\n{}", tail(&stdout(&out)), tail(&stderr(&out)))),
+    };
+    let (out, err) = (out.join().expect("stdout"), err.join().expect("stderr"));
+    match status.success() {
+        true => Ok(out),
+        false => Err(format!("{}\n{}", tail(&out), tail(&err))),
     }
 }
 
@@ -259,6 +289,7 @@ fn commands_are_rewritten_to_small_sizes_and_nothing_else() {
         "mandelreel pick z.ron --pixel 100,60 --aim"
     );
     assert!(rewrite("cargo test").starts_with(": not run here"));
+    assert_eq!(rewrite("  ls out | wc -l"), "  ls out | wc -l");
     assert_eq!(
         rewrite("ffplay -loop 0 a.mp4"),
         "test -s a.mp4 # ffplay -loop 0 a.mp4"
@@ -274,4 +305,33 @@ fn a_block_is_skipped_only_with_a_reason() {
     assert_eq!(found[0].skipped.as_deref(), Some("run by .ci/slurm-test"));
     assert_eq!(found[1].skipped, None);
     assert_eq!(found[1].line, 6);
+}
+
+#[test]
+#[should_panic(expected = "one plain command")]
+fn a_mandelreel_line_with_a_pipe_is_refused() {
+    rewrite("mandelreel render t.ron | tee log");
+}
+
+#[test]
+#[should_panic(expected = "start the line with mandelreel")]
+fn a_mandelreel_command_later_in_a_line_is_refused() {
+    rewrite("time mandelreel render t.ron");
+}
+
+#[test]
+fn a_block_that_fails_or_talks_a_lot_is_told_apart() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir(dir.path().join(".bin")).unwrap();
+    // More than a pipe holds, then success: not a hang.
+    let chatty = run(
+        dir.path(),
+        "head -c 300000 /dev/zero | tr '\\0' x; echo; echo done >&2",
+    );
+    assert!(chatty.is_ok_and(|out| out.len() > 300000));
+    let failed = run(dir.path(), "echo one; false; echo two").unwrap_err();
+    assert!(
+        failed.contains("one") && !failed.contains("two"),
+        "{failed}"
+    );
 }
