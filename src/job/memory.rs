@@ -29,8 +29,9 @@ impl Plan {
         }
         let gib = |bytes: u64| bytes as f64 / (1u64 << 30) as f64;
         let message = format!(
-            "{w}x{h} needs about {:.1} GiB for a frame's buffers, and {whose} {:.1} GiB \
+            "{} needs about {:.1} GiB for a frame's buffers, and {whose} {:.1} GiB \
              to give: render it smaller, or with more memory",
+            self.size_told(size_given),
             gib(need),
             gib(have)
         );
@@ -40,6 +41,20 @@ impl Plan {
             false => self.timeline.field_error("size", message),
         }
         .into())
+    }
+
+    /// The size measured, as the user knows it: a size --preview halved
+    /// is not the one they wrote, so the message says both.
+    fn size_told(&self, size_given: bool) -> String {
+        let (w, h) = (self.width, self.height);
+        match (self.preview, size_given) {
+            (false, _) => format!("{w}x{h}"),
+            (true, true) => format!("halved by --preview to {w}x{h},"),
+            (true, false) => {
+                let (file_w, file_h) = (self.timeline.width, self.timeline.height);
+                format!("{file_w}x{file_h}, halved by --preview to {w}x{h},")
+            }
+        }
     }
 }
 

@@ -169,8 +169,8 @@ fn token(text: &str, levels: &mut Vec<Level>, at: usize) -> usize {
     end
 }
 
-/// Where the token at `at` ends, and a string's contents if it is one
-/// (escapes kept as written: a key with none reads back as written).
+/// Where the token at `at` ends, and a string's contents if it is one:
+/// as RON reads them, so a key is named as in a file that is RON.
 fn token_end(text: &str, at: usize) -> (usize, Option<String>) {
     let rest = &text[at..];
     let quote = |c: char| rest.starts_with(c);
@@ -179,14 +179,14 @@ fn token_end(text: &str, at: usize) -> (usize, Option<String>) {
         let mut escaped = false;
         for (i, c) in rest.char_indices().skip(1) {
             if c == close && !escaped {
-                return (at + i + 1, Some(rest[1..i].to_string()));
+                return (at + i + 1, Some(unescaped(&rest[..=i])));
             }
             escaped = c == '\\' && !escaped;
         }
         return (text.len(), None);
     }
     if let Some(raw) = raw_string_end(rest) {
-        return (at + raw, None);
+        return (at + raw, Some(unescaped(&rest[..raw])));
     }
     // Numbers, names and `inf`; any other character is a token of its own.
     let word = |c: char| c.is_alphanumeric() || "_.+-".contains(c);
@@ -195,6 +195,19 @@ fn token_end(text: &str, at: usize) -> (usize, Option<String>) {
         at + end.max(rest.chars().next().map_or(1, char::len_utf8)),
         None,
     )
+}
+
+/// The contents of the string literal `literal`, escapes read by RON
+/// itself; one RON cannot read (a bad escape, a char) as written inside
+/// its quotes.
+fn unescaped(literal: &str) -> String {
+    ron::from_str::<String>(literal).unwrap_or_else(|_| {
+        let inside = literal.trim_start_matches('r').trim_matches('#');
+        inside
+            .get(1..inside.len().saturating_sub(1))
+            .unwrap_or(inside)
+            .to_string()
+    })
 }
 
 /// The length of the raw string `r#"…"#` that `rest` starts with.
@@ -270,5 +283,25 @@ mod tests {
         // Comments and strings hold no brackets.
         let text = "(a: /* ( */ \"// (\", // (\n b: 1.2.3)";
         assert_eq!(at(text, 2, 5), named("b", 2, 5));
+    }
+
+    #[test]
+    fn a_keys_escapes_are_read_as_ron_reads_them() {
+        for (key, read) in [
+            (r#""fractal.\"power""#, "fractal.\"power"),
+            (r#""fractal.\u{70}ower""#, "fractal.power"),
+            (r#""a\\b\n\t\x41""#, "a\\b\n\tA"),
+            (r##"r#"a"b"#"##, "a\"b"),
+        ] {
+            let text = format!("(tracks: {{ {key}: (keys: [1.2.3]) }})");
+            let column = text.find("1.2").expect("the broken value is there") + 1;
+            let path = spans::path_of(&[
+                Step::Field("tracks".into()),
+                Step::Key(read.into()),
+                Step::Field("keys".into()),
+                Step::Index(0),
+            ]);
+            assert_eq!(at(&text, 1, column), named(&path, 1, column), "{key}");
+        }
     }
 }

@@ -397,6 +397,19 @@ fn a_value_ron_cannot_read_is_named_by_its_field_at_its_first_character() {
 }
 
 #[test]
+fn an_escaped_key_is_named_alike_in_a_file_ron_reads_and_one_it_cannot() {
+    for key in [r#""fractal.\"power""#, r#""fractal.\u{70}ower""#] {
+        // A value of the wrong type (RON) and one RON cannot read.
+        let track = |value: &str| format!("{key}: (keys: [(time: 0, value: {value})])");
+        let read = error_of(&with_track(&track("\"x\"")));
+        let broken = error_of(&with_track(&track("1.2.3")));
+        let path = |e: &str| e.split("`").nth(1).map(str::to_string);
+        assert!(path(&read).is_some(), "{read}");
+        assert_eq!(path(&read), path(&broken), "{read}\n{broken}");
+    }
+}
+
+#[test]
 fn deep_nesting_names_the_field_its_shallow_cousin_names() {
     let deep = |open: &str, close: &str, depth: usize, inner: &str| {
         format!(

@@ -119,6 +119,39 @@ fn values_that_would_draw_a_surface_where_there_is_none_are_refused() {
     );
 }
 
+/// `mandelreel render {args}` in `d` under a 2 GB address-space limit.
+fn render_in_2gb(d: &Dir, args: &str) -> std::process::Output {
+    std::process::Command::new("sh")
+        .current_dir(d.path())
+        .arg("-c")
+        .arg(format!("ulimit -v 2000000 && exec \"$0\" render {args}"))
+        .arg(env!("CARGO_BIN_EXE_mandelreel"))
+        .output()
+        .unwrap()
+}
+
+/// Renders `args` under that limit and expects it refused with `code`
+/// for want of memory, before any output folder; returns the message.
+fn refused_in_2gb(d: &Dir, args: &str, code: i32) -> String {
+    let out = render_in_2gb(d, args);
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(code), "{err}");
+    assert!(err.contains("this process may map"), "{err}");
+    assert!(!d.path().join("out").exists());
+    err
+}
+
+/// A folder with a tiny timeline of `size` in `name`, where this system
+/// tells a process's address-space limit (only Linux does).
+fn sized_where_limits_are_told(name: &str, size: &str) -> Option<Dir> {
+    std::path::Path::new("/proc/self/limits").exists().then(|| {
+        let d = Dir::new();
+        let text = tiny_timeline(1, 6.0).replace("size: (48, 27)", &format!("size: {size}"));
+        d.write(name, &text);
+        d
+    })
+}
+
 #[test]
 fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
     // Under a 2 GB address-space limit a 10000×10000 PNG frame (about
@@ -129,17 +162,7 @@ fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
     }
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(1, 6.0));
-    let limited = |size: &str| {
-        std::process::Command::new("sh")
-            .current_dir(d.path())
-            .arg("-c")
-            .arg(format!(
-                "ulimit -v 2000000 && exec \"$0\" render t.ron --size {size} --out o{size} -q"
-            ))
-            .arg(env!("CARGO_BIN_EXE_mandelreel"))
-            .output()
-            .unwrap()
-    };
+    let limited = |size: &str| render_in_2gb(&d, &format!("t.ron --size {size} --out o{size} -q"));
     let out = limited("10000x10000");
     let err = stderr(&out);
     assert_eq!(out.status.code(), Some(2), "{err}");
@@ -154,27 +177,31 @@ fn a_size_past_the_memory_to_hand_is_refused_before_anything_is_written() {
 fn a_timelines_own_size_past_the_memory_to_hand_is_an_invalid_timeline() {
     // The size written in the timeline, not given on the command line:
     // the timeline is at fault (exit 3), at its line, and nothing is made.
-    if !std::path::Path::new("/proc/self/limits").exists() {
-        return; // only Linux tells the limit
-    }
-    let d = Dir::new();
-    let text = tiny_timeline(1, 6.0).replace("size: (48, 27)", "size: (10000, 10000)");
-    d.write("t.ron", &text);
-    let out = std::process::Command::new("sh")
-        .current_dir(d.path())
-        .arg("-c")
-        .arg("ulimit -v 2000000 && exec \"$0\" render t.ron -q")
-        .arg(env!("CARGO_BIN_EXE_mandelreel"))
-        .output()
-        .unwrap();
-    let err = stderr(&out);
-    assert_eq!(out.status.code(), Some(3), "{err}");
+    let Some(d) = sized_where_limits_are_told("t.ron", "(10000, 10000)") else {
+        return;
+    };
+    let err = refused_in_2gb(&d, "t.ron -q", 3);
     assert!(
         err.contains("t.ron:4:11: size: 10000x10000 needs about"),
         "{err}"
     );
-    assert!(err.contains("this process may map"), "{err}");
-    assert!(!d.path().join("out").exists());
+}
+
+#[test]
+fn a_size_halved_by_preview_past_the_memory_to_hand_says_so() {
+    // --preview halves the size: the message names the size as written,
+    // in the file (exit 3, at its line) or on the command line (exit 2),
+    // and the halved size that was measured against the memory.
+    let Some(d) = sized_where_limits_are_told("big.ron", "(30000, 30000)") else {
+        return;
+    };
+    d.write("t.ron", &tiny_timeline(1, 6.0));
+    let err = refused_in_2gb(&d, "big.ron --preview -q", 3);
+    let said = "big.ron:4:11: size: 30000x30000, halved by --preview to 15000x15000, needs about";
+    assert!(err.contains(said), "{err}");
+    let err = refused_in_2gb(&d, "t.ron --size 30000x30000 --preview -q", 2);
+    let said = "--size: halved by --preview to 15000x15000, needs about";
+    assert!(err.contains(said), "{err}");
 }
 
 #[test]
