@@ -122,7 +122,7 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
     }
     if moved >= SETTLED_PIXELS {
         out!(
-            "note: after {rounds} rounds the target still moves by {moved:.1} pixels a round: \
+            "note: after {rounds} round(s) the target still moves by {moved:.1} pixels a round: \
              aim at another point, or approach from another side (camera.position)"
         );
     }
@@ -150,14 +150,14 @@ fn refine_rounds(
     let mut scene = t.scene_at(args.frame);
     let pixel_angle = 2.0 * (scene.camera.fov_degrees.to_radians() / 2.0).tan() / size[1] as f64;
     let pixel = pixel_angle * scene.camera.relative_position().length();
-    let mut round = 0;
-    loop {
-        round += 1;
-        let refined = crate::render::pick::refine(&scene, size).map_err(|problem| {
-            anyhow::anyhow!(
-                "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
-            )
-        })?;
+    let mut last: Option<(crate::render::pick::Refined, usize, f64)> = None;
+    for round in 1..=MAX_ROUNDS {
+        let refined = match crate::render::pick::refine(&scene, size) {
+            Ok(refined) => refined,
+            // A later round's failure leaves the last round's target,
+            // which is what one round gives; say why it stopped.
+            Err(problem) => return stopped(last, round, &problem, args.json),
+        };
         for step in refined.steps.iter().filter(|_| !args.json) {
             out!(
                 "camera {:.3e} away: surface {:+.3e} beyond the target",
@@ -177,11 +177,35 @@ fn refine_rounds(
                 args.frame
             );
         }
-        if shift < SETTLED_PIXELS || round == MAX_ROUNDS {
+        if shift < SETTLED_PIXELS {
             return Ok((refined, round, shift));
         }
+        last = Some((refined, round, shift));
         scene = next;
     }
+    last.ok_or_else(|| anyhow::anyhow!("--refine ran no round"))
+}
+
+/// Where round `round` of `--refine` failed with `problem`: the last
+/// round's result, with a note, or the error where there is none.
+fn stopped(
+    last: Option<(crate::render::pick::Refined, usize, f64)>,
+    round: usize,
+    problem: &str,
+    json: bool,
+) -> anyhow::Result<(crate::render::pick::Refined, usize, f64)> {
+    let Some(last) = last else {
+        anyhow::bail!(
+            "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
+        );
+    };
+    if !json {
+        out!(
+            "note: round {round} stopped: {problem}; the target below is round {}'s",
+            last.1
+        );
+    }
+    Ok(last)
 }
 
 /// How far apart two cameras' targets are, from their digits where a deep

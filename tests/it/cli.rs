@@ -773,3 +773,27 @@ fn pick_refine_settles_the_target_in_one_command() {
     assert_eq!(v["rounds"], 1, "{v}");
     assert!(v["last_move_pixels"].as_f64().unwrap() < 0.5, "{v}");
 }
+
+#[test]
+fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
+    // deep_zoom.ron's last frame: the second round finds the camera inside
+    // the set; the command still gives the first round's target, and says so.
+    let d = Dir::new();
+    let deep = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/timelines/deep_zoom.ron"
+    ));
+    d.write("deep.ron", &deep.unwrap());
+    let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "71", "--refine"]));
+    assert!(
+        out.contains("Re-centred for frame 71:  target: (\""),
+        "{out}"
+    );
+    let stopped = out
+        .lines()
+        .any(|l| l.starts_with("note: round ") && l.contains("stopped"));
+    let settled = out
+        .lines()
+        .any(|l| l.starts_with("round ") && !l.contains("note"));
+    assert!(stopped || settled, "{out}");
+}
