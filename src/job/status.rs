@@ -53,27 +53,39 @@ pub fn scan(
     verify: bool,
 ) -> anyhow::Result<Scan> {
     // One plan per format, and the folder's record: read once.
-    let (parts, job) = if target.is_dir() {
+    let (parts, job, film) = if target.is_dir() {
         folder_plans(target, sequence)?
     } else {
         let plan = Plan::new(target, sequence)?;
         let job = crate::job::record::JobRecord::read(&plan.out_dir).ok();
-        (plan.per_format(), job)
+        (plan.per_format(), job, None)
     };
     let parts: Vec<Plan> = parts
         .into_iter()
         .map(|part| Plan { verify, ..part })
         .collect();
-    let Some(first) = parts.first() else {
+    // A folder's film alone decides whether it is complete; a timeline's
+    // formats all do, as its options name them.
+    let counted: Vec<bool> = (0..parts.len())
+        .map(|i| film.is_none_or(|f| f == i))
+        .collect();
+    let counted_parts: Vec<&Plan> = (parts.iter().zip(&counted))
+        .filter_map(|(p, c)| c.then_some(p))
+        .collect();
+    let Some(first) = counted_parts.first() else {
         let message = format!("{} records no output format", crate::job::record::JOB_FILE);
         return Err(Error::usage(&target.display().to_string(), message).into());
     };
     let plan = Plan {
-        range: parts.iter().map(|p| p.range.start).min().unwrap_or(0)
-            ..parts.iter().map(|p| p.range.end).max().unwrap_or(0),
-        ..first.clone()
+        range: counted_parts
+            .iter()
+            .map(|p| p.range.start)
+            .min()
+            .unwrap_or(0)
+            ..counted_parts.iter().map(|p| p.range.end).max().unwrap_or(0),
+        ..(*first).clone()
     };
-    let (by_state, by_format, workers) = frame_states(&plan, &parts, claim_timeout);
+    let (by_state, by_format, workers) = frame_states(&plan, &parts, &counted, claim_timeout);
     let total: usize = by_state.values().map(Vec::len).sum();
     let complete = by_state.get(&FrameState::Complete).map_or(0, Vec::len);
     // A folder last rendered from another timeline file (with --force).
@@ -119,7 +131,11 @@ fn renamed(job: &crate::job::record::JobRecord, parts: &[Plan]) -> Vec<(String, 
 fn folder_plans(
     target: &Path,
     s: &Sequence,
-) -> anyhow::Result<(Vec<Plan>, Option<crate::job::record::JobRecord>)> {
+) -> anyhow::Result<(
+    Vec<Plan>,
+    Option<crate::job::record::JobRecord>,
+    Option<usize>,
+)> {
     let given = [
         ("--out", s.out.is_some()),
         ("--size", s.size.is_some()),
@@ -144,20 +160,25 @@ fn folder_plans(
     let mut parts = formats_asked(target, parts, &s.formats)?;
     // The film is the format its video is made from, over all its frames
     // unless --frames asks about a part: a folder holding some of a film's
-    // frames is not a finished film. Other formats count the frames
-    // rendered in them (a few EXRs beside the PNGs).
+    // frames is not a finished film. Other formats keep the span rendered
+    // in them (a few EXRs beside the PNGs), within --frames where given,
+    // and are reported on their own lines.
     let film = parts
         .iter()
         .position(|p| p.formats[0].is_png())
         .unwrap_or(0);
     for (i, part) in parts.iter_mut().enumerate() {
-        if let Some(frames) = &s.frames {
-            part.range = parse_frames(frames, part.timeline.frame_count)?;
-        } else if i == film {
-            part.range = 0..part.timeline.frame_count;
-        }
+        let asked = match &s.frames {
+            Some(frames) => parse_frames(frames, part.timeline.frame_count)?,
+            None => 0..part.timeline.frame_count,
+        };
+        part.range = match i == film {
+            true => asked,
+            false => part.range.start.max(asked.start)..part.range.end.min(asked.end),
+        };
+        part.range.end = part.range.end.max(part.range.start);
     }
-    Ok((parts, Some(job)))
+    Ok((parts, Some(job), Some(film)))
 }
 
 /// The parts of `parts` in the formats `asked` (all where none is), or
@@ -183,6 +204,7 @@ fn formats_asked(target: &Path, parts: Vec<Plan>, asked: &[Format]) -> anyhow::R
 fn frame_states(
     plan: &Plan,
     parts: &[Plan],
+    counted: &[bool],
     claim_timeout: Duration,
 ) -> (ByState, Vec<ByState>, BTreeSet<String>) {
     // Fresh temporary files, by frame: a writer is finishing that frame
@@ -199,12 +221,13 @@ fn frame_states(
         .collect();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
-        for ((part, by_state), writing) in parts.iter().zip(&mut by_format).zip(&writing) {
+        let each = parts.iter().zip(&mut by_format).zip(&writing).zip(counted);
+        for (((part, by_state), writing), &counted) in each {
             if part.range.contains(&frame) {
                 let (state, worker) = frame_state(part, frame, writing, claim_timeout);
                 workers.extend(worker);
                 by_state.entry(state).or_insert_with(Vec::new).push(frame);
-                states.push(state);
+                states.extend(Some(state).filter(|_| counted));
             }
         }
         // A frame in a gap between formats' ranges is no format's to hold.

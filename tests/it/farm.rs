@@ -210,7 +210,7 @@ fn status_of_a_folder_refuses_what_the_folder_records() {
 fn status_of_a_folder_reports_each_format_it_holds() {
     // A few EXR frames, with their own samples, rendered into a folder of
     // complete PNGs: the film (the PNGs the video is made from) counts
-    // over all its frames, the EXRs over those rendered, each on its line.
+    // over all its frames; the EXRs show their span on a line of their own.
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(6, 6.0));
     d.ok(&["render", "t.ron", "--quiet"]);
@@ -234,12 +234,21 @@ fn status_of_a_folder_reports_each_format_it_holds() {
     let out = d.run(&["status", "out/t", "--format", "png16"]);
     assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
     says(&out, "holds no png16 frames");
+    // An EXR missing from its span shows on its line; the film decides
+    // the exit status, so a script waiting on it stops once the PNGs are done.
     std::fs::remove_file(d.path().join("out/t/frame_00001.exr")).unwrap();
     let (code, v) = d.status_json(&["out/t"]);
-    assert_eq!(code, Some(4), "{v}");
-    assert_eq!(v["states"]["missing"], serde_json::json!([1]), "{v}");
+    assert_eq!(code, Some(0), "{v}");
+    assert_eq!(
+        v["formats"]["exr"]["states"]["missing"],
+        serde_json::json!([1])
+    );
     assert_eq!(v["formats"]["png"]["complete"], 6, "{v}");
     assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([0, 3]));
+    // --frames narrows the EXRs' span, never widens it.
+    let (code, v) = d.status_json(&["out/t", "--frames", "2..5"]);
+    assert_eq!(code, Some(0), "{v}");
+    assert_eq!(v["formats"]["exr"]["frames"], serde_json::json!([2, 3]));
     // The PNGs short of the film: not complete, whatever the EXRs hold.
     std::fs::remove_file(d.path().join("out/t/frame_00005.png")).unwrap();
     let (code, v) = d.status_json(&["out/t"]);
