@@ -103,27 +103,31 @@ const SETTLED_PIXELS: f64 = 0.5;
 /// `pick --refine`: re-centres the frame's target, in rounds until it stays
 /// put (`refine_rounds`), and prints it.
 fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
-    let (refined, rounds, moved) = refine_rounds(t, args, size)?;
+    let Round {
+        refined,
+        round,
+        moved,
+    } = refine_rounds(t, args, size)?;
     if args.json {
         #[derive(serde::Serialize)]
         struct Report<'a> {
             #[serde(flatten)]
             refined: &'a crate::render::pick::Refined,
-            rounds: usize,
-            last_move_pixels: f64,
+            round: usize,
+            move_pixels: Option<f64>,
         }
         let report = Report {
             refined: &refined,
-            rounds,
-            last_move_pixels: moved,
+            round,
+            move_pixels: moved,
         };
         out!("{}", serde_json::to_string(&report)?);
         return Ok(());
     }
-    if moved >= SETTLED_PIXELS {
+    if let Some(moved) = moved.filter(|&m| m >= SETTLED_PIXELS) {
         out!(
-            "note: after {rounds} round(s) the target still moves by {moved:.1} pixels a round: \
-             aim at another point, or approach from another side (camera.position)"
+            "note: the target did not settle; this is round {round}'s, which moved it {moved:.1} \
+             pixels: aim at another point, or approach from another side (camera.position)"
         );
     }
     out!(
@@ -137,26 +141,31 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// One round of `--refine`: its target, its number, and how far it moved
+/// the target, in frame F's pixels (none where a track sets the target).
+struct Round {
+    refined: crate::render::pick::Refined,
+    round: usize,
+    moved: Option<f64>,
+}
+
 /// Refines the target in rounds, each from the target the last one found,
 /// until a round moves it by less than `SETTLED_PIXELS` of frame F's
-/// pixels, or `MAX_ROUNDS`; returns the last target, the rounds, and the
-/// last round's move in pixels.
-fn refine_rounds(
-    t: &Timeline,
-    args: &PickArgs,
-    size: [u32; 2],
-) -> anyhow::Result<(crate::render::pick::Refined, usize, f64)> {
+/// pixels, a round moves it further than the one before (the rounds
+/// diverge), or `MAX_ROUNDS`; returns the round that moved it least.
+fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<Round> {
     let text = crate::timeline::read_text(&args.timeline)?;
     let mut scene = t.scene_at(args.frame);
     let pixel_angle = 2.0 * (scene.camera.fov_degrees.to_radians() / 2.0).tan() / size[1] as f64;
     let pixel = pixel_angle * scene.camera.relative_position().length();
-    let mut last: Option<(crate::render::pick::Refined, usize, f64)> = None;
+    let mut best: Option<Round> = None;
+    let mut previous = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {
         let refined = match crate::render::pick::refine(&scene, size) {
             Ok(refined) => refined,
-            // A later round's failure leaves the last round's target,
-            // which is what one round gives; say why it stopped.
-            Err(problem) => return stopped(last, round, &problem, args.json),
+            // A later round's failure leaves the best round's target,
+            // which is never worse than one round's; say why it stopped.
+            Err(problem) => return stopped(best, round, &problem, args.json),
         };
         for step in refined.steps.iter().filter(|_| !args.json) {
             out!(
@@ -167,7 +176,12 @@ fn refine_rounds(
         }
         // A target a track sets cannot be tried again: one round.
         let Ok(moved) = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)) else {
-            return Ok((refined, round, 0.0));
+            let moved = None;
+            return Ok(Round {
+                refined,
+                round,
+                moved,
+            });
         };
         let next = Timeline::parse(&moved, &args.timeline)?.scene_at(args.frame);
         let shift = distance(&scene.camera, &next.camera) / pixel;
@@ -177,24 +191,30 @@ fn refine_rounds(
                 args.frame
             );
         }
-        if shift < SETTLED_PIXELS {
-            return Ok((refined, round, shift));
+        let done = shift < SETTLED_PIXELS || shift > previous;
+        if best
+            .as_ref()
+            .is_none_or(|b| b.moved.is_some_and(|m| shift < m))
+        {
+            let moved = Some(shift);
+            best = Some(Round {
+                refined,
+                round,
+                moved,
+            });
         }
-        last = Some((refined, round, shift));
-        scene = next;
+        if done {
+            break;
+        }
+        (previous, scene) = (shift, next);
     }
-    last.ok_or_else(|| anyhow::anyhow!("--refine ran no round"))
+    best.ok_or_else(|| anyhow::anyhow!("--refine ran no round"))
 }
 
-/// Where round `round` of `--refine` failed with `problem`: the last
+/// Where round `round` of `--refine` failed with `problem`: the best
 /// round's result, with a note, or the error where there is none.
-fn stopped(
-    last: Option<(crate::render::pick::Refined, usize, f64)>,
-    round: usize,
-    problem: &str,
-    json: bool,
-) -> anyhow::Result<(crate::render::pick::Refined, usize, f64)> {
-    let Some(last) = last else {
+fn stopped(best: Option<Round>, round: usize, problem: &str, json: bool) -> anyhow::Result<Round> {
+    let Some(best) = best else {
         anyhow::bail!(
             "{problem}: pick a target on the surface first (pick --pixel), or approach it from outside (camera.position)"
         );
@@ -202,10 +222,10 @@ fn stopped(
     if !json {
         out!(
             "note: round {round} stopped: {problem}; the target below is round {}'s",
-            last.1
+            best.round
         );
     }
-    Ok(last)
+    Ok(best)
 }
 
 /// How far apart two cameras' targets are, from their digits where a deep

@@ -770,8 +770,8 @@ fn pick_refine_settles_the_target_in_one_command() {
     assert!(first.contains("round 2:"), "{first}");
     let again = stdout(&d.ok(&["pick", "z.ron", "--frame", "119", "--refine", "--json"]));
     let v: serde_json::Value = serde_json::from_str(&again).unwrap();
-    assert_eq!(v["rounds"], 1, "{v}");
-    assert!(v["last_move_pixels"].as_f64().unwrap() < 0.5, "{v}");
+    assert_eq!(v["round"], 1, "{v}");
+    assert!(v["move_pixels"].as_f64().unwrap() < 0.5, "{v}");
 }
 
 #[test]
