@@ -79,9 +79,21 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
 /// it (the link stays a link), keeping the file's permissions.
 pub fn replace_text(path: &Path, text: &str) -> Result<()> {
     let real = std::fs::canonicalize(path).map_err(|e| Error::io(path, e))?;
-    let mode = std::fs::metadata(&real).map_err(|e| Error::io(&real, e))?;
-    write_text(&real, text)?;
-    std::fs::set_permissions(&real, mode.permissions()).map_err(|e| Error::io(&real, e))
+    let mode = std::fs::metadata(&real)
+        .map_err(|e| Error::io(&real, e))?
+        .permissions();
+    // The mode is set before the rename: the text is never more readable
+    // than the file it replaces.
+    write_atomic(&real, |writer, file| {
+        use std::io::Write as _;
+        writer
+            .write_all(text.as_bytes())
+            .map_err(|e| Error::io(file, e))?;
+        writer
+            .get_ref()
+            .set_permissions(mode)
+            .map_err(|e| Error::io(file, e))
+    })
 }
 
 /// How old a temporary `.partial` file must be to count as left behind by a

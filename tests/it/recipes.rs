@@ -176,18 +176,22 @@ fn run(dir: &Path, script: &str) -> Result<String, String> {
     let out = read(child.stdout.take().map(|p| Box::new(p) as _));
     let err = read(child.stderr.take().map(|p| Box::new(p) as _));
     let started = Instant::now();
+    let group = nix::unistd::Pid::from_raw(child.id() as i32);
+    let kill_group = || nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
     let status = loop {
         if let Some(status) = child.try_wait().expect("wait for bash") {
             break status;
         }
         if started.elapsed() > BLOCK_LIMIT {
-            let group = nix::unistd::Pid::from_raw(child.id() as i32);
-            let _ = nix::sys::signal::killpg(group, nix::sys::signal::Signal::SIGKILL);
+            let _ = kill_group();
             let _ = child.wait();
             return Err(format!("still running after {BLOCK_LIMIT:?}"));
         }
         std::thread::sleep(Duration::from_millis(50));
     };
+    // Anything a block left running in the background holds its output
+    // open: it goes with the block.
+    let _ = kill_group();
     let (out, err) = (out.join().expect("stdout"), err.join().expect("stderr"));
     match status.success() {
         true => Ok(out),
@@ -329,6 +333,8 @@ fn a_block_that_fails_or_talks_a_lot_is_told_apart() {
         "head -c 300000 /dev/zero | tr '\\0' x; echo; echo done >&2",
     );
     assert!(chatty.is_ok_and(|out| out.len() > 300000));
+    let background = run(dir.path(), "sleep 600 & echo started");
+    assert!(background.is_ok_and(|out| out.contains("started")));
     let failed = run(dir.path(), "echo one; false; echo two").unwrap_err();
     assert!(
         failed.contains("one") && !failed.contains("two"),
