@@ -53,21 +53,17 @@ pub fn scan(
     verify: bool,
 ) -> anyhow::Result<Scan> {
     // One plan per format, and the folder's record: read once.
-    let (parts, job, film) = if target.is_dir() {
+    let (parts, job, counted) = if target.is_dir() {
         folder_plans(target, sequence)?
     } else {
         let plan = Plan::new(target, sequence)?;
         let job = crate::job::record::JobRecord::read(&plan.out_dir).ok();
-        (plan.per_format(), job, None)
+        let counted = vec![true; plan.formats.len()];
+        (plan.per_format(), job, counted)
     };
     let parts: Vec<Plan> = parts
         .into_iter()
         .map(|part| Plan { verify, ..part })
-        .collect();
-    // A folder's film alone decides whether it is complete; a timeline's
-    // formats all do, as its options name them.
-    let counted: Vec<bool> = (0..parts.len())
-        .map(|i| film.is_none_or(|f| f == i))
         .collect();
     let counted_parts: Vec<&Plan> = (parts.iter().zip(&counted))
         .filter_map(|(p, c)| c.then_some(p))
@@ -131,11 +127,7 @@ fn renamed(job: &crate::job::record::JobRecord, parts: &[Plan]) -> Vec<(String, 
 fn folder_plans(
     target: &Path,
     s: &Sequence,
-) -> anyhow::Result<(
-    Vec<Plan>,
-    Option<crate::job::record::JobRecord>,
-    Option<usize>,
-)> {
+) -> anyhow::Result<(Vec<Plan>, Option<crate::job::record::JobRecord>, Vec<bool>)> {
     let given = [
         ("--out", s.out.is_some()),
         ("--size", s.size.is_some()),
@@ -158,27 +150,31 @@ fn folder_plans(
     }
     let (parts, job) = Plan::from_folder(target)?;
     let mut parts = formats_asked(target, parts, &s.formats)?;
-    // The film is the format its video is made from, over all its frames
-    // unless --frames asks about a part: a folder holding some of a film's
-    // frames is not a finished film. Other formats keep the span rendered
-    // in them (a few EXRs beside the PNGs), within --frames where given,
-    // and are reported on their own lines.
-    let film = parts
+    // The film is the format its video is made from, and every format
+    // rendered over all its frames: these count every frame (a folder
+    // holding some of a film's frames is not a finished film) and decide
+    // whether it is complete. Other formats (a few EXRs beside the PNGs)
+    // keep the span rendered in them and are reported on their own lines.
+    let video = parts
         .iter()
         .position(|p| p.formats[0].is_png())
         .unwrap_or(0);
+    let mut film = Vec::new();
     for (i, part) in parts.iter_mut().enumerate() {
+        let all = 0..part.timeline.frame_count;
+        let whole = i == video || part.range == all;
         let asked = match &s.frames {
             Some(frames) => parse_frames(frames, part.timeline.frame_count)?,
-            None => 0..part.timeline.frame_count,
+            None => all,
         };
-        part.range = match i == film {
+        part.range = match whole {
             true => asked,
             false => part.range.start.max(asked.start)..part.range.end.min(asked.end),
         };
         part.range.end = part.range.end.max(part.range.start);
+        film.push(whole);
     }
-    Ok((parts, Some(job), Some(film)))
+    Ok((parts, Some(job), film))
 }
 
 /// The parts of `parts` in the formats `asked` (all where none is), or

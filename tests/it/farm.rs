@@ -207,6 +207,20 @@ fn status_of_a_folder_refuses_what_the_folder_records() {
 }
 
 #[test]
+fn status_of_a_folder_counts_each_format_rendered_over_the_film() {
+    // PNGs and EXRs of the whole film: both are the film, so an EXR
+    // missing keeps it incomplete.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(4, 6.0));
+    d.ok(&["render", "t.ron", "--format", "png,exr", "--quiet"]);
+    d.ok(&["status", "out/t"]);
+    std::fs::remove_file(d.path().join("out/t/frame_00002.exr")).unwrap();
+    let (code, v) = d.status_json(&["out/t"]);
+    assert_eq!(code, Some(4), "{v}");
+    assert_eq!(v["states"]["missing"], serde_json::json!([2]), "{v}");
+}
+
+#[test]
 fn status_of_a_folder_reports_each_format_it_holds() {
     // A few EXR frames, with their own samples, rendered into a folder of
     // complete PNGs: the film (the PNGs the video is made from) counts
