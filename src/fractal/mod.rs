@@ -10,8 +10,8 @@
 //! 002 (course notes) and 001 (Christensen, "distance estimated 3D fractals",
 //! parts V–VI, which also gives the potential-gradient, sinh and escape-length
 //! estimators and their costs); the y-up convention, the power-8 polynomial
-//! (now only a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The algorithm", "Optimizing",
-//! "Coloring").
+//! (a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The
+//! algorithm", "Optimizing", "Coloring").
 
 use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};

@@ -33,11 +33,11 @@ const SEED: u64 = 21;
 /// to fail the test quickly.
 const DEADLINE: Duration = Duration::from_secs(5);
 
-/// Inputs of the failures known when this test was written, being fixed
-/// on other branches: a frame count or duration that makes validation walk
-/// millions of frames, and an environment map that never ends
-/// (`/dev/zero`, `/dev/urandom`, a FIFO). `true` skips them (see
-/// `known_failure`), to look for other failures while those are open.
+/// Classes of input that once hung or exhausted memory: a frame count or
+/// duration that makes validation walk millions of frames, and an
+/// environment map that never ends (`/dev/zero`, `/dev/urandom`, a FIFO).
+/// `true` skips them (see `known_failure`), to look past one while it is
+/// being mended; `the_known_endless_inputs_get_an_answer` checks each of them.
 const SKIP_KNOWN_FAILURES: bool = false;
 
 fn config() -> Config {

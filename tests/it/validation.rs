@@ -327,7 +327,7 @@ fn bad_flags_exit_with_usage_code_and_write_nothing() {
             &["--claim-timeout", "positive"],
         );
     }
-    // Beyond what a duration holds (it used to panic), negative, not a number.
+    // Beyond what a duration holds, negative, not a number.
     for bad in ["1e30", "-1", "NaN"] {
         let flag = format!("--checkpoint-seconds={bad}");
         rejected(
