@@ -713,10 +713,10 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
     // After the table, so the reference paragraph above stays as it is.
     out += &format!("\n{}\n", front_rule_text());
     out += &format!(
-        "\n{} ({}; a red ring marks overshoot on {:.1}% of pixels or more).\n",
+        "\n{} ({}; a red ring marks {}).\n",
         chart::advice(rows, recommended(rows)),
         chart::star_rule(),
-        100.0 * OVERSHOOT_FLAG
+        chart::flag_rule()
     );
     out
 }

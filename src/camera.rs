@@ -127,13 +127,10 @@ impl Camera {
         if let Some(offset) = self.offset {
             return offset;
         }
-        if self.position_digits.is_none() && self.target_digits.is_none() {
-            return self.position - self.target;
-        }
-        let bits = 64 + crate::exact::MAX_DIGITS * 4;
-        let p = crate::exact::big_point(self.position, self.position_digits.as_ref(), bits);
-        let t = crate::exact::big_point(self.target, self.target_digits.as_ref(), bits);
-        DVec3::from_array([0, 1, 2].map(|i| (&p[i] - &t[i]).to_f64().value()))
+        crate::exact::difference(
+            (self.position, self.position_digits.as_ref()),
+            (self.target, self.target_digits.as_ref()),
+        )
     }
 
     /// Builds the camera's orthonormal frame. Validation guarantees position ≠

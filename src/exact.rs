@@ -107,6 +107,18 @@ pub fn big_point(value: DVec3, digits: Option<&Digits>, bits: usize) -> [Big; 3]
     }
 }
 
+/// `a − b` for points held as f64 values with their digits where given,
+/// computed in enough bits that a difference far below f64's resolution
+/// of either point survives.
+pub fn difference(a: (DVec3, Option<&Digits>), b: (DVec3, Option<&Digits>)) -> DVec3 {
+    if a.1.is_none() && b.1.is_none() {
+        return a.0 - b.0;
+    }
+    let bits = 64 + MAX_DIGITS * 4;
+    let (p, q) = (big_point(a.0, a.1, bits), big_point(b.0, b.1, bits));
+    DVec3::from_array([0, 1, 2].map(|i| (&p[i] - &q[i]).to_f64().value()))
+}
+
 /// `b` as decimal digits: `significant` of them, in plain or scientific
 /// notation as dashu writes it.
 pub fn decimal(b: &Big, significant: usize) -> String {

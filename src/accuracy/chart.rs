@@ -102,10 +102,13 @@ impl Role {
     }
 }
 
+/// How far outside its dot a red ring is drawn, and its width.
+const FLAG_RING: (i32, u32) = (2, 2);
+
 /// How far a variant's mark reaches from its point, its red ring included.
 fn mark_radius(role: Role, r: &Measurement) -> i32 {
     let ring = match role {
-        Role::Front | Role::Dominated if flagged(r) => 2 + 1,
+        Role::Front | Role::Dominated if flagged(r) => FLAG_RING.0 + FLAG_RING.1 as i32 / 2,
         _ => 0,
     };
     role.radius() + ring
@@ -214,7 +217,8 @@ fn draw_marker(
     root.draw(&Circle::new(p, radius, fill.filled()))
         .map_err(text)?;
     if flag {
-        root.draw(&Circle::new(p, radius + 2, FLAG.stroke_width(2)))
+        let (gap, width) = FLAG_RING;
+        root.draw(&Circle::new(p, radius + gap, FLAG.stroke_width(width)))
             .map_err(text)?;
     }
     Ok(())
@@ -491,7 +495,7 @@ fn key_lines(rows: &[Measurement], pick: Option<usize>) -> Vec<Vec<(KeyMark, Str
             (KeyMark::Point(Role::Scene, false), "the scene's own settings".into()),
             (
                 KeyMark::Point(Role::Front, true),
-                format!("red ring: overshoot on {} of pixels or more", percent(OVERSHOOT_FLAG)),
+                format!("red ring: {}", flag_rule()),
             ),
             (KeyMark::Nothing, "errors of 0 drawn at the floor; reference not plotted".into()),
         ],
@@ -521,6 +525,14 @@ pub fn advice(rows: &[Measurement], pick: Option<usize>) -> String {
         }
         (None, _) => "no recommendation: no variant has a measured image error".into(),
     }
+}
+
+/// What a red ring marks, in words.
+pub fn flag_rule() -> String {
+    format!(
+        "overshoot on {}% of pixels or more",
+        tick_label(100.0 * OVERSHOOT_FLAG)
+    )
 }
 
 /// How the star is chosen, in words.

@@ -231,9 +231,9 @@ fn stopped(best: Option<Round>, round: usize, problem: &str, json: bool) -> anyh
 /// How far apart two cameras' targets are, from their digits where a deep
 /// target has them (f64 would lose the difference).
 fn distance(a: &crate::camera::Camera, b: &crate::camera::Camera) -> f64 {
-    let bits = 64 + crate::exact::MAX_DIGITS * 4;
-    let p = crate::exact::big_point(a.target, a.target_digits.as_ref(), bits);
-    let q = crate::exact::big_point(b.target, b.target_digits.as_ref(), bits);
-    let d = [0, 1, 2].map(|i| (&p[i] - &q[i]).to_f64().value());
-    glam::DVec3::from_array(d).length()
+    crate::exact::difference(
+        (a.target, a.target_digits.as_ref()),
+        (b.target, b.target_digits.as_ref()),
+    )
+    .length()
 }

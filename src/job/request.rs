@@ -57,7 +57,7 @@ pub struct Request {
 }
 
 /// The most samples per pixel `--samples` (and the explorer) take.
-pub const MAX_SAMPLES: u32 = 4096;
+pub use crate::timeline::MAX_SAMPLES;
 
 /// Parses `WxH`.
 pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
@@ -72,10 +72,11 @@ pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
         w.trim().parse().map_err(|_| bad())?,
         h.trim().parse().map_err(|_| bad())?,
     );
-    if w == 0 || h == 0 || w > 32_768 || h > 32_768 {
+    let side = crate::timeline::MAX_SIDE;
+    if w == 0 || h == 0 || w > side || h > side {
         return Err(Error::usage(
             option,
-            format!("width and height must be 1..=32768, got {text:?}"),
+            format!("width and height must be 1..={side}, got {text:?}"),
         ));
     }
     Ok((w, h))

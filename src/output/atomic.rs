@@ -67,8 +67,20 @@ pub fn write_atomic(
 
 /// `text` written over `path` whole, through a temporary file.
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
+    write_text_as(path, text, None)
+}
+
+/// `text` over `path` through a temporary file given `mode` (where given)
+/// before a byte is written: the text is never more readable than asked.
+fn write_text_as(path: &Path, text: &str, mode: Option<std::fs::Permissions>) -> Result<()> {
     write_atomic(path, |writer, file| {
         use std::io::Write as _;
+        if let Some(mode) = mode {
+            writer
+                .get_ref()
+                .set_permissions(mode)
+                .map_err(|e| Error::io(file, e))?;
+        }
         writer
             .write_all(text.as_bytes())
             .map_err(|e| Error::io(file, e))
@@ -82,18 +94,7 @@ pub fn replace_text(path: &Path, text: &str) -> Result<()> {
     let mode = std::fs::metadata(&real)
         .map_err(|e| Error::io(&real, e))?
         .permissions();
-    // The mode is set before the rename: the text is never more readable
-    // than the file it replaces.
-    write_atomic(&real, |writer, file| {
-        use std::io::Write as _;
-        writer
-            .write_all(text.as_bytes())
-            .map_err(|e| Error::io(file, e))?;
-        writer
-            .get_ref()
-            .set_permissions(mode)
-            .map_err(|e| Error::io(file, e))
-    })
+    write_text_as(&real, text, Some(mode))
 }
 
 /// How old a temporary `.partial` file must be to count as left behind by a

@@ -11,12 +11,13 @@ pub const MAX_FRAMES: u32 = 1_000_000;
 /// What the frame limit's messages suggest.
 pub(super) const FRAMES_HINT: &str = "split a longer film into timelines of its parts";
 
-/// The widest and tallest frame.
-pub(super) const MAX_SIDE: u32 = 32_768;
+/// The widest and tallest frame, from the timeline or `--size`.
+pub const MAX_SIDE: u32 = 32_768;
 
 // The most each whole-number field of a scene may hold (the least is 1):
 // past these a frame takes days, or an effect no longer changes the image.
-pub(super) const MAX_SAMPLES: u32 = 4096;
+/// Also the most `--samples` (and the explorer) take.
+pub const MAX_SAMPLES: u32 = 4096;
 pub(super) const MAX_CONE_RAYS: u32 = 4096;
 pub(super) const MAX_ITERATIONS: u32 = 10_000;
 pub(super) const MAX_MARCH_STEPS: u32 = 1_000_000;

@@ -10,6 +10,7 @@
 
 pub mod edit;
 mod limits;
+pub use limits::{MAX_SAMPLES, MAX_SIDE};
 mod messages;
 pub mod parameters;
 mod parse;

@@ -737,23 +737,10 @@ fn pick_aim_writes_the_hit_as_the_target_and_refine_moves_it_onto_the_surface() 
 
 #[test]
 fn pick_aim_writes_through_a_link_and_keeps_the_files_permissions() {
-    use std::os::unix::fs::PermissionsExt;
     let d = Dir::new();
-    std::fs::create_dir(d.path().join("real")).unwrap();
-    let real = d.write("real/t.ron", &tiny_timeline(2, 8.0));
-    std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o600)).unwrap();
-    std::os::unix::fs::symlink("real/t.ron", d.path().join("link.ron")).unwrap();
+    let real = d.linked_private_timeline(&tiny_timeline(2, 8.0));
     d.ok(&["pick", "link.ron", "--pixel", "24,13", "--aim"]);
-    let link = std::fs::symlink_metadata(d.path().join("link.ron")).unwrap();
-    assert!(
-        link.file_type().is_symlink(),
-        "the link was replaced by a file"
-    );
-    assert!(std::fs::read_to_string(&real)
-        .unwrap()
-        .contains("target: ("));
-    let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
-    assert_eq!(mode, 0o600);
+    d.assert_written_through_the_link(&real, "target: (");
 }
 
 #[test]

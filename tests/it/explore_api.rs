@@ -586,26 +586,13 @@ fn save_does_not_silently_write_over_a_file_changed_on_disk() {
 #[cfg(unix)]
 #[test]
 fn save_writes_through_a_link_and_keeps_the_files_mode() {
-    use std::os::unix::fs::PermissionsExt;
     let d = Dir::new();
-    std::fs::create_dir(d.path().join("real")).unwrap();
-    let real = d.write("real/t.ron", &tiny_timeline(2, 9.0));
-    std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o600)).unwrap();
-    std::os::unix::fs::symlink("real/t.ron", d.path().join("link.ron")).unwrap();
+    let real = d.linked_private_timeline(&tiny_timeline(2, 9.0));
     let s = explore(&d, "link.ron");
     let edit = json!({"edits": [{"kind": "set_key", "track": "fractal.power", "time": 0.5, "value": [10]}]});
     s.post("/api/edit", edit).expect(200);
     s.post("/api/save", json!({})).expect(200);
-    let link = std::fs::symlink_metadata(d.path().join("link.ron")).unwrap();
-    assert!(
-        link.file_type().is_symlink(),
-        "the link was replaced by a file"
-    );
-    assert!(std::fs::read_to_string(&real)
-        .unwrap()
-        .contains("value: 10"));
-    let mode = std::fs::metadata(&real).unwrap().permissions().mode() & 0o777;
-    assert_eq!(mode, 0o600);
+    d.assert_written_through_the_link(&real, "value: 10");
 }
 
 #[test]

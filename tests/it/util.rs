@@ -246,6 +246,34 @@ impl Dir {
     }
 }
 
+impl Dir {
+    /// `link.ron`, a link to `real/t.ron` (`text`), a file only its owner
+    /// may read: for what writes a timeline through a link.
+    pub fn linked_private_timeline(&self, text: &str) -> PathBuf {
+        use std::os::unix::fs::PermissionsExt;
+        std::fs::create_dir(self.path().join("real")).unwrap();
+        let real = self.write("real/t.ron", text);
+        std::fs::set_permissions(&real, std::fs::Permissions::from_mode(0o600)).unwrap();
+        std::os::unix::fs::symlink("real/t.ron", self.path().join("link.ron")).unwrap();
+        real
+    }
+
+    /// Asserts that `link.ron` is still a link and that `real`, the file it
+    /// names, holds `written` and is still its owner's alone.
+    pub fn assert_written_through_the_link(&self, real: &Path, written: &str) {
+        use std::os::unix::fs::PermissionsExt;
+        let link = std::fs::symlink_metadata(self.path().join("link.ron")).unwrap();
+        assert!(
+            link.file_type().is_symlink(),
+            "the link was replaced by a file"
+        );
+        let text = std::fs::read_to_string(real).unwrap();
+        assert!(text.contains(written), "{text}");
+        let mode = std::fs::metadata(real).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode, 0o600);
+    }
+}
+
 /// Whether ffmpeg and ffprobe run here; in CI they must (.ci/run installs
 /// them), elsewhere a test that needs them skips with a note.
 pub fn ffmpeg_installed() -> bool {
