@@ -315,9 +315,9 @@ fn as_written(message: String, track: &Track, k: usize) -> String {
         _ => return message,
     };
     let held = value.round().clamp(0.0, u32::MAX as Real);
-    let held_as = format!(", got {held}");
-    match message.strip_suffix(&held_as) {
-        Some(head) if held != value.round() => format!("{head}, got {}", value.shown()),
-        _ => message,
+    if held == value.round() {
+        return message;
     }
+    let field = format!("scene.{}", track.name);
+    super::limits::count_message(&field, &value.shown()).unwrap_or(message)
 }
