@@ -771,9 +771,9 @@ fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
         "/timelines/deep_zoom.ron"
     ));
     d.write("deep.ron", &deep.unwrap());
-    let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "71", "--refine"]));
+    let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "539", "--refine"]));
     assert!(
-        out.contains("Re-centred for frame 71:  target: (\""),
+        out.contains("Re-centred for frame 539:  target: (\""),
         "{out}"
     );
     let stopped = out
