@@ -156,8 +156,7 @@ struct Round {
 fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<Round> {
     let text = crate::timeline::read_text(&args.timeline)?;
     let mut scene = t.scene_at(args.frame);
-    let pixel_angle = 2.0 * (scene.camera.fov_degrees.to_radians() / 2.0).tan() / size[1] as f64;
-    let pixel = pixel_angle * scene.camera.relative_position().length();
+    let pixel = scene.camera.axis_pixel_angle(size) * scene.camera.relative_position().length();
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {

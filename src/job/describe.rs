@@ -6,7 +6,15 @@ use crate::scene::Scene;
 /// The effects enabled, and which stages run per camera sample with their
 /// cost in distance estimates.
 pub fn plan_lines(base: &Scene) -> Vec<String> {
-    let mut lines = Vec::new();
+    let c = &base.camera;
+    let mut lines = vec![format!(
+        "camera:   {}{}",
+        c.projection.describe(c.fov_degrees),
+        c.stereo.map_or(String::new(), |s| format!(
+            "; stereo {:?}, eyes {} of the camera–target distance apart",
+            s.layout, s.eye_separation
+        ))
+    )];
     let effects = &base.effects;
     let enabled = effects.enabled();
     lines.push(format!(

@@ -18,6 +18,28 @@ const INSIDE_CHECK_ITERATIONS: u64 = 10_000_000;
 /// axis, where whole powers take the trigonometric form too).
 const INSIDE_CHECK_SECONDS: f64 = 0.4;
 
+/// An equirectangular eye's image that is not twice as wide as high:
+/// its pixels are not square, and 360° players stretch it.
+fn equirectangular_shape(timeline: &Timeline) -> Option<String> {
+    use crate::camera::{Projection, StereoLayout};
+    let camera = &timeline.base.camera;
+    if camera.projection != Projection::Equirectangular {
+        return None;
+    }
+    let (mut w, mut h) = (timeline.width, timeline.height);
+    match camera.stereo.map(|s| s.layout) {
+        Some(StereoLayout::SideBySide) => w /= 2,
+        Some(StereoLayout::TopBottom) => h /= 2,
+        None => {}
+    }
+    (w != 2 * h).then(|| {
+        format!(
+            "an equirectangular image is twice as wide as high, and each eye's here is {w}×{h}: \
+             its pixels are not square, and 360° players will stretch it"
+        )
+    })
+}
+
 /// What is allowed but likely not what the author meant, in `frames` of
 /// `timeline`: `render` and `info` print these. `samples_matter` is false
 /// for previews, which take one sample whatever the timeline says. Nothing
@@ -49,6 +71,7 @@ pub fn warnings(timeline: &Timeline, frames: &[u32], samples_matter: bool) -> Ve
     if let Some(message) = camera_inside(timeline, frames) {
         said.push(message);
     }
+    said.extend(equirectangular_shape(timeline));
     // Effects that need several samples a pixel, declared with too few:
     // not an error (a test render may want it), but not what they look like.
     // No track animates the samples or the shutter; one may open the lens.

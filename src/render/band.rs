@@ -267,9 +267,18 @@ impl RowScratch {
             self.laid_out = Some(layout);
             self.picked_valid = false;
         }
-        // The same pixels take every sample of a wave.
+        // The same pixels take every sample of a wave; those the
+        // projection leaves out (beyond a fisheye's circle) take none.
         if !self.picked_valid {
-            self.pick(frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]));
+            let active = frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]);
+            let seen = |p: usize| {
+                let (x, y) = ((p % w) as u32, (y0 + p / w) as u32);
+                active.is_none_or(|a| a[p]) && camera.covers(x, y, width, height)
+            };
+            match (active, camera.covers_all()) {
+                (None, true) => self.pick(None::<fn(usize) -> bool>),
+                _ => self.pick(Some(seen)),
+            }
             self.picked_valid = true;
         }
         self.rays.clear();
@@ -293,8 +302,9 @@ impl RowScratch {
 
 impl RowScratch {
     /// The band's pixels that take this sample, from the whole layout:
-    /// each block's `active` pixels, their run as long as they are.
-    fn pick(&mut self, active: Option<&[bool]>) {
+    /// each block's pixels `active` takes (all without it), their run as
+    /// long as they are.
+    fn pick(&mut self, active: Option<impl Fn(usize) -> bool>) {
         self.picked.clear();
         self.picked_runs.clear();
         let Some(active) = active else {
@@ -307,7 +317,7 @@ impl RowScratch {
             let block = &self.order[start..start + run as usize];
             let before = self.picked.len();
             self.picked
-                .extend(block.iter().copied().filter(|&p| active[p]));
+                .extend(block.iter().copied().filter(|&p| active(p)));
             let taken = (self.picked.len() - before) as u32;
             if taken > 0 {
                 self.picked_runs.push(taken);

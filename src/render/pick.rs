@@ -39,15 +39,19 @@ pub struct PickFractal {
 }
 
 /// Marches the ray through the centre of pixel (`x`, `y`) of a
-/// `width`×`height` image of `scene`, frame `frame` of its film. The pixel
-/// must be inside the image.
+/// `width`×`height` image of `scene`, frame `frame` of its film, along the
+/// ray its projection gives it. The pixel must be inside the image.
 pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
     let deep = crate::deep::prepare(scene, height);
     let marched = deep.as_ref().unwrap_or(scene);
     let camera = marched.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
     let fractal = &marched.fractal;
-    let result = march(&ray, fractal, &marched.quality);
+    // Beyond a fisheye's circle the renderer marches nothing: nor does pick.
+    let result = match camera.covers(x, y, width, height) {
+        true => march(&ray, fractal, &marched.quality),
+        false => crate::march::MarchResult::default(),
+    };
     let hit = result
         .hit
         .map(|h| (h, normal(&ray, &h, fractal, &marched.quality).0));
@@ -116,6 +120,8 @@ pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, Strin
     let size = scene.camera.target.abs().max_element();
     let mut distance = (REFINE_STEP * size).max(last);
     let mut s = scene.clone();
+    // The centre ray of one eye at the camera itself: the view's axis.
+    s.camera.stereo = None;
     let mut steps = Vec::new();
     loop {
         let c = &mut s.camera;

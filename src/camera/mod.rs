@@ -1,5 +1,11 @@
-//! The camera: where it stands and looks, its lens, and the ray through
-//! each pixel (a pinhole's, or a thin lens's from a point on the aperture).
+//! The camera: where it stands and looks, its lens, its projection
+//! (`projection`) and the ray through each pixel (a pinhole's or another
+//! projection's, or a thin lens's from a point on the aperture), for one
+//! eye or two.
+
+mod projection;
+
+pub use projection::{Projection, Stereo, StereoLayout};
 
 use crate::exact::{Coordinates, Digits};
 use crate::march::Ray;
@@ -30,6 +36,11 @@ pub struct Camera {
     pub aperture_radius: Real,
     /// Distance along the view direction that is in focus [default: the target's].
     pub focus_distance: Option<Real>,
+    /// How image positions map to directions (`fov_degrees` is the
+    /// perspective's alone).
+    pub projection: Projection,
+    /// Two eyes side by side or one above the other, or one eye.
+    pub stereo: Option<Stereo>,
 }
 
 impl Default for Camera {
@@ -42,6 +53,8 @@ impl Default for Camera {
             fov_degrees: 45.0,
             aperture_radius: 0.0,
             focus_distance: None,
+            projection: Projection::Perspective,
+            stereo: None,
             position_digits: None,
             target_digits: None,
             offset: None,
@@ -61,6 +74,12 @@ struct CameraForm {
     fov_degrees: Real,
     aperture_radius: Real,
     focus_distance: Option<Real>,
+    /// Left out of a scene's hash when they are the defaults, so frames of
+    /// every timeline without them keep their hashes.
+    #[serde(skip_serializing_if = "Projection::is_perspective")]
+    projection: Projection,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    stereo: Option<Stereo>,
     /// Written into a scene's hash only where f64 cannot hold the position
     /// (`Camera::offset`), so frames of ordinary zooms keep their hashes.
     #[serde(skip_deserializing, skip_serializing_if = "Option::is_none")]
@@ -85,6 +104,8 @@ impl From<CameraForm> for Camera {
             fov_degrees: form.fov_degrees,
             aperture_radius: form.aperture_radius,
             focus_distance: form.focus_distance,
+            projection: form.projection,
+            stereo: form.stereo,
             offset: None,
         }
     }
@@ -110,6 +131,8 @@ impl From<Camera> for CameraForm {
             fov_degrees: c.fov_degrees,
             aperture_radius: c.aperture_radius,
             focus_distance: c.focus_distance,
+            projection: c.projection,
+            stereo: c.stereo,
             offset: c.offset.filter(unresolved),
         }
     }
@@ -133,6 +156,23 @@ impl Camera {
         )
     }
 
+    /// The angle a pixel spans on the view's axis in a `width`×`height`
+    /// image (of one eye where the image holds two).
+    pub fn axis_pixel_angle(&self, [width, height]: [u32; 2]) -> Real {
+        let mono = Camera {
+            stereo: None,
+            ..self.clone()
+        };
+        let (w, h) = match self.stereo.map(|s| s.layout) {
+            Some(StereoLayout::SideBySide) => (width / 2, height),
+            Some(StereoLayout::TopBottom) => (width, height / 2),
+            None => (width, height),
+        };
+        let (w, h) = (w.max(1), h.max(1));
+        let centre = mono.frame().ray(0.5 * w as Real, 0.5 * h as Real, w, h);
+        centre.pixel_angle
+    }
+
     /// Builds the camera's orthonormal frame. Validation guarantees position ≠
     /// target and an up vector not parallel to the view; the fallbacks only keep
     /// the maths finite.
@@ -144,8 +184,13 @@ impl Camera {
             let (s, c) = self.roll_degrees.to_radians().sin_cos();
             (right, up) = (right * c + up * s, up * c - right * s);
         }
+        let distance = self.relative_position().length();
         CameraFrame {
             origin: self.position,
+            projection: self.projection,
+            stereo: self
+                .stereo
+                .map(|s| (0.5 * s.eye_separation * distance, s.layout)),
             forward,
             right,
             up,
@@ -158,7 +203,8 @@ impl Camera {
     }
 }
 
-/// Orthonormal camera frame with the image-plane half-height.
+/// Orthonormal camera frame with the image-plane half-height, the
+/// projection, and each eye's distance from the centre.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraFrame {
     pub origin: DVec3,
@@ -168,22 +214,99 @@ pub struct CameraFrame {
     pub tan_half_fov: Real,
     pub aperture_radius: Real,
     pub focus_distance: Real,
+    pub projection: Projection,
+    /// Half the eye separation in scene units, and where the eyes lie.
+    pub stereo: Option<(Real, StereoLayout)>,
+}
+
+/// One eye's part of an image: the eye (−1 left, +1 right, 0 the only
+/// one), the position in its part and the part's size.
+struct Eye {
+    side: Real,
+    x: Real,
+    y: Real,
+    w: Real,
+    h: Real,
 }
 
 impl CameraFrame {
-    /// The ray through image position (`x`, `y`) in pixels from the top-left
-    /// corner (pixel centres at +0.5) of a `width`×`height` image.
-    pub fn ray(&self, x: Real, y: Real, width: u32, height: u32) -> Ray {
+    /// Which eye image position (`x`, `y`) of a `width`×`height` image
+    /// belongs to, and where in that eye's image it is.
+    fn eye(&self, x: Real, y: Real, width: u32, height: u32) -> Eye {
         let (w, h) = (width as Real, height as Real);
-        let sx = (2.0 * x / w - 1.0) * self.tan_half_fov * (w / h);
-        let sy = (1.0 - 2.0 * y / h) * self.tan_half_fov;
-        let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+        let eye = |side, x, y, w, h| Eye { side, x, y, w, h };
+        match self.stereo {
+            None => eye(0.0, x, y, w, h),
+            Some((_, StereoLayout::SideBySide)) => {
+                let half = (0.5 * w).floor();
+                match x < half {
+                    true => eye(-1.0, x, y, half, h),
+                    false => eye(1.0, x - half, y, w - half, h),
+                }
+            }
+            Some((_, StereoLayout::TopBottom)) => {
+                let half = (0.5 * h).floor();
+                match y < half {
+                    true => eye(-1.0, x, y, w, half),
+                    false => eye(1.0, x, y - half, w, h - half),
+                }
+            }
+        }
+    }
+
+    /// The ray through image position (`x`, `y`) in pixels from the top-left
+    /// corner (pixel centres at +0.5) of a `width`×`height` image; its
+    /// origin is the eye's where the image holds two.
+    pub fn ray(&self, x: Real, y: Real, width: u32, height: u32) -> Ray {
+        let eye = self.eye(x, y, width, height);
+        let half = self.stereo.map_or(0.0, |(half, _)| half);
+        let (dir, pixel_angle, offset) = match self.projection {
+            Projection::Perspective => {
+                let sx = (2.0 * eye.x / eye.w - 1.0) * self.tan_half_fov * (eye.w / eye.h);
+                let sy = (1.0 - 2.0 * eye.y / eye.h) * self.tan_half_fov;
+                let dir = (self.forward + self.right * sx + self.up * sy).normalize();
+                let angle = 2.0 * self.tan_half_fov / eye.h;
+                (dir, angle, self.right * (eye.side * half))
+            }
+            other => {
+                let d = projection::direction(other, eye.x, eye.y, eye.w, eye.h);
+                let dir = self.right * d.right + self.up * d.up + self.forward * d.forward;
+                let offset = match other {
+                    // Omni-directional stereo: each column's eyes.
+                    Projection::Equirectangular => {
+                        let (longitude, _) =
+                            projection::longitude_latitude(eye.x, eye.y, eye.w, eye.h);
+                        let (r, f) = (self.right, self.forward);
+                        projection::ods_offset(longitude, half, eye.side, r, f)
+                    }
+                    _ => self.right * (eye.side * half),
+                };
+                (dir.normalize(), d.pixel_angle, offset)
+            }
+        };
+        // One eye's rays leave from the centre itself, to the bit.
+        let origin = match self.stereo {
+            Some(_) => self.origin + offset,
+            None => self.origin,
+        };
         Ray {
-            origin: self.origin,
+            origin,
             dir,
-            pixel_angle: 2.0 * self.tan_half_fov / h,
+            pixel_angle,
             start_footprint: 0.0,
         }
+    }
+
+    /// Whether the pixel at (`px`, `py`) of a `width`×`height` image sees
+    /// anything (outside a fisheye's circle it does not, and takes no rays).
+    pub fn covers(&self, px: u32, py: u32, width: u32, height: u32) -> bool {
+        let eye = self.eye(px as Real + 0.5, py as Real + 0.5, width, height);
+        projection::covers(self.projection, eye.x, eye.y, eye.w, eye.h)
+    }
+
+    /// Whether every pixel of a `width`×`height` image sees something.
+    pub fn covers_all(&self) -> bool {
+        !matches!(self.projection, Projection::Fisheye { .. })
     }
 }
 
@@ -195,18 +318,26 @@ impl CameraFrame {
 
     /// The ray through image position (`x`, `y`) from lens position (`u`, `v`)
     /// in [0, 1)²: a thin lens focused at `focus_distance`. Every lens position
-    /// of one image position meets the others on the plane of focus.
+    /// of one image position meets the others on the plane of focus (for a
+    /// perspective; on the sphere of that radius about the eye for the
+    /// other projections, whose lens faces each ray).
     pub fn lens_ray(&self, x: Real, y: Real, width: u32, height: u32, u: Real, v: Real) -> Ray {
         let pinhole = self.ray(x, y, width, height);
         if !self.has_lens() {
             return pinhole;
         }
-        let focus =
-            pinhole.origin + pinhole.dir * (self.focus_distance / pinhole.dir.dot(self.forward));
+        let (across, above, along) = match self.projection {
+            Projection::Perspective => (self.right, self.up, pinhole.dir.dot(self.forward)),
+            _ => {
+                let across = crate::math::normalize_or(pinhole.dir.cross(self.up), self.right);
+                (across, across.cross(pinhole.dir), 1.0)
+            }
+        };
+        let focus = pinhole.origin + pinhole.dir * (self.focus_distance / along);
         // Uniform point on the disc (polar mapping; the sampler is stratified
         // in u already, so the mapping's distortion matters little).
         let (radius, angle) = (u.sqrt() * self.aperture_radius, std::f64::consts::TAU * v);
-        let origin = self.origin + (self.right * angle.cos() + self.up * angle.sin()) * radius;
+        let origin = pinhole.origin + (across * angle.cos() + above * angle.sin()) * radius;
         Ray {
             origin,
             dir: (focus - origin).normalize(),
@@ -289,3 +420,6 @@ mod tests {
         assert!(frame.forward.dot(frame.up).abs() < 1e-15);
     }
 }
+
+#[cfg(test)]
+mod projection_tests;
