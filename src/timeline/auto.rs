@@ -143,3 +143,56 @@ impl Counts {
         r
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::math::DVec3;
+
+    /// On the y axis Quilez's power-8 map sends y to y⁸ (θ is 0 or π, and
+    /// 8θ a whole turn): the orbit of (0, c, 0) is y ↦ y⁸ + c and its
+    /// derivative dr ↦ 8|y|⁷·dr + 1, iterated here apart from the kernel.
+    fn axis_passes(c: Real, footprint: Real, bailout: Real) -> u32 {
+        let (mut y, mut dr) = (c, 1.0);
+        for i in 0.. {
+            if dr * footprint >= 1.0 {
+                return i;
+            }
+            assert!(y.abs() <= bailout, "the test's orbit escapes first");
+            dr = 8.0 * y.abs().powi(7) * dr + 1.0;
+            y = y.powi(8) + c;
+        }
+        unreachable!()
+    }
+
+    #[test]
+    fn auto_is_where_the_targets_derivative_resolves_a_pixel_plus_the_margin() {
+        let (width, height) = (64, 48);
+        for (c, distance, margin) in [(0.66, 0.5, 2), (0.6505, 0.01, 0), (0.7, 2.0, 5)] {
+            let mut scene = Scene::default();
+            scene.camera.target = DVec3::new(0.0, c, 0.0);
+            scene.camera.position = scene.camera.target + DVec3::new(0.0, 0.0, distance);
+            let pixel = 2.0 * (scene.camera.fov_degrees.to_radians() / 2.0).tan() / height as Real;
+            let passes = axis_passes(c, distance * pixel, scene.fractal.bailout);
+            let auto = AutoIterations { margin };
+            let r = resolve(&scene, auto, [width, height]);
+            assert_eq!(r.decided, Decided::Target, "c = {c}");
+            let want = (passes + margin).max(MIN_AUTO_ITERATIONS);
+            assert_eq!(r.count, want, "c = {c}, passes at {passes}");
+            assert!(
+                passes + margin > MIN_AUTO_ITERATIONS,
+                "the floor decides c = {c}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_target_inside_the_set_takes_the_surface_under_the_centre_ray() {
+        // The origin's orbit stays at 0: its derivative never grows.
+        let mut scene = Scene::default();
+        scene.camera.target = DVec3::ZERO;
+        scene.camera.position = DVec3::new(0.0, 0.0, 3.0);
+        let r = resolve(&scene, AutoIterations { margin: 1 }, [64, 48]);
+        assert_eq!(r.decided, Decided::Centre);
+    }
+}
