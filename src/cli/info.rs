@@ -55,6 +55,7 @@ pub fn info(path: &Path) -> anyhow::Result<()> {
         base.quality.fudge,
         base.quality.max_steps
     );
+    print_auto(&t)?;
     print_deep(&t)?;
     print_tracks(&t)?;
     print_plan(base)?;
@@ -149,6 +150,47 @@ fn print_cost(t: &Timeline, base: &Scene) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `iterations: Auto`'s count for every frame, as runs of frames that
+/// share a count and what decided it (the target, or the surface under the
+/// centre ray); nothing where the timeline gives a number.
+fn print_auto(t: &Timeline) -> anyhow::Result<()> {
+    use rayon::prelude::*;
+    let Some(auto) = t.base.fractal.auto else {
+        return Ok(());
+    };
+    let counts: Vec<_> = (0..t.frame_count)
+        .into_par_iter()
+        .filter_map(|f| t.auto_count(f))
+        .collect();
+    let (Some(least), Some(most)) = (
+        counts.iter().map(|r| r.count).min(),
+        counts.iter().map(|r| r.count).max(),
+    ) else {
+        return Ok(());
+    };
+    out!(
+        "iterations: Auto, margin {}: {least} to {most} at {}x{} (where the orbit's derivative passes one over a pixel, plus the margin)",
+        auto.margin,
+        t.width,
+        t.height
+    );
+    let mut runs: Vec<(u32, u32, crate::timeline::auto::Resolved)> = Vec::new();
+    for (f, r) in (0..).zip(&counts) {
+        match runs.last_mut() {
+            Some((_, end, last)) if last == r => *end = f,
+            _ => runs.push((f, f, *r)),
+        }
+    }
+    for (start, end, r) in runs {
+        let frames = match start == end {
+            true => format!("frame {start}"),
+            false => format!("frames {start}..={end}"),
+        };
+        out!("          {frames}: {} ({})", r.count, r.decided.name());
+    }
+    Ok(())
+}
+
 /// Which frames are deep (`crate::deep`) at the timeline's size, the
 /// precision their reference orbits take, and the iterations that resolve
 /// the deepest; nothing where every frame is within f64's reach.
@@ -177,6 +219,10 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
         crate::deep::bits(&scene, t.height),
         crate::deep::max_steps(&scene, t.height)
     );
+    if t.base.fractal.auto.is_some() {
+        // `print_auto` told each frame's count.
+        return Ok(());
+    }
     use crate::deep::Derivative;
     let (has, last) = (scene.fractal.iterations, deepest);
     match crate::deep::iterations_for(&scene, t.height) {

@@ -97,8 +97,12 @@ pub struct Fractal {
     pub formula: Formula,
     /// The exponent n of the triplex power (any real; 8 is the classic bulb).
     pub power: Real,
-    /// Maximum orbit length.
+    /// Maximum orbit length: the timeline's count, or the one `auto`
+    /// resolved for this frame.
     pub iterations: u32,
+    /// `iterations: Auto`: the count is chosen per frame where the scene is
+    /// made (`crate::timeline`), and `iterations` holds it after.
+    pub auto: Option<AutoIterations>,
     /// Escape radius; must exceed 1 so ln(r) is positive at escape.
     pub bailout: Real,
     /// `None` for the Mandelbrot mode (z₀ = c = p), `Some(k)` for the Julia set of constant k.
@@ -125,6 +129,7 @@ impl Default for Fractal {
             formula: Formula::Quilez,
             power: 8.0,
             iterations: 12,
+            auto: None,
             bailout: 4.0,
             julia: None,
             de: DeMethod::Analytic,
@@ -134,6 +139,26 @@ impl Default for Fractal {
             perturbation: true,
         }
     }
+}
+
+/// The most orbit iterations a timeline may ask for, or `Auto` choose:
+/// past this a frame takes days.
+pub const MAX_ITERATIONS: u32 = 10_000;
+
+/// `iterations: Auto(margin: m)`: per frame, the iterations after which
+/// the running derivative at the frame's surface passes one over a pixel's
+/// width (finer detail would alias), and `margin` more.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct AutoIterations {
+    pub margin: u32,
+}
+
+impl AutoIterations {
+    /// The margin `Auto` alone takes.
+    pub const DEFAULT_MARGIN: u32 = 2;
+    /// The largest margin: each iteration multiplies the derivative about
+    /// eightfold at power 8, so past this the margin alone is 1e90 pixels.
+    pub const MAX_MARGIN: u32 = 100;
 }
 
 /// Minimum distances of the orbit to the four traps of Quilez's colouring.

@@ -187,6 +187,37 @@ impl Fractal {
         }
     }
 
+    /// Where the running derivative of `p`'s orbit reaches `value`, or why
+    /// it does not within `limit` iterations: the f64 twin of
+    /// `deep::Reference::derivative_passes`, one iteration at a time.
+    pub fn derivative_passes(&self, p: DVec3, value: Real, limit: u32) -> super::deep::Derivative {
+        use super::deep::Derivative;
+        let (formula, n) = (self.formula, self.power);
+        let escape = self.escape_radius::<Real>();
+        let mut state = OrbitState::start(self, p.to_array());
+        let whole = whole_power(n);
+        let power = |z: Triplex<Real>, r: Real| match whole {
+            Some(k) => whole_power_step(formula, z, r, k),
+            None => {
+                let r_n_minus_1 = r.powf(n - 1.0);
+                (
+                    triplex_power_trig_scaled(formula, z, r, n, r_n_minus_1 * r),
+                    r_n_minus_1,
+                )
+            }
+        };
+        while state.i < limit {
+            if state.dr >= value {
+                return Derivative::Passes(state.i);
+            }
+            if state.outside(escape) {
+                return Derivative::Escapes(state.i);
+            }
+            state.step(&power);
+        }
+        Derivative::Stays
+    }
+
     /// The orbit loop, given the power step: (z, |z|) ↦ (zⁿ, |z|ⁿ⁻¹).
     #[inline(always)]
     pub(super) fn orbit_with<T: Number>(

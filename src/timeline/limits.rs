@@ -19,7 +19,7 @@ pub const MAX_SIDE: u32 = 32_768;
 /// Also the most `--samples` (and the explorer) take.
 pub const MAX_SAMPLES: u32 = 4096;
 pub(super) const MAX_CONE_RAYS: u32 = 4096;
-pub(super) const MAX_ITERATIONS: u32 = 10_000;
+pub(super) const MAX_ITERATIONS: u32 = crate::fractal::MAX_ITERATIONS;
 pub(super) const MAX_MARCH_STEPS: u32 = 1_000_000;
 pub(super) const MAX_SHADOW_STEPS: u32 = 100_000;
 pub(super) const MAX_OCCLUSION_SAMPLES: u32 = 64;

@@ -180,6 +180,13 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
             });
             (shown, format!("{in_field}{message}"))
         }
+        // A count's own visitor (`fractal::form`) saw the number as read,
+        // not as written: show it as written.
+        Ron::Message(m) if m.starts_with("must be 1..=") => {
+            let written = number_around(row(shown.0), shown.1);
+            let told = m.split(", got ").next().unwrap_or(m);
+            (shown, format!("{in_field}{told}, got {written}"))
+        }
         Ron::SuggestRawIdentifier(found) => (
             (line, column),
             format!("{in_field}expected a field name here (`name: value`), got `{found}`"),

@@ -8,6 +8,7 @@
 //! spline code; `camera.distance` is interpolated in log space so a zoom
 //! keeps a constant apparent speed over many decades of scale.
 
+pub mod auto;
 pub mod edit;
 mod limits;
 pub use limits::{MAX_SAMPLES, MAX_SIDE};
@@ -49,6 +50,8 @@ pub struct Timeline {
     /// `loop: true`: the film is one period of a seamless loop, and frame
     /// `frame_count` would be frame 0 again. The period is `duration_seconds`.
     pub looping: bool,
+    /// `fractal.iterations: Auto`'s count at each instant made so far.
+    auto_counts: auto::Counts,
 }
 
 /// The longest file read as a timeline: real ones are a few kilobytes, and
@@ -122,8 +125,10 @@ impl Timeline {
     }
 
     /// This timeline with only the tracks `keep` names: its scenes are
-    /// quicker to build where only some parameters matter.
+    /// quicker to build where only some parameters matter. With
+    /// `iterations: Auto` every track is kept: the count depends on them.
     pub fn with_tracks(&self, keep: impl Fn(&str) -> bool) -> Timeline {
+        let auto = self.base.fractal.auto.is_some();
         Timeline {
             source: self.source.clone(),
             name: self.name.clone(),
@@ -131,11 +136,24 @@ impl Timeline {
             tracks: self
                 .tracks
                 .iter()
-                .filter(|t| keep(&t.name))
+                .filter(|t| auto || keep(&t.name))
                 .cloned()
                 .collect(),
+            auto_counts: self.auto_counts.clone(),
             ..*self
         }
+    }
+
+    /// The count `iterations: Auto` chose for frame `frame_index`, and
+    /// what decided it; `None` where the timeline gives a number.
+    pub fn auto_count(&self, frame_index: u32) -> Option<auto::Resolved> {
+        let time = self.time_of(frame_index);
+        let scene = self.scene_built(time, false).ok()?;
+        let auto = scene.fractal.auto?;
+        Some(
+            self.auto_counts
+                .at(time, &scene, auto, [self.width, self.height]),
+        )
     }
 
     /// The error of this timeline's value at `field`, a path into its file,
@@ -220,6 +238,10 @@ impl Timeline {
                 }
             }
             track.apply(&mut scene, time_seconds);
+        }
+        if let Some(auto) = scene.fractal.auto {
+            let size = [self.width, self.height];
+            scene.fractal.iterations = self.auto_counts.at(time_seconds, &scene, auto, size).count;
         }
         Ok(scene)
     }

@@ -33,6 +33,7 @@ impl Timeline {
         let (width, height) = source.size(&file)?;
         let frame_count = source.frame_count(&file)?;
         source.environment_map(&mut file.scene)?;
+        source.auto_iterations(&file)?;
         if let Err((field, message)) = validate_scene(&file.scene) {
             return Err(source.value(&format!("scene.{field}"), message));
         }
@@ -57,6 +58,7 @@ impl Timeline {
             base: file.scene,
             tracks,
             looping: file.looping,
+            auto_counts: Default::default(),
         };
         // Splines can overshoot their keys: check every scene the frames
         // render; the first frame that fails is told.
@@ -70,6 +72,38 @@ impl Timeline {
 }
 
 impl Source<'_> {
+    /// `iterations: Auto` as written: the word RON leaves out of what it
+    /// hands over (`fractal::form`) is `Auto`, and no track sets the count
+    /// `Auto` chooses.
+    fn auto_iterations(&self, file: &TimelineFile) -> Result<()> {
+        if file.scene.fractal.auto.is_none() {
+            return Ok(());
+        }
+        let field = "scene.fractal.iterations";
+        let written = spans::range_at(self.text, &spans::steps(field))
+            .map(|r| self.text[r].trim().to_string())
+            .unwrap_or_default();
+        let word: String = written
+            .chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect();
+        if word != "Auto" {
+            let shown = written.lines().next().unwrap_or_default();
+            let message = format!(
+                "expected a whole number of iterations, `Auto` or `Auto(margin: 2)`, got `{shown}`"
+            );
+            return Err(self.value(field, message));
+        }
+        let track = "fractal.iterations";
+        if file.tracks.contains_key(track) {
+            let message = format!(
+                "`scene.{track}` is `Auto`, which chooses the count per frame: remove this track, or write a number in the scene"
+            );
+            return Err(self.value(&format!("tracks[\"{track}\"]"), message));
+        }
+        Ok(())
+    }
+
     /// The file as written, or where its RON goes wrong.
     fn read(&self) -> Result<TimelineFile> {
         let options = ron::Options::default()

@@ -979,3 +979,81 @@ fn a_camera_too_far_to_see_anything_is_refused_by_name() {
         "{e}"
     );
 }
+
+/// timelines/zoom.ron with `iterations: Auto` and its iterations track cut.
+fn zoom_with_auto() -> String {
+    let text = include_str!("../../timelines/zoom.ron");
+    let line = "iterations: 10,     // raised by a track as the zoom deepens";
+    assert!(text.contains(line), "zoom.ron's iterations line moved");
+    let text = text.replace(line, "iterations: Auto,");
+    let start = text
+        .find("        // Deeper views need longer")
+        .expect("the track");
+    let end = text.find("    },\n)").expect("the tracks' end");
+    format!("{}\n{}", text[..start].trim_end(), &text[end..])
+}
+
+#[test]
+fn auto_iterations_deepen_with_the_zoom() {
+    let t = parse(&zoom_with_auto()).unwrap();
+    let counts: Vec<u32> = (0..t.frame_count)
+        .map(|f| t.scene_at(f).fractal.iterations)
+        .collect();
+    assert!(counts.windows(2).all(|w| w[0] <= w[1]), "{counts:?}");
+    assert!(counts[counts.len() - 1] > counts[0], "{counts:?}");
+    let told: Vec<u32> = (0..t.frame_count)
+        .map(|f| t.auto_count(f).expect("Auto").count)
+        .collect();
+    assert_eq!(told, counts);
+}
+
+#[test]
+fn bad_auto_iterations_are_refused_at_their_place() {
+    let at = |value: &str| {
+        let text = format!(
+            "(fps: 10, frames: 2, size: (8, 6),\n scene: (fractal: (\n    iterations: {value})))"
+        );
+        error_of(&text)
+    };
+    let e = at("Auto(margin: -1)");
+    assert!(
+        e.starts_with("test.ron:3:") && e.contains("margin must be 0..=100, got -1"),
+        "{e}"
+    );
+    for word in ["Banana", "Automatic", "()"] {
+        let e = at(word);
+        assert!(e.starts_with("test.ron:3:17: "), "{e}");
+        assert!(
+            e.contains(&format!("`Auto` or `Auto(margin: 2)`, got `{word}`")),
+            "{e}"
+        );
+    }
+    let e = at("Auto(margins: 2)");
+    assert!(
+        e.starts_with("test.ron:3:") && e.contains("`margin`, got `margins`"),
+        "{e}"
+    );
+}
+
+#[test]
+fn auto_iterations_and_an_iterations_track_contradict() {
+    let text = "(fps: 10, frames: 2, size: (8, 6), scene: (fractal: (iterations: Auto)),\n tracks: { \"fractal.iterations\": (keys: [(time: 0, value: 10)]) })";
+    let e = error_of(text);
+    assert!(e.starts_with("test.ron:2:"), "{e}");
+    assert!(
+        e.contains("is `Auto`, which chooses the count per frame"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_count_and_auto_hash_alike_where_auto_chose_that_count() {
+    let auto = parse(&zoom_with_auto()).unwrap().scene_at(100);
+    let count = auto.fractal.iterations;
+    let text = zoom_with_auto().replace("iterations: Auto,", &format!("iterations: {count},"));
+    let fixed = parse(&text).unwrap().scene_at(100);
+    assert_eq!(
+        serde_json::to_string(&auto).unwrap(),
+        serde_json::to_string(&fixed).unwrap()
+    );
+}

@@ -3,6 +3,7 @@
 mod util;
 
 mod accuracy;
+mod auto;
 mod bench;
 mod browser;
 mod cli;

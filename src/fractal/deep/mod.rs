@@ -140,7 +140,7 @@ impl Reference {
         self.run(fractal, self.start(delta), dc, limit, stop_at_bailout)
     }
 
-    /// Where the running derivative of the anchor's own orbit exceeds
+    /// Where the running derivative of the anchor's own orbit reaches
     /// `value`, or why it does not.
     pub fn derivative_passes(&self, fractal: &Fractal, value: Real) -> Derivative {
         let plus_one = if fractal.julia.is_none() { 1.0 } else { 0.0 };
@@ -148,7 +148,7 @@ impl Reference {
         let mut dr: Real = 1.0;
         for (i, z) in self.main.z[self.start..].iter().enumerate() {
             let r2 = z[0] * z[0] + z[1] * z[1] + z[2] * z[2];
-            if dr > value {
+            if dr >= value {
                 return Derivative::Passes(i as u32);
             }
             if r2 > escape2 {
