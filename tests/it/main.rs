@@ -17,6 +17,7 @@ mod layers;
 mod limits;
 mod locations;
 mod names;
+mod palette;
 mod quality;
 mod recipes;
 mod resume;
