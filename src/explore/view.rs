@@ -104,6 +104,11 @@ impl View {
                     "{name}: the scene leaves {effect} off; turn it on in the timeline first"
                 ));
             }
+            if palette_part_missing(scene, name) {
+                return Err(format!(
+                    "{name}: the scene's look has no such palette or stop; add it in the timeline first"
+                ));
+            }
             if *name == zoom && values[0] <= 0.0 {
                 return Err(format!(
                     "{name}: a camera distance must be positive, got {}",
@@ -136,15 +141,33 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
 
 /// The numbers at parameter `name`'s field of a scene written as JSON
 /// (coordinates written as digits, as their nearest numbers). A look's
-/// exposure of 1 is left out of the JSON.
+/// exposure of 1 is left out of the JSON. A palette stop's parameter
+/// indexes its list (`look.palette.stops[1].colour`).
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
+    use crate::spans::Step;
     let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
-    match name.split('.').try_fold(scene, |v, step| v.get(step)) {
+    let found = crate::spans::steps(name)
+        .iter()
+        .try_fold(scene, |v, step| match step {
+            Step::Field(f) | Step::Key(f) => v.get(f),
+            Step::Index(i) => v.get(i),
+        });
+    match found {
         Some(serde_json::Value::Array(a)) => a.iter().map(number).collect(),
         Some(v) if !v.is_null() => Some(vec![number(v)?]),
         _ if name == "look.exposure" => Some(vec![1.0]),
         _ => None,
     }
+}
+
+/// Whether `name` is a part of the look's palette that `scene` lacks: the
+/// palette, or the stop the name indexes.
+fn palette_part_missing(scene: &Scene, name: &str) -> bool {
+    if !name.starts_with("look.palette.") {
+        return false;
+    }
+    let scene = serde_json::to_value(scene).unwrap_or_default();
+    field(&scene, name).is_none()
 }
 
 /// The effect `name` is a field of (`effects.glow`), where the scene
@@ -195,6 +218,44 @@ mod tests {
     }
 
     #[test]
+    fn a_palettes_stops_show_and_take_edits() {
+        let text = "(fps: 1, frames: 1, size: (8, 6), scene: (look: (palette: (stops: [
+            (position: 0, colour: (1, 0, 0)), (position: 1, colour: (0, 0, 1))]))))";
+        let t = Timeline::parse(text, Path::new("p.ron")).unwrap();
+        let shown = values(&t, 0);
+        assert_eq!(
+            shown["look.palette.stops[1].colour"],
+            Some(vec![0.0, 0.0, 1.0])
+        );
+        assert_eq!(shown["look.palette.stops[1].position"], Some(vec![1.0]));
+        assert_eq!(shown["look.palette.stops[2].colour"], None);
+        assert_eq!(shown["look.palette.mix"], Some(vec![1.0]));
+        let mut view = View::default();
+        let green = vec![0.0, 1.0, 0.0];
+        view.overrides
+            .insert("look.palette.stops[1].colour".into(), green);
+        let scene = &view.prepare(&t).unwrap().scenes[0];
+        let stop = scene.look.palette.as_ref().unwrap().stops[1];
+        assert_eq!(stop.colour, crate::math::Vec3::new(0.0, 1.0, 0.0));
+        view.overrides
+            .insert("look.palette.stops[2].colour".into(), vec![1.0; 3]);
+        assert!(view
+            .prepare(&t)
+            .err()
+            .unwrap()
+            .contains("no such palette or stop"));
+        // Saved into the file where the stop is written.
+        let edit = crate::timeline::edit::Edit::SetScene {
+            parameter: "look.palette.stops[1].colour".into(),
+            value: crate::timeline::KeyValue::Triple(0.0, 1.0, 0.0),
+        };
+        let saved = crate::timeline::edit::apply(text, &edit).unwrap();
+        let t = Timeline::parse(&saved, Path::new("p.ron")).unwrap();
+        let stop = t.scene_at(0).look.palette.unwrap().stops[1];
+        assert_eq!(stop.colour, crate::math::Vec3::new(0.0, 1.0, 0.0));
+    }
+
+    #[test]
     fn bad_views_say_what_is_wrong() {
         let t = zoom();
         let error = |view: View| view.prepare(&t).err().unwrap();
@@ -218,6 +279,7 @@ mod tests {
         assert!(at("fractal.julia", vec![0.1, 0.2, 0.3]).prepare(&t).is_ok());
         assert!(at("camera.focus_distance", vec![2.0]).prepare(&t).is_ok());
         assert_eq!(values(&t, 0)["look.exposure"], Some(vec![1.0]));
+        assert!(error(at("look.palette.mix", vec![0.5])).contains("no such palette"));
         let huge = View {
             size: Some("3841x2160".into()),
             ..View::default()

@@ -142,7 +142,8 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
             |i, ray, hit, (nrm, evals)| {
                 stats.normal_evaluations += evals as u64;
                 sums.spent[order[i]] += evals as u64;
-                surfaces[i] = Some(SurfacePoint::from_hit(ray, hit, nrm));
+                let at = SurfacePoint::from_hit(ray, hit, nrm);
+                surfaces[i] = Some(at.coloured(&scene.look, &scene.fractal));
             },
         );
         band_shadows(scene, surfaces, walks, shadows);
@@ -220,6 +221,7 @@ impl RowSums<'_> {
             t,
             normal: nrm,
             traps,
+            palette_quantity,
             ..
         } = at;
         self.hits[p] += 1;
@@ -229,7 +231,7 @@ impl RowSums<'_> {
         }
         // Only a requested albedo layer pays for the albedo.
         if let Some(row) = self.albedo.as_deref_mut() {
-            row[p] += scene.look.albedo(&traps);
+            row[p] += scene.look.albedo(&traps, palette_quantity);
         }
         if let Some(row) = self.traps.as_deref_mut() {
             let v = [

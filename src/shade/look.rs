@@ -2,6 +2,7 @@
 //! sets, with their defaults.
 
 use super::lighting::Light;
+use super::palette::Palette;
 use crate::color::Display;
 use crate::color::ToneMap;
 use crate::math::{DVec3, Vec3};
@@ -26,6 +27,11 @@ pub struct Look {
     pub trap_z_colour: Vec3,
     /// How strongly the origin trap darkens crevices (0 = not at all).
     pub trap_occlusion: f32,
+    /// A gradient that colours the surface by an orbit quantity, mixed
+    /// over the trap colours; none by default. Left out of a scene's
+    /// serialised form when absent, so frames without one keep their hashes.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub palette: Option<Palette>,
     /// Background at the top and bottom of the frame (by the camera's up vector).
     pub background_top: Vec3,
     pub background_bottom: Vec3,
@@ -71,6 +77,7 @@ impl Default for Look {
             trap_y_colour: Vec3::new(0.10, 0.35, 0.65),
             trap_z_colour: Vec3::new(0.85, 0.65, 0.20),
             trap_occlusion: 0.8,
+            palette: None,
             background_top: Vec3::new(0.02, 0.03, 0.06),
             background_bottom: Vec3::new(0.10, 0.09, 0.12),
             tone_map: ToneMap::Clip,

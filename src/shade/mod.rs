@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 mod fog;
 mod lighting;
 mod look;
+mod palette;
 mod path;
 mod shadow;
 mod sky;
@@ -25,6 +26,7 @@ mod sky;
 pub use fog::{fogged, glow, Fog, Glow};
 pub use lighting::{Light, Specular, MAX_LIGHTS};
 pub use look::Look;
+pub use palette::{mix_oklab, smooth_iterations, OrbitQuantity, Palette, Stop, Wrap, MAX_STOPS};
 #[cfg(test)]
 pub use path::trace_path;
 pub use path::{cone_direction, cosine_direction, trace_paths, PathScratch, PathTracing};
@@ -110,6 +112,9 @@ pub struct SurfacePoint {
     pub t: Real,
     pub footprint: Real,
     pub traps: OrbitTraps,
+    /// The orbit quantity the look's palette is driven by, where it has
+    /// one that shows (`coloured`); `None` costs nothing.
+    pub palette_quantity: Option<f32>,
 }
 
 impl SurfacePoint {
@@ -122,7 +127,17 @@ impl SurfacePoint {
             t: hit.t,
             footprint: ray.footprint(hit.t),
             traps: hit.estimate.traps,
+            palette_quantity: None,
         }
+    }
+
+    /// This point with the orbit quantity `look`'s palette needs, where it
+    /// has a palette with some mix: a palette that is off runs no orbit.
+    pub fn coloured(mut self, look: &Look, fractal: &crate::fractal::Fractal) -> Self {
+        if let Some(palette) = look.palette.as_ref().filter(|p| p.mix > 0.0) {
+            self.palette_quantity = Some(palette.quantity(fractal, self.point, &self.traps));
+        }
+        self
     }
 }
 

@@ -194,7 +194,7 @@ impl Tracing<'_> {
         for (i, path) in paths.iter_mut().enumerate() {
             let Some(path) = path else { continue };
             let here = &path.here;
-            let albedo = self.look.albedo(&here.traps);
+            let albedo = self.look.albedo(&here.traps, here.palette_quantity);
             for (l, (to_light, brightness)) in self.look.lights().enumerate() {
                 let k = 3 + 2 * l as u32;
                 let dir = if self.sun_half_angle > 0.0 {
@@ -372,7 +372,7 @@ pub fn trace_paths(
             let path = paths[i].as_mut().expect("a path that goes on");
             path.here = SurfacePoint {
                 t: path.here.t + hit.t,
-                ..SurfacePoint::from_hit(ray, hit, nrm)
+                ..SurfacePoint::from_hit(ray, hit, nrm).coloured(look, fractal)
             };
         });
     }

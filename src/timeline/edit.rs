@@ -115,8 +115,9 @@ fn set_scene(text: &str, name: &str, value: &KeyValue) -> Result<String, String>
             return Err(format!("scene.{name} is a whole number, got {v}"));
         }
     }
+    // A palette stop's parameter indexes its list: `look.palette.stops[1].colour`.
     let mut path = vec![Step::Field("scene".into())];
-    path.extend(name.split('.').map(|field| Step::Field(field.into())));
+    path.extend(spans::steps(name));
     set_field(text, &path, &written)
 }
 

@@ -8,6 +8,7 @@ use super::messages::Shown;
 use super::validate::{colour, counted, non_negative, positive, rule, Checked};
 use crate::math::{DVec3, Real, Vec3};
 use crate::scene::Scene;
+use crate::shade::{Stop, MAX_STOPS};
 use Shape::{Number, Triple};
 
 /// A parameter's value: one number, or a triple such as a position or colour.
@@ -79,11 +80,12 @@ pub const MIN_FOV_DEGREES: Real = 1e-7;
 /// Every animatable parameter, group by group in the order validation
 /// checks them (`validate_scene` runs each group's checks between the
 /// scene's other ones; quality's and look's in `validate::*_CHECKS` order).
-pub const GROUPS: [&[Parameter]; 9] = [
+pub const GROUPS: [&[Parameter]; 10] = [
     CAMERA,
     FRACTAL,
     QUALITY,
     LOOK,
+    PALETTE,
     SHADOWS,
     AMBIENT_OCCLUSION,
     SPECULAR,
@@ -470,6 +472,117 @@ pub(super) const LOOK: &[Parameter] = &[
     look_colour!("look.background_top", background_top),
     look_colour!("look.background_bottom", background_bottom),
 ];
+
+/// A palette's number: a track may animate it only where the scene's look
+/// has a palette (`Timeline::parse` checks), which its setter relies on.
+const PALETTE_NUMBER: &str = "number (the look must have a `palette`)";
+/// A stop's value: only a stop the palette has.
+const STOP_POSITION: &str = "number in [0, 1], at or after the stop before (the stop must exist)";
+const STOP_COLOUR: &str = "triple (the stop must exist)";
+
+/// A field of the look's palette: checked and set only where the look has one.
+macro_rules! palette_field {
+    ($name:literal, $field:ident, $check:expr) => {
+        Parameter {
+            name: $name,
+            shape: Number,
+            doc: PALETTE_NUMBER,
+            check: |s| s.look.palette.as_ref().map_or(Ok(()), |p| $check(p.$field)),
+            set: |s, v| {
+                s.look
+                    .palette
+                    .iter_mut()
+                    .for_each(|p| p.$field = v[0] as f32)
+            },
+        }
+    };
+}
+
+/// Stop `$i`'s position and colour: checked and set only where the
+/// palette has that stop. A position lies in [0, 1], at or after the
+/// position before it.
+macro_rules! palette_stop {
+    ($i:literal) => {
+        [
+            Parameter {
+                name: concat!("look.palette.stops[", $i, "].position"),
+                shape: Number,
+                doc: STOP_POSITION,
+                check: |s| stop_check(s, $i, |before, stop| stop_position(before, stop.position)),
+                set: |s, v| stop_set(s, $i, |stop| stop.position = v[0] as f32),
+            },
+            Parameter {
+                name: concat!("look.palette.stops[", $i, "].colour"),
+                shape: Triple,
+                doc: STOP_COLOUR,
+                check: |s| stop_check(s, $i, |_, stop| colour(stop.colour)),
+                set: |s, v| stop_set(s, $i, |stop| stop.colour = colour_of(v)),
+            },
+        ]
+    };
+}
+
+/// `check` of stop `i` (given the position before it) where the scene's
+/// palette has it.
+fn stop_check(s: &Scene, i: usize, check: impl Fn(f32, &Stop) -> Checked) -> Checked {
+    let Some(stops) = s.look.palette.as_ref().map(|p| &p.stops) else {
+        return Ok(());
+    };
+    let before = i
+        .checked_sub(1)
+        .and_then(|b| stops.get(b))
+        .map_or(0.0, |b| b.position);
+    stops.get(i).map_or(Ok(()), |stop| check(before, stop))
+}
+
+/// `set` applied to stop `i` where the scene's palette has it.
+fn stop_set(s: &mut Scene, i: usize, set: impl FnOnce(&mut Stop)) {
+    if let Some(stop) = s.look.palette.as_mut().and_then(|p| p.stops.get_mut(i)) {
+        set(stop);
+    }
+}
+
+/// A stop's position: in [0, 1], and not before the stop before it (at
+/// `before`; equal makes a hard edge).
+fn stop_position(before: f32, position: f32) -> Checked {
+    fraction(position)?;
+    rule(position >= before, || {
+        format!(
+            "stops go in order of position: {} comes before the stop before it, at {}",
+            position.shown(),
+            before.shown()
+        )
+    })
+}
+
+/// Any finite number.
+fn finite_f32(v: f32) -> Checked {
+    finite(v.is_finite(), v)
+}
+
+const STOPS: [[Parameter; 2]; MAX_STOPS] = [
+    palette_stop!(0),
+    palette_stop!(1),
+    palette_stop!(2),
+    palette_stop!(3),
+    palette_stop!(4),
+    palette_stop!(5),
+    palette_stop!(6),
+    palette_stop!(7),
+];
+
+pub(super) const PALETTE: &[Parameter] = &{
+    let mut all = [STOPS[0][0]; 3 + 2 * MAX_STOPS];
+    all[0] = palette_field!("look.palette.scale", scale, finite_f32);
+    all[1] = palette_field!("look.palette.offset", offset, finite_f32);
+    all[2] = palette_field!("look.palette.mix", mix, fraction);
+    let mut i = 0;
+    while i < 2 * MAX_STOPS {
+        all[3 + i] = STOPS[i / 2][i % 2];
+        i += 1;
+    }
+    all
+};
 
 /// An effect's number: a track may animate it only where the scene enables
 /// the effect (`Timeline::parse` checks), which its setter relies on.

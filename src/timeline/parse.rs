@@ -256,6 +256,9 @@ impl Source<'_> {
                     )));
                 }
             }
+            if let Some(missing) = palette_missing(&file.scene, name) {
+                return Err(at((String::new(), missing)));
+            }
             if spec.keys.is_empty() {
                 return Err(at((
                     ".keys".into(),
@@ -337,6 +340,32 @@ impl Source<'_> {
             ),
         )
     }
+}
+
+/// What a track named `name` of the look's palette lacks in `scene`:
+/// the palette itself, or the stop it animates.
+fn palette_missing(scene: &Scene, name: &str) -> Option<String> {
+    let rest = name.strip_prefix("look.palette.")?;
+    let Some(palette) = &scene.look.palette else {
+        return Some(
+            "animates the look's palette, which the scene does not have: add `palette: ()` \
+             (or its stops) to scene.look"
+                .into(),
+        );
+    };
+    let stop: usize = rest
+        .strip_prefix("stops[")?
+        .split(']')
+        .next()?
+        .parse()
+        .ok()?;
+    let count = palette.stops.len();
+    (stop >= count).then(|| {
+        format!(
+            "animates stop {stop} of the palette, which has {count} (stops[0] to stops[{}])",
+            count - 1
+        )
+    })
 }
 
 /// `message` about key `k` of `track`, with the key's value as written

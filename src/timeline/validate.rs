@@ -9,7 +9,7 @@ use super::limits::{
 use super::messages::Shown;
 use super::parameters::Parameter;
 use super::parameters::{
-    AMBIENT_OCCLUSION, CAMERA, FOG, FRACTAL, GLOW, LOOK, QUALITY, SHADOWS, SPECULAR,
+    AMBIENT_OCCLUSION, CAMERA, FOG, FRACTAL, GLOW, LOOK, PALETTE, QUALITY, SHADOWS, SPECULAR,
 };
 use crate::error::Result;
 use crate::math::{Real, Vec3};
@@ -119,6 +119,7 @@ pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
         at("adaptive.noise", noise(a.noise))?;
     }
     animatable_in(s, LOOK, &LOOK_CHECKS)?;
+    palette(s)?;
     extra_lights(s)?;
     effects(s)
 }
@@ -199,6 +200,20 @@ fn projection(c: &crate::camera::Camera) -> Result<(), Invalid> {
         at("camera.stereo.eye_separation", checked)?;
     }
     Ok(())
+}
+
+/// The look's palette, where it has one: 1 to `MAX_STOPS` stops, then
+/// each animatable part (stops in order, within [0, 1]).
+fn palette(s: &Scene) -> Result<(), Invalid> {
+    let Some(p) = &s.look.palette else {
+        return Ok(());
+    };
+    let (count, most) = (p.stops.len(), crate::shade::MAX_STOPS);
+    let stops = rule((1..=most).contains(&count), || {
+        format!("a palette has 1 to {most} stops, got {count}")
+    });
+    at("look.palette.stops", stops)?;
+    animatable(s, PALETTE)
 }
 
 fn extra_lights(s: &Scene) -> Result<(), Invalid> {

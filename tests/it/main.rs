@@ -18,6 +18,7 @@ mod layers;
 mod limits;
 mod locations;
 mod names;
+mod palette;
 mod projections;
 mod quality;
 mod recipes;

@@ -27,6 +27,7 @@ fn every_light_adds_its_light_and_casts_its_shadow() {
             origin: 1.0,
             planes: DVec3::splat(1.0),
         },
+        palette_quantity: None,
     };
     let effects = Effects {
         shadows: Some(Shadows::default()),
@@ -47,7 +48,7 @@ fn every_light_adds_its_light_and_casts_its_shadow() {
         &at,
         &mut c2,
     );
-    let albedo = one.albedo(&at.traps);
+    let albedo = one.albedo(&at.traps, None);
     let extra = albedo * Vec3::ONE * (0.5 * std::f32::consts::FRAC_1_SQRT_2);
     assert!((b - a - extra).length() < 1e-5, "{b} vs {a} + {extra}");
     // One shadow march per light that faces the surface.
@@ -74,6 +75,7 @@ fn lambert_is_ambient_only_facing_away_and_brightest_facing_light() {
             t: 1.0,
             footprint: 1e-3,
             traps: traps_far(),
+            palette_quantity: None,
         };
         let mut counts = StageCounts::default();
         let c = look.shade(
@@ -88,7 +90,7 @@ fn lambert_is_ambient_only_facing_away_and_brightest_facing_light() {
     };
     let lit = plain(light);
     let unlit = plain(-light);
-    let albedo = look.albedo(&traps_far());
+    let albedo = look.albedo(&traps_far(), None);
     assert!((unlit - albedo * look.ambient).length() < 1e-6);
     assert!((lit - albedo * (look.ambient + look.light_colour)).length() < 1e-6);
 }
@@ -96,17 +98,17 @@ fn lambert_is_ambient_only_facing_away_and_brightest_facing_light() {
 #[test]
 fn far_traps_give_base_colour_and_plane_traps_pull() {
     let look = Look::default();
-    assert!((look.albedo(&traps_far()) - look.base_colour).length() < 1e-6);
+    assert!((look.albedo(&traps_far(), None) - look.base_colour).length() < 1e-6);
     let on_x_plane = OrbitTraps {
         planes: DVec3::new(0.0, 1.0, 1.0),
         ..traps_far()
     };
-    assert!((look.albedo(&on_x_plane) - look.trap_x_colour).length() < 1e-6);
+    assert!((look.albedo(&on_x_plane, None) - look.trap_x_colour).length() < 1e-6);
     let crevice = OrbitTraps {
         origin: 0.0,
         ..traps_far()
     };
-    assert!(look.albedo(&crevice).length() < look.albedo(&traps_far()).length());
+    assert!(look.albedo(&crevice, None).length() < look.albedo(&traps_far(), None).length());
 }
 
 #[test]

@@ -50,6 +50,7 @@ fn unit_ball() -> Fractal {
 mod fog;
 mod lighting;
 mod look;
+mod palette;
 mod path;
 mod shadow;
 mod sky;

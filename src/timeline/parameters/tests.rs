@@ -14,6 +14,12 @@ fn every_parameter_sets_its_field() {
         },
         ..Scene::default()
     };
+    let mut all_effects = all_effects;
+    all_effects.look.palette = Some(crate::shade::Palette {
+        stops: vec![crate::shade::Palette::default().stops[0]; MAX_STOPS],
+        scale: 1.0,
+        ..Default::default()
+    });
     for p in all() {
         let mut scene = all_effects.clone();
         let before = scene.clone();
@@ -96,4 +102,97 @@ fn of_two_wrong_fields_validation_names_the_one_it_always_checked_first() {
     s.look.exposure = -1.0;
     s.look.background_top = crate::math::Vec3::splat(-1.0);
     assert_eq!(validate_scene(&s).unwrap_err().0, "look.background_top");
+}
+
+/// The error parsing timeline `text` gives.
+fn error_of(text: &str) -> String {
+    crate::timeline::Timeline::parse(text, std::path::Path::new("test.ron"))
+        .expect_err("timeline should be rejected")
+        .to_string()
+}
+
+/// A timeline of two frames whose look has the palette `palette`, with `tracks`.
+fn palette_timeline(palette: &str, tracks: &str) -> String {
+    format!(
+        "(fps: 1, frames: 2, size: (8, 6),\n scene: (look: (palette: {palette})),\n tracks: {{ {tracks} }})"
+    )
+}
+
+#[test]
+fn palette_parts_animate_from_tracks() {
+    let text = palette_timeline(
+        "(stops: [(position: 0, colour: (1, 0, 0)), (position: 1, colour: (0, 0, 1))])",
+        "\"look.palette.offset\": (interpolation: Linear, keys: [(time: 0, value: 0), (time: 1, value: 0.5)]),\n \
+         \"look.palette.stops[1].colour\": (keys: [(time: 0, value: (0, 1, 0))])",
+    );
+    let t = crate::timeline::Timeline::parse(&text, std::path::Path::new("test.ron")).unwrap();
+    let (a, b) = (t.scene_at(0), t.scene_at(1));
+    let (pa, pb) = (a.look.palette.unwrap(), b.look.palette.unwrap());
+    assert_eq!((pa.offset, pb.offset), (0.0, 0.5));
+    assert_eq!(pb.stops[1].colour, crate::math::Vec3::new(0.0, 1.0, 0.0));
+    assert_eq!(pb.by, crate::shade::OrbitQuantity::SmoothIterations);
+}
+
+#[test]
+fn bad_palettes_are_refused_at_their_line_and_column() {
+    let stops = |positions: &[&str]| {
+        let stops: Vec<String> = positions
+            .iter()
+            .map(|p| format!("(position: {p}, colour: (1, 1, 1))"))
+            .collect();
+        format!("(stops: [{}])", stops.join(", "))
+    };
+    // Out of order: the later stop's position, where it is written.
+    let e = error_of(&palette_timeline(&stops(&["0.5", "0.25"]), ""));
+    assert!(
+        e.starts_with("test.ron:2:82: scene.look.palette.stops[1].position: stops go in order"),
+        "{e}"
+    );
+    let e = error_of(&palette_timeline(&stops(&["0", "1.5"]), ""));
+    assert!(
+        e.starts_with("test.ron:2:80: scene.look.palette.stops[1].position: must be in [0, 1]"),
+        "{e}"
+    );
+    let e = error_of(&palette_timeline(&stops(&["0"; MAX_STOPS + 1]), ""));
+    assert!(
+        e.starts_with("test.ron:2:34: scene.look.palette.stops: a palette has 1 to 8 stops, got 9"),
+        "{e}"
+    );
+    let e = error_of(&palette_timeline("(stops: [])", ""));
+    assert!(e.contains("got 0"), "{e}");
+    let e = error_of(&palette_timeline("(by: Hue)", ""));
+    assert!(e.starts_with("test.ron:2:31:"), "{e}");
+    assert!(e.contains("palette.by") && e.contains("Hue"), "{e}");
+    let e = error_of(&palette_timeline("(mix: 2)", ""));
+    assert!(
+        e.contains("scene.look.palette.mix: must be in [0, 1]"),
+        "{e}"
+    );
+}
+
+#[test]
+fn palette_tracks_need_the_palette_and_the_stop() {
+    let track = |name: &str| format!("\"{name}\": (keys: [(time: 0, value: 0.5)])");
+    let text = "(fps: 1, frames: 2, size: (8, 6), tracks: { \"look.palette.mix\": (keys: [(time: 0, value: 0.5)]) })";
+    let e = error_of(text);
+    assert!(e.contains("which the scene does not have"), "{e}");
+    let e = error_of(&palette_timeline(
+        "(stops: [(position: 0, colour: (1, 0, 0))])",
+        &track("look.palette.stops[1].position"),
+    ));
+    assert!(e.contains("stop 1 of the palette, which has 1"), "{e}");
+    // A key out of range is blamed on its own line.
+    let e = error_of(&palette_timeline(
+        "()",
+        &track("look.palette.stops[0].position").replace("0.5", "-1"),
+    ));
+    assert!(e.starts_with("test.ron:3:"), "{e}");
+    assert!(e.contains("must be in [0, 1]"), "{e}");
+}
+
+#[test]
+fn a_scene_without_a_palette_serialises_as_before() {
+    let scene = Scene::default();
+    let json = serde_json::to_string(&scene).unwrap();
+    assert!(!json.contains("palette"), "{json}");
 }
