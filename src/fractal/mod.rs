@@ -154,8 +154,10 @@ pub struct AutoIterations {
 }
 
 impl AutoIterations {
-    /// The margin `Auto` alone takes.
-    pub const DEFAULT_MARGIN: u32 = 2;
+    /// The margin `Auto` alone takes: the target's derivative grows
+    /// fastest, and the surface elsewhere in the frame needs a few more
+    /// (docs/iterations.md measures it).
+    pub const DEFAULT_MARGIN: u32 = 6;
     /// The largest margin: each iteration multiplies the derivative about
     /// eightfold at power 8, so past this the margin alone is 1e90 pixels.
     pub const MAX_MARGIN: u32 = 100;
