@@ -1,5 +1,6 @@
-//! The HTTP routes: the page, the timeline's state, renders, picks, edits,
-//! saves and server-sent events. Every route is behind `guard::check`.
+//! The HTTP routes: the page, the timeline's state and a frame's values
+//! (with `iterations: Auto`'s count), renders, picks, edits, saves and
+//! server-sent events. Every route is behind `guard::check`.
 
 use super::renderer::Stage;
 use super::view::View;
@@ -21,6 +22,7 @@ pub fn router(state: Arc<State>) -> Router {
         .route("/explore.css", get(super::page::style))
         .route("/api/state", get(timeline_state))
         .route("/api/values", get(values))
+        .route("/api/iterations", get(iterations))
         .route("/api/render", post(render))
         .route("/api/pick", post(pick))
         .route("/api/estimate", post(estimate))
@@ -140,6 +142,22 @@ async fn values(state: Shared, query: axum::extract::Query<FrameQuery>) -> Respo
         return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
     }
     Json(super::view::values(&timeline, query.frame)).into_response()
+}
+
+async fn iterations(state: Shared, query: axum::extract::Query<FrameQuery>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    if query.frame >= timeline.frame_count {
+        let last = timeline.frame_count - 1;
+        let message = format!("frame {} is past the last frame ({last})", query.frame);
+        return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
+    }
+    // A deep frame's first count follows a high-precision orbit.
+    let shown =
+        tokio::task::spawn_blocking(move || super::view::iterations(&timeline, query.frame));
+    match shown.await {
+        Ok(shown) => Json(shown).into_response(),
+        Err(e) => refused(StatusCode::INTERNAL_SERVER_ERROR, format!("failed: {e}")),
+    }
 }
 
 #[derive(Deserialize)]

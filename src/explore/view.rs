@@ -6,12 +6,15 @@
 use crate::job::request::MAX_SAMPLES;
 use crate::scene::Scene;
 use crate::timeline::Timeline;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// The most pixels a view may have: a 4K frame. A larger one is a render's
 /// job, whose memory is checked before it starts.
 pub const MAX_VIEW_PIXELS: u64 = 3840 * 2160;
+
+/// The parameter `iterations: Auto` sets: read-only while the scene says so.
+const AUTO_FIELD: &str = "fractal.iterations";
 
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -99,6 +102,11 @@ impl View {
             if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
                 return Err(format!("{name}: values must be finite, got {bad}"));
             }
+            if *name == AUTO_FIELD && scene.fractal.auto.is_some() {
+                return Err(format!(
+                    "{name}: the timeline's scene says `Auto`, which chooses each frame's count: write a number in place of `Auto` in the timeline's text to fix it"
+                ));
+            }
             if let Some(effect) = effect_left_off(scene, name) {
                 return Err(format!(
                     "{name}: the scene leaves {effect} off; turn it on in the timeline first"
@@ -137,6 +145,41 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
             (p.name, field(&scene, p.name))
         })
         .collect()
+}
+
+/// A frame's iteration count as the page shows it: with `Auto`, the count
+/// it chose and what decided it, read-only.
+#[derive(Debug, Serialize)]
+pub struct Iterations {
+    /// `Auto`'s margin; none where the timeline gives the count.
+    pub margin: Option<u32>,
+    pub count: u32,
+    /// What decided an `Auto` count (`auto::Decided::name`).
+    pub decided: Option<&'static str>,
+    /// One line for the page: `Auto → 13 (target)`, or the count.
+    pub shown: String,
+}
+
+/// The iteration count of `frame`, which must be one of the timeline's.
+pub fn iterations(timeline: &Timeline, frame: u32) -> Iterations {
+    let margin = timeline.base.fractal.auto.map(|a| a.margin);
+    match timeline.auto_count(frame) {
+        Some(resolved) => Iterations {
+            margin,
+            count: resolved.count,
+            decided: Some(resolved.decided.name()),
+            shown: format!("Auto → {} ({})", resolved.count, resolved.decided.name()),
+        },
+        None => {
+            let count = timeline.scene_at(frame).fractal.iterations;
+            Iterations {
+                margin,
+                count,
+                decided: None,
+                shown: count.to_string(),
+            }
+        }
+    }
 }
 
 /// The numbers at parameter `name`'s field of a scene written as JSON

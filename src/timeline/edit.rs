@@ -109,6 +109,7 @@ fn set_scene(text: &str, name: &str, value: &KeyValue) -> Result<String, String>
             "{ZOOM_TRACK} is no scene field: only a track sets it"
         ));
     }
+    auto_kept(text, name)?;
     let written = written(value, parameter)?;
     if let (true, KeyValue::Number(v)) = (WHOLE_NUMBERS.contains(&name), value) {
         if v.fract() != 0.0 || !(0.0..=u32::MAX as Real).contains(v) {
@@ -119,6 +120,23 @@ fn set_scene(text: &str, name: &str, value: &KeyValue) -> Result<String, String>
     let mut path = vec![Step::Field("scene".into())];
     path.extend(spans::steps(name));
     set_field(text, &path, &written)
+}
+
+/// Refuses a number for `fractal.iterations`, as a scene value or a key,
+/// where the scene writes `Auto`: a number there would silently end the
+/// per-frame choice, so switching to a fixed count is the author's, in the
+/// text.
+fn auto_kept(text: &str, name: &str) -> Result<(), String> {
+    const ITERATIONS: &str = "fractal.iterations";
+    let path = ["scene", "fractal", "iterations"].map(|f| Step::Field(f.into()));
+    let auto = name == ITERATIONS
+        && spans::range_at(text, &path).is_some_and(|r| text[r].trim_start().starts_with("Auto"));
+    match auto {
+        true => Err(format!(
+            "scene.{ITERATIONS} is `Auto`, which chooses each frame's count: the explorer writes no number over it; to fix the count, write a number in place of `Auto` in the timeline's text"
+        )),
+        false => Ok(()),
+    }
 }
 
 /// The field at `path` set to `value`: replaced where written (inside its
@@ -154,6 +172,7 @@ fn set_field(text: &str, path: &[Step], value: &str) -> Result<String, String> {
 
 fn set_key(text: &str, track: &str, time: Real, value: &KeyValue) -> Result<String, String> {
     let value = written(value, parameter(track)?)?;
+    auto_kept(text, track)?;
     let time_text = key_time_text(time)?;
     let Some(keys) = keys(text, track)? else {
         let key = format!("(time: {time_text}, value: {value})");

@@ -6,7 +6,7 @@ use super::limits::count_message;
 use super::schema::KeyValue;
 use crate::error::Error;
 use crate::math::{DVec3, Real, Vec3};
-use crate::spans;
+use crate::spans::{self, Place};
 use std::path::Path;
 
 /// The number written at `line`:`column` (1-based), where a parse error
@@ -105,6 +105,10 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
     // missing), else from the brackets and names before the error.
     let typed =
         spans::path_at(text, line, column).or_else(|| super::scan::path_at(text, line, column));
+    let typed = match (&e.code, typed) {
+        (Ron::Message(m), Some(typed)) => Some(field_named(text, typed, m)),
+        (_, typed) => typed,
+    };
     let shown = typed
         .as_ref()
         .map_or((line, column), |(_, at)| (at.line, at.column));
@@ -192,6 +196,19 @@ pub(super) fn syntax_message(text: &str, e: &ron::error::SpannedError) -> ((usiz
             format!("{in_field}expected a field name here (`name: value`), got `{found}`"),
         ),
         code => (shown, named(format!("{in_field}{code}"))),
+    }
+}
+
+/// A visitor's message about one field of the value it read whole (`margin
+/// must be 0..=100` in `Auto(margin: -1)`), which RON places at the value's
+/// end: that field's path and place, where the value has a field so named.
+fn field_named(text: &str, (path, place): (String, Place), message: &str) -> (String, Place) {
+    let name = message.split_whitespace().next().unwrap_or_default();
+    let inner = format!("{path}.{name}");
+    let plain = !name.is_empty() && name.chars().all(|c| c.is_alphanumeric() || c == '_');
+    match plain.then(|| spans::place_of(text, &inner)).flatten() {
+        Some(at) => (inner, at),
+        None => (path, place),
     }
 }
 

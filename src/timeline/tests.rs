@@ -1015,11 +1015,13 @@ fn bad_auto_iterations_are_refused_at_their_place() {
         );
         error_of(&text)
     };
-    let e = at("Auto(margin: -1)");
-    assert!(
-        e.starts_with("test.ron:3:") && e.contains("margin must be 0..=100, got -1"),
-        "{e}"
-    );
+    // At the margin's value, not at the `)` after it.
+    for (margin, told) in [("-1", "0..=100, got -1"), ("200", "0..=100, got 200")] {
+        let e = at(&format!("Auto(margin: {margin})"));
+        let want =
+            format!("test.ron:3:30: `scene.fractal.iterations.margin`: margin must be {told}");
+        assert!(e.starts_with(&want), "{e}");
+    }
     for word in ["Banana", "Automatic", "()"] {
         let e = at(word);
         assert!(e.starts_with("test.ron:3:17: "), "{e}");

@@ -5,7 +5,7 @@
 use crate::util::{stdout, Dir};
 
 /// A zoom from the whole bulb to a point on its pole, 64×36, with `Auto`.
-const ZOOM: &str = "(
+pub(super) const ZOOM: &str = "(
     fps: 24,
     frames: 3,
     size: (64, 36),
@@ -19,7 +19,7 @@ const ZOOM: &str = "(
 )";
 
 /// The counts `info` prints for frames 0..=2 (`frames A..=B: N (…)` lines).
-fn counts(info: &str) -> Vec<u32> {
+pub(super) fn counts(info: &str) -> Vec<u32> {
     let mut counts = Vec::new();
     for line in info.lines() {
         let Some(rest) = line.strip_prefix("          frame") else {

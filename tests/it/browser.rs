@@ -356,3 +356,37 @@ async fn author(client: &Client, url: &str) -> (Vec<u8>, Vec<u8>) {
     until(client, "!page.state.dirty").await;
     (seen_0, seen_12)
 }
+
+#[test]
+fn the_page_shows_auto_iterations_count_read_only() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    let dir = Dir::new();
+    dir.write("zoom.ron", crate::auto::ZOOM);
+    let info = crate::util::stdout(&dir.ok(&["info", "zoom.ron"]));
+    let count = crate::auto::counts(&info)[2];
+    let (_server, url) = explore(&dir, "zoom.ron");
+    let (_driver, driver_url) = chromedriver();
+    let profile = dir.path().join("chromium-profile");
+    let runtime = tokio::runtime::Runtime::new().expect("runtime");
+    runtime.block_on(async {
+        let client = browser(&driver_url, &profile).await;
+        client.goto(&url).await.expect("load the page");
+        settled(&client).await;
+        js(&client, "showFrame(2);").await;
+        let shown = format!("Auto → {count} (target)");
+        let note = "document.getElementById('auto-iterations')";
+        until(
+            &client,
+            &format!("{note} && {note}.textContent === '{shown}'"),
+        )
+        .await;
+        let field = "document.querySelector('.param[data-name=\"fractal.iterations\"] input')";
+        assert_eq!(
+            js(&client, &format!("return {field}.hidden;")).await,
+            json!(true)
+        );
+        client.close().await.expect("close the browser");
+    });
+}

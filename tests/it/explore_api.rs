@@ -671,3 +671,49 @@ fn edits_sent_together_take_turns() {
     let state = s.state()["text"].as_str().unwrap().to_string();
     assert!(state.contains("time: 5.5") && state.contains("time: 6.5"));
 }
+
+#[test]
+fn auto_iterations_are_shown_per_frame_and_never_written_over() {
+    use crate::auto::{counts, ZOOM};
+    let d = Dir::new();
+    d.write("zoom.ron", ZOOM);
+    let s = explore(&d, "zoom.ron");
+    // The counts shown are those `info` lists, frame by frame.
+    let info = stdout(&d.ok(&["info", "zoom.ron"]));
+    for (frame, count) in counts(&info).into_iter().enumerate() {
+        let shown = s.get(&format!("/api/iterations?frame={frame}")).expect(200);
+        let shown = shown.json();
+        assert_eq!(shown["count"], count, "frame {frame}: {shown}");
+        assert_eq!(shown["margin"], 1);
+        assert_eq!(shown["shown"], format!("Auto → {count} (target)"));
+    }
+    s.get("/api/iterations?frame=3").expect(422);
+
+    // A number over `Auto`, as a scene value, a key or a view's value, is
+    // refused with the way to fix the count, and the text stays as it was.
+    let refusals = [
+        json!({"kind": "set_scene", "parameter": "fractal.iterations", "value": [20]}),
+        json!({"kind": "set_key", "track": "fractal.iterations", "time": 0, "value": [20]}),
+    ];
+    for edit in refusals {
+        let refused = s.post("/api/edit", json!({ "edits": [edit] })).expect(422);
+        assert!(
+            refused.text().contains("writes no number over it"),
+            "{edit}: {}",
+            refused.text()
+        );
+        assert_eq!(s.state()["text"], ZOOM, "{edit} changed the text");
+    }
+    let view = json!({"frame": 0, "overrides": {"fractal.iterations": [20]}});
+    let refused = s.post("/api/render", json!({"view": view, "stage": "quick"}));
+    assert!(refused.expect(422).text().contains("says `Auto`"));
+
+    // A count the timeline gives is shown as it is.
+    d.write("fixed.ron", &ZOOM.replace("Auto(margin: 1)", "9"));
+    let fixed = explore(&d, "fixed.ron");
+    let shown = fixed.get("/api/iterations?frame=2").expect(200).json();
+    assert_eq!(
+        shown,
+        json!({"margin": null, "count": 9, "decided": null, "shown": "9"})
+    );
+}

@@ -9,6 +9,7 @@ const $ = (id) => document.getElementById(id);
 const page = {
   state: null,          // the timeline as the server shows it (/api/state)
   values: {},           // every parameter's value at this frame
+  iterations: null,     // this frame's count, as /api/iterations shows it
   frame: 0,
   overrides: {},        // parameter -> numbers, laid over the tracks' values
   selected: null,       // {track, index} of the selected key
@@ -80,9 +81,13 @@ async function showFrame(frame) {
   $("frame").value = $("slider").value = frame;
   $("time").textContent = `t = ${(frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
   const asked = page.valuesAsked = (page.valuesAsked || 0) + 1;
-  const values = await (await api(`/api/values?frame=${frame}`)).json();
+  const [values, iterations] = await Promise.all([
+    api(`/api/values?frame=${frame}`).then((r) => r.json()),
+    api(`/api/iterations?frame=${frame}`).then((r) => r.json()),
+  ]);
   if (asked !== page.valuesAsked) return;  // asked again meanwhile
   page.values = values;
+  page.iterations = iterations;
   drawStrip();
   fillControls();
   refresh();
@@ -544,6 +549,26 @@ function fillControls() {
       input.placeholder = numbers ? "" : "off";
     });
   }
+  showAutoIterations();
+}
+
+// `iterations: Auto` chooses each frame's count: shown, never edited here
+// (the server refuses a number over `Auto`).
+function showAutoIterations() {
+  const row = document.querySelector('.param[data-name="fractal.iterations"]');
+  const auto = page.iterations && page.iterations.decided;
+  if (!row) return;
+  let note = row.querySelector(".auto");
+  if (auto && !note) {
+    note = document.createElement("span");
+    note.className = "auto";
+    note.id = "auto-iterations";
+    note.title = "iterations: Auto chooses each frame's count; write a number in the timeline's text to fix it";
+    row.append(note);
+  }
+  if (note) note.hidden = !auto;
+  if (note && auto) note.textContent = page.iterations.shown;
+  row.querySelectorAll("input").forEach((input) => { input.hidden = Boolean(auto); });
 }
 
 function changeFromControl(row, name) {

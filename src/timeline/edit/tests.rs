@@ -577,3 +577,36 @@ fn a_target_set_by_a_track_is_not_overwritten() {
     let problem = set_target(text, "(0, 0, 0)").unwrap_err();
     assert!(problem.contains("\"camera.target\" track"), "{problem}");
 }
+
+#[test]
+fn no_number_is_written_over_auto_iterations() {
+    let text = "(fps: 10, frames: 11, scene: (fractal: (iterations: Auto(margin: 3))))";
+    let count = KeyValue::Number(20.0);
+    let edits = [
+        Edit::SetScene {
+            parameter: "fractal.iterations".into(),
+            value: count.clone(),
+        },
+        Edit::SetKey {
+            track: "fractal.iterations".into(),
+            time: 0.5,
+            value: count,
+        },
+    ];
+    for edit in edits {
+        let problem = apply(text, &edit).unwrap_err();
+        assert!(problem.contains("is `Auto`"), "{edit:?}: {problem}");
+    }
+    // A fixed count, and other fields beside `Auto`, are edited as ever.
+    let fixed = text.replace("Auto(margin: 3)", "12");
+    let set = Edit::SetScene {
+        parameter: "fractal.iterations".into(),
+        value: KeyValue::Number(20.0),
+    };
+    assert!(edited(&fixed, set).contains("iterations: 20"));
+    let power = Edit::SetScene {
+        parameter: "fractal.power".into(),
+        value: KeyValue::Number(7.0),
+    };
+    assert!(edited(text, power).contains("Auto(margin: 3)"));
+}
