@@ -322,7 +322,9 @@ mod tests {
         assert!(at("fractal.julia", vec![0.1, 0.2, 0.3]).prepare(&t).is_ok());
         assert!(at("camera.focus_distance", vec![2.0]).prepare(&t).is_ok());
         assert_eq!(values(&t, 0)["look.exposure"], Some(vec![1.0]));
-        assert!(error(at("look.palette.mix", vec![0.5])).contains("no such palette"));
+        // zoom.ron's palette has four stops.
+        let fifth = at("look.palette.stops[4].colour", vec![0.5, 0.5, 0.5]);
+        assert!(error(fifth).contains("no such palette or stop"));
         let huge = View {
             size: Some("3841x2160".into()),
             ..View::default()

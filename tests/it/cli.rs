@@ -763,7 +763,7 @@ fn pick_refine_settles_the_target_in_one_command() {
 
 #[test]
 fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
-    // deep_zoom.ron's last frame: the second round finds the camera inside
+    // deep_zoom.ron's frame 300: the second round finds the camera inside
     // the set; the command still gives the first round's target, and says so.
     let d = Dir::new();
     let deep = std::fs::read_to_string(concat!(
@@ -771,9 +771,9 @@ fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
         "/timelines/deep_zoom.ron"
     ));
     d.write("deep.ron", &deep.unwrap());
-    let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "539", "--refine"]));
+    let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "300", "--refine"]));
     assert!(
-        out.contains("Re-centred for frame 539:  target: (\""),
+        out.contains("Re-centred for frame 300:  target: (\""),
         "{out}"
     );
     let stopped = out

@@ -14,6 +14,7 @@ mod explore_api;
 mod farm;
 mod formats;
 mod fuzz;
+mod gallery;
 mod layers;
 mod limits;
 mod locations;

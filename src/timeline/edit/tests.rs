@@ -157,6 +157,10 @@ fn a_scene_value_set_in_every_example_reads_back() {
                 parameter: name.into(),
                 value: value.clone(),
             };
+            if name == "fractal.iterations" && before.base.fractal.auto.is_some() {
+                assert!(apply(&text, &set).is_err(), "{}", path.display());
+                continue;
+            }
             let result = edited(&text, set);
             let scene = spans::range_at(&text, &[Step::Field("scene".into())]).unwrap();
             check_kept(&text, &result, scene);
@@ -443,7 +447,7 @@ proptest! {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("timelines/zoom.ron");
         let mut text = std::fs::read_to_string(&path).unwrap();
         let mut model: BTreeMap<&str, BTreeMap<u64, Real>> = BTreeMap::new();
-        model.insert("camera.distance", [(0.0f64, 3.1), (5.0, 0.0002)].map(|(t, v)| (t.to_bits(), v)).into());
+        model.insert("camera.distance", [(0.0f64, 2.6), (5.0, 0.0002)].map(|(t, v)| (t.to_bits(), v)).into());
         model.insert("fractal.iterations", [(0.0f64, 10.0), (5.0, 18.0)].map(|(t, v)| (t.to_bits(), v)).into());
         for step in steps {
             match step {
