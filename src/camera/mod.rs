@@ -156,6 +156,17 @@ impl Camera {
         )
     }
 
+    /// The size of one eye's image in a `width`×`height` image (the image
+    /// itself without stereo), at least 1×1.
+    pub fn eye_size(&self, [width, height]: [u32; 2]) -> [u32; 2] {
+        let (w, h) = match self.stereo.map(|s| s.layout) {
+            Some(StereoLayout::SideBySide) => (width / 2, height),
+            Some(StereoLayout::TopBottom) => (width, height / 2),
+            None => (width, height),
+        };
+        [w.max(1), h.max(1)]
+    }
+
     /// The angle a pixel spans on the view's axis in a `width`×`height`
     /// image (of one eye where the image holds two).
     pub fn axis_pixel_angle(&self, [width, height]: [u32; 2]) -> Real {
@@ -163,12 +174,7 @@ impl Camera {
             stereo: None,
             ..self.clone()
         };
-        let (w, h) = match self.stereo.map(|s| s.layout) {
-            Some(StereoLayout::SideBySide) => (width / 2, height),
-            Some(StereoLayout::TopBottom) => (width, height / 2),
-            None => (width, height),
-        };
-        let (w, h) = (w.max(1), h.max(1));
+        let [w, h] = self.eye_size([width, height]);
         let centre = mono.frame().ray(0.5 * w as Real, 0.5 * h as Real, w, h);
         centre.pixel_angle
     }

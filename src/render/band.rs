@@ -44,7 +44,7 @@ impl<'a> FrameSetup<'a> {
         samples: std::ops::Range<u32>,
         on_row: &'a (dyn Fn() + Sync),
     ) -> Self {
-        let scenes = match crate::deep::prepare_all(scenes, height) {
+        let scenes = match crate::deep::prepare_all(scenes, [width, height]) {
             Some(deep) => std::borrow::Cow::Owned(deep),
             None => std::borrow::Cow::Borrowed(scenes),
         };
