@@ -304,10 +304,24 @@ impl CameraFrame {
     }
 
     /// Whether the pixel at (`px`, `py`) of a `width`×`height` image sees
-    /// anything (outside a fisheye's circle it does not, and takes no rays).
+    /// anything through its centre (outside a fisheye's circle it does not).
     pub fn covers(&self, px: u32, py: u32, width: u32, height: u32) -> bool {
-        let eye = self.eye(px as Real + 0.5, py as Real + 0.5, width, height);
+        self.sees(px as Real + 0.5, py as Real + 0.5, width, height)
+    }
+
+    /// Whether image position (`x`, `y`) of a `width`×`height` image is in
+    /// the picture: a sample beyond a fisheye's circle is transparent black.
+    pub fn sees(&self, x: Real, y: Real, width: u32, height: u32) -> bool {
+        let eye = self.eye(x, y, width, height);
         projection::covers(self.projection, eye.x, eye.y, eye.w, eye.h)
+    }
+
+    /// Whether any of the pixel at (`px`, `py`) is in the picture: a pixel
+    /// wholly outside a fisheye's circle takes no rays.
+    pub fn touches(&self, px: u32, py: u32, width: u32, height: u32) -> bool {
+        let eye = self.eye(px as Real + 0.5, py as Real + 0.5, width, height);
+        let (x, y) = (eye.x - 0.5, eye.y - 0.5);
+        projection::touches(self.projection, x, y, eye.w, eye.h)
     }
 
     /// Whether every pixel of a `width`×`height` image sees something.
