@@ -104,6 +104,11 @@ impl View {
                     "{name}: the scene leaves {effect} off; turn it on in the timeline first"
                 ));
             }
+            if let Some(lacking) = crate::timeline::parameters::camera_lacks(scene, name) {
+                return Err(format!(
+                    "{name}: the scene's camera lacks it; it needs {lacking}"
+                ));
+            }
             if *name == zoom && values[0] <= 0.0 {
                 return Err(format!(
                     "{name}: a camera distance must be positive, got {}",
@@ -139,7 +144,12 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
 /// exposure of 1 is left out of the JSON.
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
     let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
-    match name.split('.').try_fold(scene, |v, step| v.get(step)) {
+    // A projection is written as its variant: `{"Fisheye": {"degrees": D}}`.
+    let path = match name {
+        crate::timeline::parameters::FISHEYE_DEGREES => "camera.projection.Fisheye.degrees",
+        _ => name,
+    };
+    match path.split('.').try_fold(scene, |v, step| v.get(step)) {
         Some(serde_json::Value::Array(a)) => a.iter().map(number).collect(),
         Some(v) if !v.is_null() => Some(vec![number(v)?]),
         _ if name == "look.exposure" => Some(vec![1.0]),

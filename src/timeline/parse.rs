@@ -256,6 +256,11 @@ impl Source<'_> {
                     )));
                 }
             }
+            if let Some(lacking) = parameters::camera_lacks(&file.scene, name) {
+                let message =
+                    format!("animates a field the scene's camera lacks; it needs {lacking}");
+                return Err(at((String::new(), message)));
+            }
             if spec.keys.is_empty() {
                 return Err(at((
                     ".keys".into(),

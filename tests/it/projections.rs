@@ -158,3 +158,43 @@ fn a_fisheyes_outside_is_transparent_over_an_opaque_background() {
         }
     }
 }
+
+/// A track animates the fisheye's angle, and frames follow it; on a
+/// scene without a fisheye (or stereo) such a track is refused at its
+/// place in the file, naming the field.
+#[test]
+fn a_track_animates_the_fisheyes_angle_and_needs_a_fisheye() {
+    let d = Dir::new();
+    let track = "\"camera.projection.degrees\": (interpolation: Linear, keys: [(time: 0, value: 180), (time: 1, value: 90)]),";
+    let t = timeline("(32, 32)", "projection: Fisheye(degrees: 180)")
+        .replace("frames: 1", "frames: 2")
+        .replace("fps: 24", "fps: 1")
+        .replace("tracks: {", &format!("tracks: {{ {track}"));
+    d.write("t.ron", &t);
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let r = |frame: u32| {
+        d.exr(&format!("out/t/frame_{frame:05}.exr"))
+            .channel("R")
+            .to_vec()
+    };
+    let differ = r(0).iter().zip(r(1)).filter(|(a, b)| *a != b).count();
+    assert!(differ > 50, "only {differ} pixels differ");
+    for (camera, field) in [
+        ("fov_degrees: 45", "camera.projection.degrees"),
+        (
+            "projection: Fisheye(degrees: 180)",
+            "camera.stereo.eye_separation",
+        ),
+    ] {
+        let track = format!("\"{field}\": (keys: [(time: 0, value: 0.5)]),");
+        let bad = timeline("(32, 32)", camera).replace("tracks: {", &format!("tracks: {{ {track}"));
+        d.write("bad.ron", &bad);
+        let out = d.run(&["info", "bad.ron"]);
+        assert_eq!(out.status.code(), Some(3));
+        let said = stderr(&out);
+        assert!(
+            said.contains("bad.ron:") && said.contains(&format!("tracks[\"{field}\"]")),
+            "{said}"
+        );
+    }
+}
