@@ -207,7 +207,7 @@ pub fn reference_depths(
     step_fraction: Real,
 ) -> (Vec<Option<Real>>, u64) {
     // A deep frame is marched as it renders, measured from its target.
-    let deep = crate::deep::prepare(scene, height);
+    let deep = crate::deep::prepare(scene, [width, height]);
     let scene = deep.as_ref().unwrap_or(scene);
     let camera = scene.camera.frame();
     // Never step finer than a millionth of the camera–target distance: bounds the
@@ -419,7 +419,7 @@ pub fn measure(
     progress: &dyn Fn(usize, usize, &Variant),
 ) -> Report {
     // Perturbation is a knob only where the frame is deep.
-    let deep = crate::deep::needed(scene, height)
+    let deep = crate::deep::needed(scene, [width, height])
         && crate::fractal::whole_power(scene.fractal.power).is_some();
     let all: Vec<Variant> = variants(scene)
         .into_iter()

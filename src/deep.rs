@@ -33,20 +33,20 @@ const STEPS_PER_DECADE: Real = 40.0;
 
 /// `quality.max_steps` for a deep frame: the scene's own, and
 /// `STEPS_PER_DECADE` for every decade of the target's size over a pixel.
-pub fn max_steps(scene: &Scene, height: u32) -> u32 {
-    let decades = (1.0 / resolution(scene, height)).log10().clamp(0.0, 400.0);
+pub fn max_steps(scene: &Scene, size: [u32; 2]) -> u32 {
+    let decades = (1.0 / resolution(scene, size)).log10().clamp(0.0, 400.0);
     let more = (STEPS_PER_DECADE * decades).ceil() as u32;
     scene.quality.max_steps.saturating_add(more)
 }
 
-/// The march steps the frame of `scene` at `height` rows takes: `max_steps`
+/// The march steps the frame of `scene` at `size` takes: `max_steps`
 /// where it renders deep (needed, and a whole power), else the scene's own.
-pub fn steps_of(scene: &Scene, height: u32) -> u32 {
-    let perturbed = needed(scene, height)
+pub fn steps_of(scene: &Scene, size: [u32; 2]) -> u32 {
+    let perturbed = needed(scene, size)
         && scene.fractal.perturbation
         && crate::fractal::whole_power(scene.fractal.power).is_some();
     if perturbed {
-        max_steps(scene, height)
+        max_steps(scene, size)
     } else {
         scene.quality.max_steps
     }
@@ -59,33 +59,34 @@ pub const DEEP_REVISION: u32 = 1;
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;
 
-/// The width of a pixel at the target, at `height` rows.
-pub fn footprint(scene: &Scene, height: u32) -> Real {
+/// The width of a pixel at the target in a `size` (width, height) image:
+/// the angle the projection gives the view axis's pixel, at the target's
+/// distance.
+pub fn footprint(scene: &Scene, size: [u32; 2]) -> Real {
     let c = &scene.camera;
-    let pixel_angle = 2.0 * (c.fov_degrees.to_radians() * 0.5).tan() / height.max(1) as Real;
-    c.relative_position().length() * pixel_angle
+    c.relative_position().length() * c.axis_pixel_angle(size)
 }
 
 /// A pixel's width at the target over the size of the target's coordinates.
-pub fn resolution(scene: &Scene, height: u32) -> Real {
-    let size = scene
+pub fn resolution(scene: &Scene, size: [u32; 2]) -> Real {
+    let extent = scene
         .camera
         .target
         .abs()
         .max_element()
         .max(Real::MIN_POSITIVE);
-    footprint(scene, height) / size
+    footprint(scene, size) / extent
 }
 
-/// Whether the frame of `scene` at `height` rows is deep (`DEEP_BELOW`).
-pub fn needed(scene: &Scene, height: u32) -> bool {
-    resolution(scene, height) < DEEP_BELOW
+/// Whether the frame of `scene` at `size` is deep (`DEEP_BELOW`).
+pub fn needed(scene: &Scene, size: [u32; 2]) -> bool {
+    resolution(scene, size) < DEEP_BELOW
 }
 
 /// The precision a deep frame's reference orbit takes: the target's
 /// digits down to a pixel, and 64 bits more for the orbit's own rounding.
-pub fn bits(scene: &Scene, height: u32) -> usize {
-    let below = -resolution(scene, height).log2();
+pub fn bits(scene: &Scene, size: [u32; 2]) -> usize {
+    let below = -resolution(scene, size).log2();
     // A resolution of 0 (validation keeps frames from it) would ask for ∞.
     (64 + below.clamp(0.0, 2048.0).ceil() as usize + 32).max(MIN_BITS)
 }
@@ -94,8 +95,8 @@ pub fn bits(scene: &Scene, height: u32) -> usize {
 /// target, with the reference orbit set. `None` for a frame f64 resolves,
 /// and for powers that are not whole, which perturbation does not cover
 /// (they render in f64, and `info` says so).
-pub fn prepare(scene: &Scene, height: u32) -> Option<Scene> {
-    prepare_sharing(scene, height, &mut Vec::new())
+pub fn prepare(scene: &Scene, size: [u32; 2]) -> Option<Scene> {
+    prepare_sharing(scene, size, &mut Vec::new())
 }
 
 /// `prepare`, taking the reference from `built` where a scene there has
@@ -103,13 +104,13 @@ pub fn prepare(scene: &Scene, height: u32) -> Option<Scene> {
 /// instants), and adding the one it builds.
 fn prepare_sharing(
     scene: &Scene,
-    height: u32,
+    size: [u32; 2],
     built: &mut Vec<(Scene, usize, Arc<Reference>)>,
 ) -> Option<Scene> {
-    if !needed(scene, height) || !scene.fractal.perturbation {
+    if !needed(scene, size) || !scene.fractal.perturbation {
         return None;
     }
-    let bits = bits(scene, height);
+    let bits = bits(scene, size);
     let c = &scene.camera;
     let same = |(s, b, _): &&(Scene, usize, Arc<Reference>)| {
         *b == bits
@@ -128,7 +129,7 @@ fn prepare_sharing(
     };
     let mut deep = scene.clone();
     deep.quality.centre = -reference.anchor;
-    deep.quality.max_steps = max_steps(scene, height);
+    deep.quality.max_steps = max_steps(scene, size);
     deep.camera.position = c.relative_position();
     deep.camera.target = DVec3::ZERO;
     (deep.camera.position_digits, deep.camera.target_digits) = (None, None);
@@ -139,14 +140,14 @@ fn prepare_sharing(
     Some(deep)
 }
 
-/// `scenes` (a frame's instants) as they render at `height` rows: `None`
+/// `scenes` (a frame's instants) as they render at `size`: `None`
 /// where none is deep, so the caller keeps its own. Instants that share a
 /// target and fractal share one reference orbit.
-pub fn prepare_all(scenes: &[Scene], height: u32) -> Option<Vec<Scene>> {
+pub fn prepare_all(scenes: &[Scene], size: [u32; 2]) -> Option<Vec<Scene>> {
     let mut built = Vec::new();
     let prepared: Vec<Option<Scene>> = scenes
         .iter()
-        .map(|s| prepare_sharing(s, height, &mut built))
+        .map(|s| prepare_sharing(s, size, &mut built))
         .collect();
     if prepared.iter().all(Option::is_none) {
         return None;
@@ -187,15 +188,59 @@ pub fn digits_for(size: Real, footprint: Real) -> usize {
 /// over the pixel's width, since the finest detail an iteration count draws
 /// is about 1/dr; or what the target's orbit does instead. `None` for a
 /// power that is not whole.
-pub fn iterations_for(scene: &Scene, height: u32) -> Option<Derivative> {
+pub fn iterations_for(scene: &Scene, size: [u32; 2]) -> Option<Derivative> {
     let mut probe = scene.fractal.clone();
     probe.iterations = MOST_ITERATIONS;
-    let bits = bits(scene, height);
+    let bits = bits(scene, size);
     let c = &scene.camera;
     let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
     let reference = Reference::new(&probe, anchor, bits)?;
-    Some(reference.derivative_passes(&probe, 1.0 / footprint(scene, height)))
+    Some(reference.derivative_passes(&probe, 1.0 / footprint(scene, size)))
 }
 
 /// How far `iterations_for` looks.
 const MOST_ITERATIONS: u32 = 2000;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::Projection;
+
+    /// A scene looking down −z at the bulb's tip from `distance`.
+    fn scene(projection: Projection, distance: Real) -> Scene {
+        let mut s = Scene::default();
+        s.camera.target = DVec3::new(0.0, 0.65, 0.0);
+        s.camera.position = s.camera.target + DVec3::new(0.0, 0.0, distance);
+        s.camera.projection = projection;
+        s
+    }
+
+    #[test]
+    fn a_fisheyes_footprint_is_its_own_pixel_angle_at_the_target() {
+        let (distance, size) = (1e-3, [64, 48]);
+        let fisheye = scene(Projection::Fisheye { degrees: 180.0 }, distance);
+        // 180° over the inscribed circle's 48-pixel diameter.
+        let want = std::f64::consts::PI / 48.0 * distance;
+        let got = footprint(&fisheye, size);
+        assert!((got - want).abs() < 1e-15 * want, "{got} vs {want}");
+        let pinhole = footprint(&scene(Projection::Perspective, distance), size);
+        assert!(
+            (pinhole - want).abs() > 0.1 * want,
+            "{pinhole} is the perspective's"
+        );
+    }
+
+    #[test]
+    fn which_frames_are_deep_follows_the_projection() {
+        // At this depth a 45° perspective's pixel is below `DEEP_BELOW`
+        // of the target, an equirectangular's (360° across) is not.
+        let size = [64, 32];
+        let distance = 0.65 * DEEP_BELOW * 32.0 / (2.0 * (22.5f64).to_radians().tan()) * 0.9;
+        assert!(needed(&scene(Projection::Perspective, distance), size));
+        let equirect = scene(Projection::Equirectangular, distance);
+        assert!(!needed(&equirect, size));
+        // Deeper, where precision is above its floor, it takes fewer bits.
+        let deeper = |p| bits(&scene(p, distance * 1e-20), size);
+        assert!(deeper(Projection::Equirectangular) < deeper(Projection::Perspective));
+    }
+}

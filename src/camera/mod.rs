@@ -156,6 +156,17 @@ impl Camera {
         )
     }
 
+    /// The size of one eye's image in a `width`×`height` image (the image
+    /// itself without stereo), at least 1×1.
+    pub fn eye_size(&self, [width, height]: [u32; 2]) -> [u32; 2] {
+        let (w, h) = match self.stereo.map(|s| s.layout) {
+            Some(StereoLayout::SideBySide) => (width / 2, height),
+            Some(StereoLayout::TopBottom) => (width, height / 2),
+            None => (width, height),
+        };
+        [w.max(1), h.max(1)]
+    }
+
     /// The angle a pixel spans on the view's axis in a `width`×`height`
     /// image (of one eye where the image holds two).
     pub fn axis_pixel_angle(&self, [width, height]: [u32; 2]) -> Real {
@@ -163,12 +174,7 @@ impl Camera {
             stereo: None,
             ..self.clone()
         };
-        let (w, h) = match self.stereo.map(|s| s.layout) {
-            Some(StereoLayout::SideBySide) => (width / 2, height),
-            Some(StereoLayout::TopBottom) => (width, height / 2),
-            None => (width, height),
-        };
-        let (w, h) = (w.max(1), h.max(1));
+        let [w, h] = self.eye_size([width, height]);
         let centre = mono.frame().ray(0.5 * w as Real, 0.5 * h as Real, w, h);
         centre.pixel_angle
     }
@@ -298,10 +304,24 @@ impl CameraFrame {
     }
 
     /// Whether the pixel at (`px`, `py`) of a `width`×`height` image sees
-    /// anything (outside a fisheye's circle it does not, and takes no rays).
+    /// anything through its centre (outside a fisheye's circle it does not).
     pub fn covers(&self, px: u32, py: u32, width: u32, height: u32) -> bool {
-        let eye = self.eye(px as Real + 0.5, py as Real + 0.5, width, height);
+        self.sees(px as Real + 0.5, py as Real + 0.5, width, height)
+    }
+
+    /// Whether image position (`x`, `y`) of a `width`×`height` image is in
+    /// the picture: a sample beyond a fisheye's circle is transparent black.
+    pub fn sees(&self, x: Real, y: Real, width: u32, height: u32) -> bool {
+        let eye = self.eye(x, y, width, height);
         projection::covers(self.projection, eye.x, eye.y, eye.w, eye.h)
+    }
+
+    /// Whether any of the pixel at (`px`, `py`) is in the picture: a pixel
+    /// wholly outside a fisheye's circle takes no rays.
+    pub fn touches(&self, px: u32, py: u32, width: u32, height: u32) -> bool {
+        let eye = self.eye(px as Real + 0.5, py as Real + 0.5, width, height);
+        let (x, y) = (eye.x - 0.5, eye.y - 0.5);
+        projection::touches(self.projection, x, y, eye.w, eye.h)
     }
 
     /// Whether every pixel of a `width`×`height` image sees something.

@@ -129,8 +129,8 @@ pub fn longitude_latitude(x: Real, y: Real, w: Real, h: Real) -> (Real, Real) {
     ((x / w - 0.5) * TAU, (0.5 - y / h) * PI)
 }
 
-/// Whether the pixel centred at (`x`, `y`) of a `w`×`h` eye image sees
-/// anything: outside a fisheye's circle nothing is marched.
+/// Whether image position (`x`, `y`) of a `w`×`h` eye image is in the
+/// picture: outside a fisheye's circle it is not.
 pub fn covers(projection: Projection, x: Real, y: Real, w: Real, h: Real) -> bool {
     match projection {
         Projection::Fisheye { .. } => {
@@ -139,6 +139,15 @@ pub fn covers(projection: Projection, x: Real, y: Real, w: Real, h: Real) -> boo
         }
         Projection::Perspective | Projection::Equirectangular => true,
     }
+}
+
+/// Whether any of the pixel whose top-left corner is (`x`, `y`) of a
+/// `w`×`h` eye image is in the picture: the point of its square nearest
+/// the fisheye circle's centre is.
+pub fn touches(projection: Projection, x: Real, y: Real, w: Real, h: Real) -> bool {
+    let nearest = |corner: Real, centre: Real| centre.clamp(corner, corner + 1.0);
+    let (cx, cy) = (0.5 * w, 0.5 * h);
+    covers(projection, nearest(x, cx), nearest(y, cy), w, h)
 }
 
 /// The omni-directional stereo offset of the eye on `side` (−1 left, +1

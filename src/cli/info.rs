@@ -131,7 +131,7 @@ fn print_cost(t: &Timeline, base: &Scene) -> anyhow::Result<()> {
         None => out!(
             "cost:     not measured: one sample of frame 0 could compute {} orbits of {} \
              iterations (every march to quality.max_steps); render it with --frames 0 --stats",
-            worst_orbits_per_sample(&crate::job::probe::deep_steps(base, t.height)),
+            worst_orbits_per_sample(&crate::job::probe::deep_steps(base, [t.width, t.height])),
             base.fractal.iterations
         ),
     }
@@ -196,13 +196,13 @@ fn print_auto(t: &Timeline) -> anyhow::Result<()> {
 /// the deepest; nothing where every frame is within f64's reach.
 fn print_deep(t: &Timeline) -> anyhow::Result<()> {
     let deep: Vec<u32> = (0..t.frame_count)
-        .filter(|&f| crate::deep::needed(&t.scene_at(f), t.height))
+        .filter(|&f| crate::deep::needed(&t.scene_at(f), [t.width, t.height]))
         .collect();
     let (Some(&first), Some(&last)) = (deep.first(), deep.last()) else {
         return Ok(());
     };
     // The deepest: the finest pixel against the target's size.
-    let resolution = |f: &u32| crate::deep::resolution(&t.scene_at(*f), t.height);
+    let resolution = |f: &u32| crate::deep::resolution(&t.scene_at(*f), [t.width, t.height]);
     let deepest = *deep
         .iter()
         .min_by(|a, b| resolution(a).total_cmp(&resolution(b)))
@@ -216,8 +216,8 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
     }
     out!(
         "deep:     {frames} are finer than f64 resolves at {size}: rendered by perturbation, the deepest (frame {deepest}) from a {}-bit reference orbit with up to {} march steps (40 more per decade)",
-        crate::deep::bits(&scene, t.height),
-        crate::deep::max_steps(&scene, t.height)
+        crate::deep::bits(&scene, [t.width, t.height]),
+        crate::deep::max_steps(&scene, [t.width, t.height])
     );
     if t.base.fractal.auto.is_some() {
         // `print_auto` told each frame's count.
@@ -225,7 +225,7 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
     }
     use crate::deep::Derivative;
     let (has, last) = (scene.fractal.iterations, deepest);
-    match crate::deep::iterations_for(&scene, t.height) {
+    match crate::deep::iterations_for(&scene, [t.width, t.height]) {
         Some(Derivative::Passes(n)) => out!(
             "          frame {last} has {has} iterations; {n} resolve its pixels (where the target's own orbit's derivative passes one over a pixel)"
         ),

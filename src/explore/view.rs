@@ -117,6 +117,11 @@ impl View {
                     "{name}: the scene's look has no such palette or stop; add it in the timeline first"
                 ));
             }
+            if let Some(lacking) = crate::timeline::parameters::camera_lacks(scene, name) {
+                return Err(format!(
+                    "{name}: the scene's camera lacks it; it needs {lacking}"
+                ));
+            }
             if *name == zoom && values[0] <= 0.0 {
                 return Err(format!(
                     "{name}: a camera distance must be positive, got {}",
@@ -189,7 +194,12 @@ pub fn iterations(timeline: &Timeline, frame: u32) -> Iterations {
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
     use crate::spans::Step;
     let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
-    let found = crate::spans::steps(name)
+    // A projection is written as its variant: `{"Fisheye": {"degrees": D}}`.
+    let path = match name {
+        crate::timeline::parameters::FISHEYE_DEGREES => "camera.projection.Fisheye.degrees",
+        _ => name,
+    };
+    let found = crate::spans::steps(path)
         .iter()
         .try_fold(scene, |v, step| match step {
             Step::Field(f) | Step::Key(f) => v.get(f),

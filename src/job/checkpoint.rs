@@ -20,6 +20,9 @@ struct CheckpointHeader {
     /// Whether each pixel's adaptive-sampling spread follows the layers.
     #[serde(default)]
     spreads: bool,
+    /// Whether each pixel's samples within the picture follow (a fisheye's).
+    #[serde(default)]
+    inside: bool,
     stats: crate::render::FrameStats,
 }
 
@@ -36,6 +39,7 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
             !acc.traps.is_empty(),
         ],
         spreads: !acc.spread.is_empty(),
+        inside: !acc.inside.is_empty(),
         stats: acc.stats,
     };
     // Streamed through the file's buffer, not assembled first: the
@@ -75,6 +79,9 @@ pub fn write_checkpoint(path: &Path, acc: &crate::render::Accumulation, hash: &s
             put(&p.grazes.to_le_bytes())?;
             put(&p.sum.to_le_bytes())?;
             put(&p.squares.to_le_bytes())?;
+        }
+        for v in &acc.inside {
+            put(&v.to_le_bytes())?;
         }
         Ok(())
     })
@@ -174,6 +181,12 @@ pub fn read_checkpoint(
             }
         }
     }
+    if header.inside {
+        acc.inside.resize(acc.colour.len(), 0);
+        for v in acc.inside.iter_mut() {
+            *v = u32::from_le_bytes(take(&mut file)?);
+        }
+    }
     // Whole: nothing after the arrays.
     if file.read(&mut [0u8; 1]).ok()? != 0 {
         return None;
@@ -221,6 +234,25 @@ mod tests {
         assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_none());
         std::fs::write(&path, &bytes).unwrap();
         assert!(read_checkpoint(&path, "h1", 12, 8, layers).is_some());
+    }
+
+    #[test]
+    fn a_fisheyes_checkpoint_keeps_each_pixels_samples_in_the_picture() {
+        use crate::render::{render_samples, Accumulation, Layers};
+        let dir = tempfile::tempdir().unwrap();
+        let mut scene = Scene {
+            samples_per_pixel: 4,
+            ..Scene::default()
+        };
+        scene.camera.projection = crate::camera::Projection::Fisheye { degrees: 180.0 };
+        let mut acc = Accumulation::new(12, 8, Layers::default());
+        render_samples(std::slice::from_ref(&scene), 0, &mut acc, 2, &|| {});
+        assert_eq!(acc.inside[0], 0, "a corner is outside the circle");
+        assert_eq!(acc.inside[4 * 12 + 6], 2, "the centre is inside");
+        let path = dir.path().join(".frame_00000.ckpt");
+        write_checkpoint(&path, &acc, "h").unwrap();
+        let read = read_checkpoint(&path, "h", 12, 8, Layers::default());
+        assert_eq!(read.as_ref(), Some(&acc));
     }
 
     #[test]

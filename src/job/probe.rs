@@ -40,11 +40,11 @@ pub fn thumbnail_size(width: u32, height: u32, side: u32) -> (u32, u32) {
     (scale(width), scale(height))
 }
 
-/// `s` with the march steps its frame takes at `height` rows, which a deep
-/// frame raises (`deep::steps_of`): at the film's height, the most it can.
-pub fn deep_steps(s: &crate::scene::Scene, height: u32) -> crate::scene::Scene {
+/// `s` with the march steps its frame takes at `size`, which a deep
+/// frame raises (`deep::steps_of`): at the film's size, the most it can.
+pub fn deep_steps(s: &crate::scene::Scene, size: [u32; 2]) -> crate::scene::Scene {
     let mut s = s.clone();
-    s.quality.max_steps = crate::deep::steps_of(&s, height);
+    s.quality.max_steps = crate::deep::steps_of(&s, size);
     s
 }
 
@@ -87,7 +87,7 @@ pub fn cost_probe(t: &Timeline) -> Option<Probe> {
     let scenes = |samples: u32| t.clone().with_samples(Some(samples)).scenes_for_frame(0);
     let first = &scenes(1)[0];
     let iterations = first.fractal.iterations as u64 * iteration_weight(&first.fractal);
-    let per_sample = worst_orbits_per_sample(&deep_steps(first, t.height)) * iterations;
+    let per_sample = worst_orbits_per_sample(&deep_steps(first, [t.width, t.height])) * iterations;
     let pixels = |side: u32| {
         let (w, h) = thumbnail_size(t.width, t.height, side);
         w as u64 * h as u64

@@ -213,7 +213,7 @@ fn frames_inside(timeline: &Timeline, frames: &[u32]) -> (Vec<usize>, usize) {
                     }
                     // A deep frame's camera is placed from its target more
                     // finely than f64 holds its position.
-                    let is = match crate::deep::prepare(&s, timeline.height) {
+                    let is = match crate::deep::prepare(&s, [timeline.width, timeline.height]) {
                         Some(d) => d.fractal.contains(d.camera.position),
                         None => s.fractal.contains(s.camera.position),
                     };
@@ -253,7 +253,7 @@ pub fn out_of_steps_matters(stats: &FrameStats) -> bool {
 pub fn out_of_steps_warning(frames: &[u32], timeline: &Timeline) -> String {
     let scene = timeline.scene_at(frames[0]);
     let quality = &scene.quality;
-    let steps = crate::deep::steps_of(&scene, timeline.height);
+    let steps = crate::deep::steps_of(&scene, [timeline.width, timeline.height]);
     let deeper = if steps > quality.max_steps {
         " with 40 more a decade of a deep frame's depth"
     } else {

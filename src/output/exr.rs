@@ -208,12 +208,16 @@ enum Plane<'f> {
 
 impl<'f> Plane<'f> {
     /// The plane `source` names, if the film has it (the steps layer only
-    /// where `aovs` asks for it; alpha the coverage only where the
-    /// background is transparent).
+    /// where `aovs` asks for it; alpha the hit coverage where the
+    /// background is transparent, else the picture's: 0 beyond a fisheye's
+    /// circle, whatever the background).
     fn of(film: &'f Film, aovs: &[Aov], source: Source, encoding: &Encoding) -> Option<Plane<'f>> {
         use Plane::*;
         Some(match source {
-            Source::Alpha if !encoding.transparent => Constant(1.0),
+            Source::Alpha if !encoding.transparent => match &film.coverage {
+                Some(coverage) => Floats(coverage),
+                None => Constant(1.0),
+            },
             Source::Colour(k) => Vectors(&film.colour, k),
             Source::Normal(k) => Vectors(film.normal.as_deref()?, k),
             Source::Albedo(k) => Vectors(film.albedo.as_deref()?, k),

@@ -60,7 +60,9 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         #[serde(skip_serializing_if = "Option::is_none")]
         deep: Option<u32>,
     }
-    let deep = scenes.iter().any(|s| crate::deep::needed(s, height));
+    let deep = scenes
+        .iter()
+        .any(|s| crate::deep::needed(s, [width, height]));
     let inputs = Inputs {
         renderer: env!("CARGO_PKG_VERSION"),
         revision: crate::RENDERER_REVISION,

@@ -53,7 +53,8 @@ pub(crate) fn encode(
 struct Kind {
     colour: png::ColorType,
     depth: png::BitDepth,
-    /// Alpha is the film's coverage where the background is transparent.
+    /// Alpha is the film's hit coverage where the background is
+    /// transparent (else the picture's coverage, `Film::coverage`).
     transparent: bool,
 }
 
@@ -98,13 +99,20 @@ fn pixel_bytes(film: &Film, kind: Kind, display: crate::color::Display) -> Vec<u
     let row = (film.width as usize).max(1);
     let size = kind.bytes_per_pixel();
     let mut bytes = vec![0u8; film.colour.len() * size];
+    // Beyond a fisheye's circle is no part of the picture, whatever the
+    // background: there an opaque frame's alpha is the picture's coverage.
+    let alpha = match (kind.transparent, film.coverage.as_deref()) {
+        (true, _) => Some(&film.alpha[..]),
+        (false, coverage) => coverage,
+    };
     bytes
         .par_chunks_mut(size * row)
-        .zip(film.colour.par_chunks(row).zip(film.alpha.par_chunks(row)))
+        .zip(film.colour.par_chunks(row))
         .enumerate()
-        .for_each(|(y, (bytes, (colour, alpha)))| {
-            let pixels = bytes.chunks_exact_mut(size).zip(colour.iter().zip(alpha));
-            for (x, (out, (c, &a))) in pixels.enumerate() {
+        .for_each(|(y, (bytes, colour))| {
+            let alpha = alpha.map(|a| &a[y * row..][..colour.len()]);
+            for (x, (out, c)) in bytes.chunks_exact_mut(size).zip(colour).enumerate() {
+                let a = alpha.map(|a| a[x]);
                 painter.put(out, [c.x, c.y, c.z], a, (x as u32, y as u32));
             }
         });
@@ -132,12 +140,12 @@ impl Painter {
     }
 
     /// One pixel's codes into `out`. PNG colour is straight: a pixel with
-    /// alpha shows its colour divided by its coverage; one without shows
-    /// the film's colour, which, where the background is transparent, is
-    /// the fractal over black. 8-bit codes are dithered by the pixel's
-    /// offset.
+    /// alpha (`Some`: its coverage) shows its colour divided by it; one
+    /// without shows the film's colour, which, where the background is
+    /// transparent, is the fractal over black. 8-bit codes are dithered by
+    /// the pixel's offset.
     #[inline]
-    fn put(&self, out: &mut [u8], rgb: [f32; 3], alpha: f32, (x, y): (u32, u32)) {
+    fn put(&self, out: &mut [u8], rgb: [f32; 3], alpha: Option<f32>, (x, y): (u32, u32)) {
         let (kind, curve) = (self.kind, self.curve);
         let show = |v: f32| self.show(v);
         if kind.depth == png::BitDepth::Eight {
@@ -147,12 +155,12 @@ impl Painter {
             }
             return;
         }
-        let (shown, alpha) = match kind.colour {
-            png::ColorType::Rgba if kind.transparent => {
-                let a = alpha.clamp(0.0, 1.0);
+        let (shown, alpha) = match (kind.colour, alpha) {
+            (png::ColorType::Rgba, Some(a)) => {
+                let a = a.clamp(0.0, 1.0);
                 (straight_shown(rgb, a, show), Some(a))
             }
-            png::ColorType::Rgba => (rgb.map(show), Some(1.0)),
+            (png::ColorType::Rgba, None) => (rgb.map(show), Some(1.0)),
             _ => (rgb.map(show), None),
         };
         let codes = shown.map(|v| curve.code16(v));

@@ -29,6 +29,9 @@ pub struct Accumulation {
     /// Each pixel's samples and their spread under adaptive sampling;
     /// empty for uniform sampling, where every pixel has `samples_done`.
     pub spread: Vec<Spread>,
+    /// Each pixel's samples within the picture, where the projection
+    /// leaves some of the image out (a fisheye's circle); empty otherwise.
+    pub inside: Vec<u32>,
     pub stats: FrameStats,
 }
 
@@ -61,6 +64,7 @@ impl Accumulation {
         refill(&mut self.albedo, layer(layers.albedo), Vec3::ZERO);
         refill(&mut self.traps, layer(layers.traps), [0.0; 4]);
         self.spread.clear();
+        self.inside.clear();
         self.stats = FrameStats::default();
     }
 
@@ -84,7 +88,16 @@ impl Accumulation {
             albedo: (!self.albedo.is_empty()).then_some(&mut self.albedo[..]),
             traps: (!self.traps.is_empty()).then_some(&mut self.traps[..]),
             spread: (!self.spread.is_empty()).then_some(&mut self.spread[..]),
+            inside: (!self.inside.is_empty()).then_some(&mut self.inside[..]),
         }
+    }
+
+    /// Starts counting each pixel's samples within the picture, before any
+    /// sample.
+    pub(super) fn start_coverage(&mut self) {
+        debug_assert_eq!(self.samples_done, 0);
+        self.inside.clear();
+        self.inside.resize(self.colour.len(), 0);
     }
 
     /// Starts the per-pixel spreads of adaptive sampling, before any sample.
@@ -109,16 +122,23 @@ impl Accumulation {
             .zip(optional_bands(&mut self.albedo, w, h))
             .zip(optional_bands(&mut self.traps, w, h))
             .zip(optional_bands(&mut self.spread, w, h))
+            .zip(optional_bands(&mut self.inside, w, h))
             .map(
-                |(((((((colour, hits), depth), spent), normal), albedo), traps), spread)| RowSums {
-                    colour,
-                    hits,
-                    depth,
-                    spent,
-                    normal,
-                    albedo,
-                    traps,
-                    spread,
+                |(
+                    (((((((colour, hits), depth), spent), normal), albedo), traps), spread),
+                    inside,
+                )| {
+                    RowSums {
+                        colour,
+                        hits,
+                        depth,
+                        spent,
+                        normal,
+                        albedo,
+                        traps,
+                        spread,
+                        inside,
+                    }
                 },
             )
             .with_max_len(BAND_TASKS)
@@ -127,6 +147,7 @@ impl Accumulation {
     /// The finished film, with `n` samples per pixel.
     pub fn finish(self, n: u32) -> Film {
         let mut film = Film::blank(self.width, self.height, self.layers());
+        film.cover(!self.inside.is_empty());
         let all = FilmPixels {
             colour: &mut film.colour,
             alpha: &mut film.alpha,
@@ -135,6 +156,7 @@ impl Accumulation {
             normal: film.normal.as_deref_mut(),
             albedo: film.albedo.as_deref_mut(),
             traps: film.traps.as_deref_mut(),
+            coverage: film.coverage.as_deref_mut(),
         };
         let max_pixel = finish_pixels(&self, n, all);
         film.stats = self.stats.finished(max_pixel);
@@ -152,4 +174,5 @@ pub(super) struct RowSums<'a> {
     pub(super) albedo: Option<&'a mut [Vec3]>,
     pub(super) traps: Option<&'a mut [[f32; 4]]>,
     pub(super) spread: Option<&'a mut [Spread]>,
+    pub(super) inside: Option<&'a mut [u32]>,
 }

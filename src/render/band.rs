@@ -32,6 +32,9 @@ pub(super) struct FrameSetup<'a> {
     pub(super) active: Option<&'a [bool]>,
     /// How samples will be displayed, for adaptive sampling's error.
     pub(super) display: crate::color::Display,
+    /// The projection leaves part of the image out (beyond a fisheye's
+    /// circle): samples there are transparent black, and counted apart.
+    pub(super) partial: bool,
     pub(super) on_row: &'a (dyn Fn() + Sync),
 }
 
@@ -44,17 +47,19 @@ impl<'a> FrameSetup<'a> {
         samples: std::ops::Range<u32>,
         on_row: &'a (dyn Fn() + Sync),
     ) -> Self {
-        let scenes = match crate::deep::prepare_all(scenes, height) {
+        let scenes = match crate::deep::prepare_all(scenes, [width, height]) {
             Some(deep) => std::borrow::Cow::Owned(deep),
             None => std::borrow::Cow::Borrowed(scenes),
         };
+        let cameras: Vec<_> = scenes.iter().map(|s| s.camera.frame()).collect();
         FrameSetup {
+            partial: !cameras.iter().all(|c| c.covers_all()),
             frame_index,
             width,
             height,
             n: scenes[0].samples_per_pixel.max(1),
             samples,
-            cameras: scenes.iter().map(|s| s.camera.frame()).collect(),
+            cameras,
             scales: scenes
                 .iter()
                 .map(|s| (s.camera.position - s.camera.target).length())
@@ -114,6 +119,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
             picked: order,
             picked_runs: runs,
             rays,
+            seen,
             marched,
             surfaces,
             walks,
@@ -128,12 +134,15 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
         crate::march::march_camera_rays(rays, f, q, runs, marched, cone_free);
         // Where each ray met the surface, with its normal (the band's hits
         // four to a kernel call); each pixel's cost goes straight to its sum.
+        // A sample beyond the picture (`seen`) meets nothing.
         surfaces.clear();
         surfaces.resize(rays.len(), None);
+        let in_picture = |i: usize| seen.get(i).is_none_or(|&s| s);
         let hits = rays
             .iter()
             .zip(marched.iter())
             .enumerate()
+            .filter(|&(i, _)| in_picture(i))
             .filter_map(|(x, (ray, result))| Some((x, ray, result.hit.as_ref()?)));
         normals_many(
             hits,
@@ -162,6 +171,15 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
             stats.out_of_steps += result.out_of_steps as u64;
             sums.spent[p] += result.evaluations as u64;
             let before = stats.stage_total();
+            if !in_picture(i) {
+                // Transparent black: no light, and not within the picture.
+                add_black(&mut sums, p, &frame.display);
+                stats.samples += 1;
+                continue;
+            }
+            if let Some(inside) = sums.inside.as_deref_mut() {
+                inside[p] += 1;
+            }
             let c = trace(
                 scene,
                 ray,
@@ -211,6 +229,14 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
         (frame.on_row)();
     }
     stats
+}
+
+/// Adds a sample beyond the picture to pixel `p`: no colour, and to an
+/// adaptive pixel's spread as black.
+fn add_black(sums: &mut RowSums, p: usize, display: &crate::color::Display) {
+    if let Some(spread) = sums.spread.as_deref_mut() {
+        spread[p].add(Vec3::ZERO, display, Real::INFINITY);
+    }
 }
 
 impl RowSums<'_> {
@@ -270,12 +296,12 @@ impl RowScratch {
             self.picked_valid = false;
         }
         // The same pixels take every sample of a wave; those the
-        // projection leaves out (beyond a fisheye's circle) take none.
+        // projection leaves wholly out (beyond a fisheye's circle) take none.
         if !self.picked_valid {
             let active = frame.active.map(|a| &a[y0 * w..(y0 + rows) * w]);
             let seen = |p: usize| {
                 let (x, y) = ((p % w) as u32, (y0 + p / w) as u32);
-                active.is_none_or(|a| a[p]) && camera.covers(x, y, width, height)
+                active.is_none_or(|a| a[p]) && camera.touches(x, y, width, height)
             };
             match (active, camera.covers_all()) {
                 (None, true) => self.pick(None::<fn(usize) -> bool>),
@@ -284,6 +310,8 @@ impl RowScratch {
             self.picked_valid = true;
         }
         self.rays.clear();
+        self.seen.clear();
+        let partial = frame.partial;
         self.rays.extend(self.picked.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
             let pixel = (y0 * w + p) as u64;
@@ -291,6 +319,10 @@ impl RowScratch {
                 Some(_) if n > 1 => progressive_subpixel(scene, frame.frame_index, pixel, s),
                 _ => subpixel(scene, frame.frame_index, pixel, s, n),
             };
+            if partial {
+                let (x, y) = (x as Real + ox, y as Real + oy);
+                self.seen.push(camera.sees(x, y, width, height));
+            }
             if camera.has_lens() {
                 let u = sample_1d(scene.seed, frame.frame_index, pixel, s, 2);
                 let v = sample_1d(scene.seed, frame.frame_index, pixel, s, 3);
@@ -428,6 +460,9 @@ pub(super) struct RowScratch {
     /// Whether `picked` holds this band's pixels for this layout.
     pub(super) picked_valid: bool,
     pub(super) rays: Vec<crate::march::Ray>,
+    /// Whether each camera ray's sample is within the picture, where the
+    /// projection leaves part of the image out; empty otherwise.
+    pub(super) seen: Vec<bool>,
     pub(super) marched: Vec<MarchResult>,
     /// Where each camera ray met the surface.
     pub(super) surfaces: Vec<Option<SurfacePoint>>,

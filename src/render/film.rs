@@ -26,6 +26,10 @@ pub struct Film {
     pub albedo: Option<Vec<Vec3>>,
     /// Orbit traps: origin, then the x, y and z planes.
     pub traps: Option<Vec<[f32; 4]>>,
+    /// Share of the pixel's samples within the picture, where the
+    /// projection leaves part of the image out (beyond a fisheye's circle):
+    /// an opaque frame's alpha. `None` where every sample is in it.
+    pub coverage: Option<Vec<f32>>,
     pub stats: FrameStats,
 }
 
@@ -68,7 +72,14 @@ impl Film {
         layer(&mut self.normal, layers.normal, pixels);
         layer(&mut self.albedo, layers.albedo, pixels);
         layer(&mut self.traps, layers.traps, pixels);
+        self.coverage = None;
         self.stats = FrameStats::default();
+    }
+
+    /// Gives the film its coverage layer (`coverage`) where `partial`,
+    /// sized like the others, for `finish_pixels` to fill.
+    pub(super) fn cover(&mut self, partial: bool) {
+        self.coverage = partial.then(|| vec![0.0; self.colour.len()]);
     }
 
     /// Bytes per pixel of the buffers every film holds (colour, alpha,
@@ -132,6 +143,7 @@ pub(super) struct FilmPixels<'a> {
     pub(super) normal: Option<&'a mut [Vec3]>,
     pub(super) albedo: Option<&'a mut [Vec3]>,
     pub(super) traps: Option<&'a mut [[f32; 4]]>,
+    pub(super) coverage: Option<&'a mut [f32]>,
 }
 
 impl Film {
@@ -143,6 +155,7 @@ impl Film {
         let normal = self.normal.as_deref_mut().unwrap_or_default();
         let albedo = self.albedo.as_deref_mut().unwrap_or_default();
         let traps = self.traps.as_deref_mut().unwrap_or_default();
+        let coverage = self.coverage.as_deref_mut().unwrap_or_default();
         self.colour
             .par_chunks_mut(band)
             .zip(self.alpha.par_chunks_mut(band))
@@ -151,15 +164,22 @@ impl Film {
             .zip(optional_bands(normal, w, h))
             .zip(optional_bands(albedo, w, h))
             .zip(optional_bands(traps, w, h))
+            .zip(optional_bands(coverage, w, h))
             .map(
-                |((((((colour, alpha), depth), evaluations), normal), albedo), traps)| FilmPixels {
-                    colour,
-                    alpha,
-                    depth,
-                    evaluations,
-                    normal,
-                    albedo,
-                    traps,
+                |(
+                    ((((((colour, alpha), depth), evaluations), normal), albedo), traps),
+                    coverage,
+                )| {
+                    FilmPixels {
+                        colour,
+                        alpha,
+                        depth,
+                        evaluations,
+                        normal,
+                        albedo,
+                        traps,
+                        coverage,
+                    }
                 },
             )
             .with_max_len(BAND_TASKS)
@@ -186,7 +206,8 @@ pub(super) fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64
         .all(|len| len == pixels)
             && layer(out.normal.as_ref().map(|v| v.len()), sums.normal.len())
             && layer(out.albedo.as_ref().map(|v| v.len()), sums.albedo.len())
-            && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len()),
+            && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len())
+            && layer(out.coverage.as_ref().map(|v| v.len()), sums.inside.len()),
         "a band's film and sums differ in size"
     );
     // Under adaptive sampling each pixel has the samples it took.
@@ -216,6 +237,11 @@ pub(super) fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64
     if let Some(albedo) = out.albedo {
         for (i, (o, &v)) in albedo.iter_mut().zip(&sums.albedo).enumerate() {
             *o = v * per_hit(i);
+        }
+    }
+    if let Some(coverage) = out.coverage {
+        for (i, (o, &k)) in coverage.iter_mut().zip(&sums.inside).enumerate() {
+            *o = k as f32 / taken(i) as f32;
         }
     }
     if let Some(traps) = out.traps {

@@ -93,6 +93,7 @@ pub fn render_frame_into(
     }
     let frame = FrameSetup::new(scenes, frame_index, width, height, 0..n, on_row);
     film.prepare(width, height, layers);
+    film.cover(frame.partial);
     // Every band of rows renders in parallel into this thread's one-band
     // sums (the running sums, f64 colour and counters, exist for a band at
     // a time, not the frame) and is finished straight into its place in the
@@ -104,6 +105,9 @@ pub fn render_frame_into(
             let mut sums = ROW_SUMS.take();
             let rows = pixels.colour.len() / width as usize;
             sums.reset(width, rows as u32, layers);
+            if frame.partial {
+                sums.start_coverage();
+            }
             let stats = render_band(&frame, band * BAND_ROWS, sums.all_mut());
             let max_pixel = finish_pixels(&sums, n, pixels);
             ROW_SUMS.set(sums);
@@ -176,6 +180,9 @@ pub fn render_samples_unless(
         adaptive::refining(a, acc, &mut active);
     }
     let mut frame = FrameSetup::new(scenes, frame_index, acc.width, acc.height, samples, on_row);
+    if frame.partial && acc.samples_done == 0 {
+        acc.start_coverage();
+    }
     frame.active = (!active.is_empty()).then_some(&active[..]);
     let stopped = std::sync::atomic::AtomicBool::new(false);
     // One band of rows per task; rayon spreads bands over threads and each

@@ -42,7 +42,7 @@ pub struct PickFractal {
 /// `width`×`height` image of `scene`, frame `frame` of its film, along the
 /// ray its projection gives it. The pixel must be inside the image.
 pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
-    let deep = crate::deep::prepare(scene, height);
+    let deep = crate::deep::prepare(scene, [width, height]);
     let marched = deep.as_ref().unwrap_or(scene);
     let camera = marched.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
@@ -128,7 +128,7 @@ pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, Strin
         c.offset = Some(away * distance);
         c.position = c.target + away * distance;
         c.position_digits = None;
-        let deep = crate::deep::prepare(&s, height);
+        let deep = crate::deep::prepare(&s, [width, height]);
         let marched = deep.as_ref().unwrap_or(&s);
         let ray =
             marched

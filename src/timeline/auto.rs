@@ -54,10 +54,10 @@ pub struct Resolved {
 }
 
 /// The count `auto` chooses for `scene` at `width`×`height`.
-pub fn resolve(scene: &Scene, auto: AutoIterations, [width, height]: [u32; 2]) -> Resolved {
-    let (passes, decided) = match target_passes(scene, height) {
+pub fn resolve(scene: &Scene, auto: AutoIterations, size: [u32; 2]) -> Resolved {
+    let (passes, decided) = match target_passes(scene, size) {
         Derivative::Passes(n) => (Some(n), Decided::Target),
-        _ => match centre_passes(scene, [width, height]) {
+        _ => match centre_passes(scene, size) {
             Some(n) => (Some(n), Decided::Centre),
             None => (None, Decided::Floor),
         },
@@ -70,14 +70,15 @@ pub fn resolve(scene: &Scene, auto: AutoIterations, [width, height]: [u32; 2]) -
 }
 
 /// Where the target's orbit's derivative passes one over the pixel's
-/// width at the target: in high precision where the frame is deep.
-fn target_passes(scene: &Scene, height: u32) -> Derivative {
-    if deep::needed(scene, height) {
-        if let Some(d) = deep::iterations_for(scene, height) {
+/// width at the target (the projection's pixel on the view's axis): in
+/// high precision where the frame is deep.
+fn target_passes(scene: &Scene, size: [u32; 2]) -> Derivative {
+    if deep::needed(scene, size) {
+        if let Some(d) = deep::iterations_for(scene, size) {
             return d;
         }
     }
-    let value = 1.0 / deep::footprint(scene, height);
+    let value = 1.0 / deep::footprint(scene, size);
     let f = &scene.fractal;
     f.derivative_passes(scene.camera.target, value, MOST_ITERATIONS)
 }
@@ -88,14 +89,20 @@ fn target_passes(scene: &Scene, height: u32) -> Derivative {
 /// from the target that f64 cannot iterate alone: there the iterations its
 /// orbit took to escape stand in (at a hit, within half a pixel of the
 /// surface, the derivative has passed one over a pixel by its escape).
-fn centre_passes(scene: &Scene, [width, height]: [u32; 2]) -> Option<u32> {
+fn centre_passes(scene: &Scene, size: [u32; 2]) -> Option<u32> {
     let mut probe = scene.clone();
     probe.fractal.iterations = CENTRE_ITERATIONS;
-    probe.quality.max_steps = deep::steps_of(scene, height).saturating_mul(4);
-    let prepared = deep::prepare(&probe, height);
+    probe.quality.max_steps = deep::steps_of(scene, size).saturating_mul(4);
+    let prepared = deep::prepare(&probe, size);
     let marched = prepared.as_ref().unwrap_or(&probe);
+    // One eye's centre: a stereo image's centre is where its eyes meet.
+    let [width, height] = scene.camera.eye_size(size);
+    let mono = crate::camera::Camera {
+        stereo: None,
+        ..marched.camera.clone()
+    };
     let (w, h) = (width as Real, height as Real);
-    let ray = marched.camera.frame().ray(w * 0.5, h * 0.5, width, height);
+    let ray = mono.frame().ray(w * 0.5, h * 0.5, width, height);
     let hit = crate::march::march(&ray, &marched.fractal, &marched.quality).hit?;
     if prepared.is_some() {
         return Some(hit.estimate.iterations);
@@ -184,6 +191,21 @@ mod tests {
                 "the floor decides c = {c}"
             );
         }
+    }
+
+    #[test]
+    fn a_fisheyes_count_resolves_its_own_pixel() {
+        // 180° across a 48-row circle: π/48 a pixel, not the perspective's.
+        let (c, distance) = (0.6505, 0.01);
+        let mut scene = Scene::default();
+        scene.camera.target = DVec3::new(0.0, c, 0.0);
+        scene.camera.position = scene.camera.target + DVec3::new(0.0, 0.0, distance);
+        scene.camera.projection = crate::camera::Projection::Fisheye { degrees: 180.0 };
+        let pixel = std::f64::consts::PI / 48.0;
+        let passes = axis_passes(c, distance * pixel, scene.fractal.bailout);
+        let r = resolve(&scene, AutoIterations { margin: 0 }, [64, 48]);
+        assert_eq!(r.decided, Decided::Target);
+        assert_eq!(r.count, passes.max(MIN_AUTO_ITERATIONS));
     }
 
     #[test]

@@ -6,6 +6,7 @@
 use super::limits::{MAX_ITERATIONS, MAX_MARCH_STEPS};
 use super::messages::Shown;
 use super::validate::{colour, counted, non_negative, positive, rule, Checked};
+use crate::camera::Projection;
 use crate::math::{DVec3, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{Stop, MAX_STOPS};
@@ -274,7 +275,75 @@ pub(super) const CAMERA: &[Parameter] = &[
         check: |s| s.camera.focus_distance.map_or(Ok(()), positive),
         set: |s, v| s.camera.focus_distance = Some(v[0]),
     },
+    Parameter {
+        name: FISHEYE_DEGREES,
+        shape: Number,
+        doc: "number (the scene's projection must be a `Fisheye`)",
+        check: |s| match s.camera.projection {
+            Projection::Fisheye { degrees } => fisheye_degrees(degrees),
+            Projection::Perspective | Projection::Equirectangular => Ok(()),
+        },
+        set: |s, v| {
+            if let Projection::Fisheye { degrees } = &mut s.camera.projection {
+                *degrees = v[0];
+            }
+        },
+    },
+    Parameter {
+        name: EYE_SEPARATION,
+        shape: Number,
+        doc: "number (the scene must have `camera.stereo`)",
+        check: |s| {
+            s.camera.stereo.map_or(Ok(()), |stereo| {
+                let e = stereo.eye_separation;
+                rule(e.is_finite() && (0.0..=1.0).contains(&e), || {
+                    format!(
+                        "must be from 0 to 1 (a share of the camera–target distance), got {}",
+                        e.shown()
+                    )
+                })
+            })
+        },
+        set: |s, v| {
+            s.camera
+                .stereo
+                .iter_mut()
+                .for_each(|e| e.eye_separation = v[0])
+        },
+    },
 ];
+
+/// The fisheye's angle across its circle, animatable.
+pub const FISHEYE_DEGREES: &str = "camera.projection.degrees";
+/// The stereo eyes' separation, animatable.
+pub const EYE_SEPARATION: &str = "camera.stereo.eye_separation";
+
+fn fisheye_degrees(degrees: Real) -> Checked {
+    let ok = degrees.is_finite() && degrees > 0.0 && degrees <= 360.0;
+    rule(ok, || {
+        format!(
+            "a fisheye's angle must be above 0 and at most 360 degrees, got {}",
+            degrees.shown()
+        )
+    })
+}
+
+/// What `scene`'s camera lacks for parameter `name` to mean anything, if
+/// it does: a fisheye's angle needs a fisheye, the eyes' separation stereo.
+/// A track or an explorer's value for it is refused then, as for an
+/// effect the scene leaves off.
+pub fn camera_lacks(scene: &Scene, name: &str) -> Option<&'static str> {
+    let c = &scene.camera;
+    match name {
+        FISHEYE_DEGREES if !matches!(c.projection, Projection::Fisheye { .. }) => {
+            Some("a fisheye projection: set scene.camera.projection to Fisheye(degrees: …)")
+        }
+        EYE_SEPARATION if c.stereo.is_none() => {
+            Some("stereo: add stereo: (eye_separation: …, layout: SideBySide) to scene.camera")
+        }
+        _ => None,
+    }
+}
 
 fn fov(fov: Real) -> Checked {
     rule(

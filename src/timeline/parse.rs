@@ -259,6 +259,11 @@ impl Source<'_> {
             if let Some(missing) = palette_missing(&file.scene, name) {
                 return Err(at((String::new(), missing)));
             }
+            if let Some(lacking) = parameters::camera_lacks(&file.scene, name) {
+                let message =
+                    format!("animates a field the scene's camera lacks; it needs {lacking}");
+                return Err(at((String::new(), message)));
+            }
             if spec.keys.is_empty() {
                 return Err(at((
                     ".keys".into(),

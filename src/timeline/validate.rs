@@ -103,7 +103,6 @@ fn animatable_in(s: &Scene, group: &[Parameter], order: &[&str]) -> Result<(), I
 pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
     animatable(s, CAMERA)?;
     view(s)?;
-    projection(&s.camera)?;
     animatable(s, FRACTAL)?;
     animatable_in(s, QUALITY, &QUALITY_CHECKS)?;
     at(
@@ -175,31 +174,6 @@ fn view(s: &Scene) -> Result<(), Invalid> {
         )
     });
     at("camera.up", parallel)
-}
-
-/// The projection's angle and the stereo eyes' separation.
-fn projection(c: &crate::camera::Camera) -> Result<(), Invalid> {
-    if let crate::camera::Projection::Fisheye { degrees } = c.projection {
-        let ok = degrees.is_finite() && degrees > 0.0 && degrees <= 360.0;
-        let checked = rule(ok, || {
-            format!(
-                "a fisheye's angle must be above 0 and at most 360 degrees, got {}",
-                degrees.shown()
-            )
-        });
-        at("camera.projection.degrees", checked)?;
-    }
-    if let Some(stereo) = &c.stereo {
-        let e = stereo.eye_separation;
-        let checked = rule(e.is_finite() && (0.0..=1.0).contains(&e), || {
-            format!(
-                "must be from 0 to 1 (a share of the camera–target distance), got {}",
-                e.shown()
-            )
-        });
-        at("camera.stereo.eye_separation", checked)?;
-    }
-    Ok(())
 }
 
 /// The look's palette, where it has one: 1 to `MAX_STOPS` stops, then

@@ -65,7 +65,7 @@ fn check_against_the_oracle(
 ) {
     let outside = |offset: DVec3| deep_oracle::estimate(oracle, base, offset.to_array()).2;
     let distance = s.camera.relative_position().length();
-    let deep = mandelreel::deep::prepare(s, SIZE[1]).expect("a deep frame");
+    let deep = mandelreel::deep::prepare(s, SIZE).expect("a deep frame");
     let camera = deep.camera.frame();
     for (x, y) in pixels {
         let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, SIZE[0], SIZE[1]);
@@ -124,7 +124,7 @@ fn a_few_pixels_a_hundred_decades_down() {
 
 #[test]
 fn every_pixel_has_its_own_hit_thirty_decades_down() {
-    let deep = mandelreel::deep::prepare(&scene(1e-30), SIZE[1]).unwrap();
+    let deep = mandelreel::deep::prepare(&scene(1e-30), SIZE).unwrap();
     let camera = deep.camera.frame();
     let settings = MarchSettings {
         cone_rays: 1,
@@ -346,4 +346,31 @@ fn the_out_of_steps_warning_names_a_deep_frames_steps() {
         said.contains(&format!("quality.max_steps ({steps} with 40 more a decade")),
         "{said}"
     );
+}
+
+/// A dome master 1e-20 from the target: `info` counts it deep, and it
+/// renders from its reference orbit with every channel finite and the
+/// surface in view.
+#[test]
+fn a_fisheye_deep_frame_renders_without_nan() {
+    let dir = Dir::new();
+    let t = deep_timeline(2)
+        .replace("frames: 2", "frames: 1")
+        .replace("size: (48, 27)", "size: (24, 24)")
+        .replace("fov_degrees: 40", "projection: Fisheye(degrees: 180)")
+        .replace("value: 1e-12", "value: 1e-20");
+    dir.write("dome.ron", &t);
+    let info = stdout(&dir.ok(&["info", "dome.ron"]));
+    assert!(info.contains("deep:     1 frame(s)"), "{info}");
+    dir.ok(&["render", "dome.ron", "--format", "exr", "--quiet"]);
+    let frame = dir.exr("out/dome/frame_00000.exr");
+    for (name, values) in &frame.channels {
+        assert!(values.iter().all(|v| v.is_finite()), "{name} not finite");
+    }
+    let hits = frame
+        .channel("depth.Z")
+        .iter()
+        .filter(|&&z| z < 1e9)
+        .count();
+    assert!(hits > 50, "{hits} pixels see the surface");
 }

@@ -717,3 +717,48 @@ fn auto_iterations_are_shown_per_frame_and_never_written_over() {
         json!({"margin": null, "count": 9, "decided": null, "shown": "9"})
     );
 }
+
+/// A fisheye's angle and stereo's separation are parameters the explorer
+/// lists, shows at a frame and sets in a view; a scene without them
+/// shows none and refuses a value for them.
+#[test]
+fn the_fisheyes_angle_and_the_eyes_separation_are_listed_and_set() {
+    let d = Dir::new();
+    let dome = tiny_timeline(1, 8.0).replace(
+        "camera: (",
+        "camera: (projection: Fisheye(degrees: 180), stereo: (eye_separation: 0.03, layout: SideBySide), ",
+    );
+    d.write("t.ron", &dome);
+    d.write("plain.ron", &tiny_timeline(1, 8.0));
+    let s = explore(&d, "t.ron");
+    let listed = s.state()["parameters"].to_string();
+    for name in ["camera.projection.degrees", "camera.stereo.eye_separation"] {
+        assert!(listed.contains(&format!("[\"{name}\",1]")), "{listed}");
+    }
+    let values = s.get("/api/values?frame=0").expect(200).json();
+    assert_eq!(values["camera.projection.degrees"], json!([180.0]));
+    assert_eq!(values["camera.stereo.eye_separation"], json!([0.03]));
+    let view = |degrees: f64| {
+        let view = json!({"frame": 0, "overrides": {"camera.projection.degrees": [degrees]}});
+        let shown = s.post("/api/render", json!({"view": view, "stage": "final"}));
+        pixels(&shown.expect(200).body)
+    };
+    assert!(view(180.0) != view(120.0), "the angle set changes nothing");
+    let bad = json!({"frame": 0, "overrides": {"camera.projection.degrees": [400]}});
+    let refused = s.post("/api/render", json!({"view": bad, "stage": "quick"}));
+    assert!(refused
+        .expect(422)
+        .text()
+        .contains("camera.projection.degrees"));
+    drop(s);
+    let plain = explore(&d, "plain.ron");
+    let values = plain.get("/api/values?frame=0").expect(200).json();
+    assert_eq!(values["camera.projection.degrees"], Value::Null);
+    let view = json!({"frame": 0, "overrides": {"camera.stereo.eye_separation": [0.1]}});
+    let refused = plain.post("/api/render", json!({"view": view, "stage": "quick"}));
+    let message = refused.expect(422).text();
+    assert!(
+        message.contains("camera.stereo.eye_separation") && message.contains("stereo"),
+        "{message}"
+    );
+}

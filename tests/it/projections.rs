@@ -122,3 +122,79 @@ fn pick_on_a_fisheye_marches_the_rendered_ray() {
         "{out}"
     );
 }
+
+/// A dome master's outside is no part of the picture: with the default
+/// opaque background its alpha is 0 (its colour black) in every format
+/// with alpha, and the circle's edge is anti-aliased by its samples.
+#[test]
+fn a_fisheyes_outside_is_transparent_over_an_opaque_background() {
+    let d = Dir::new();
+    let t = with_scene(&tiny_timeline(1, 8.0), "samples_per_pixel: 16")
+        .replace("size: (48, 27)", "size: (40, 30)")
+        .replace("camera: (", "camera: (projection: Fisheye(degrees: 180), ")
+        .replace("(0, 0.5, 3.0)", "(0, 0, 1.6)");
+    d.write("t.ron", &t);
+    d.ok(&["render", "t.ron", "--format", "exr", "--out", "exr"]);
+    d.ok(&["render", "t.ron", "--format", "png16alpha", "--out", "png"]);
+    let exr = d.exr("exr/frame_00000.exr");
+    let png = image::open(d.path().join("png/frame_00000.png"))
+        .unwrap()
+        .to_rgba16();
+    let (a, r) = (exr.channel("A"), exr.channel("R"));
+    let png_alpha = |x: u32, y: u32| png.get_pixel(x, y).0[3] as f32 / 65535.0;
+    // The circle, 30 across at (20, 15), crosses pixel (9, 4) (45° up-left).
+    for (x, y, what) in [(0, 0, "corner"), (9, 4, "edge"), (20, 15, "inside")] {
+        let (exr_a, png_a) = (a[y as usize * 40 + x as usize], png_alpha(x, y));
+        match what {
+            "corner" => {
+                assert_eq!((exr_a, r[0], png_a), (0.0, 0.0, 0.0), "{what}");
+                assert_eq!(png.get_pixel(x, y).0, [0; 4], "{what}");
+            }
+            "edge" => assert!(
+                exr_a > 0.0 && exr_a < 1.0 && png_a > 0.0 && png_a < 1.0,
+                "{what}: {exr_a}, {png_a}"
+            ),
+            _ => assert_eq!((exr_a, png_a), (1.0, 1.0), "{what}"),
+        }
+    }
+}
+
+/// A track animates the fisheye's angle, and frames follow it; on a
+/// scene without a fisheye (or stereo) such a track is refused at its
+/// place in the file, naming the field.
+#[test]
+fn a_track_animates_the_fisheyes_angle_and_needs_a_fisheye() {
+    let d = Dir::new();
+    let track = "\"camera.projection.degrees\": (interpolation: Linear, keys: [(time: 0, value: 180), (time: 1, value: 90)]),";
+    let t = timeline("(32, 32)", "projection: Fisheye(degrees: 180)")
+        .replace("frames: 1", "frames: 2")
+        .replace("fps: 24", "fps: 1")
+        .replace("tracks: {", &format!("tracks: {{ {track}"));
+    d.write("t.ron", &t);
+    d.ok(&["render", "t.ron", "--format", "exr"]);
+    let r = |frame: u32| {
+        d.exr(&format!("out/t/frame_{frame:05}.exr"))
+            .channel("R")
+            .to_vec()
+    };
+    let differ = r(0).iter().zip(r(1)).filter(|(a, b)| *a != b).count();
+    assert!(differ > 50, "only {differ} pixels differ");
+    for (camera, field) in [
+        ("fov_degrees: 45", "camera.projection.degrees"),
+        (
+            "projection: Fisheye(degrees: 180)",
+            "camera.stereo.eye_separation",
+        ),
+    ] {
+        let track = format!("\"{field}\": (keys: [(time: 0, value: 0.5)]),");
+        let bad = timeline("(32, 32)", camera).replace("tracks: {", &format!("tracks: {{ {track}"));
+        d.write("bad.ron", &bad);
+        let out = d.run(&["info", "bad.ron"]);
+        assert_eq!(out.status.code(), Some(3));
+        let said = stderr(&out);
+        assert!(
+            said.contains("bad.ron:") && said.contains(&format!("tracks[\"{field}\"]")),
+            "{said}"
+        );
+    }
+}

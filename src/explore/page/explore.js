@@ -544,6 +544,8 @@ function fillControls() {
       numbers = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
     }
     row.classList.toggle("changed", name in page.overrides);
+    // A fisheye's angle and stereo's separation only where the camera has them.
+    row.hidden = !numbers && ["camera.projection.degrees", "camera.stereo.eye_separation"].includes(name);
     row.querySelectorAll("input").forEach((input, i) => {
       input.value = numbers ? Number(numbers[i].toPrecision(10)) : "";
       input.placeholder = numbers ? "" : "off";

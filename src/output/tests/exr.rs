@@ -39,6 +39,7 @@ fn exr_tiles_read_back_as_the_film_across_partial_tiles() {
                 .map(|i| [v(i, 11), v(i, 12), v(i, 13), v(i, 14)])
                 .collect(),
         ),
+        coverage: None,
         stats: FrameStats::default(),
     };
     let plain = Film {

@@ -27,6 +27,7 @@ fn film() -> Film {
         normal: None,
         albedo: None,
         traps: None,
+        coverage: None,
         stats: FrameStats::default(),
     }
 }

@@ -235,11 +235,17 @@ fn a_field_is_inserted_like_its_siblings() {
 #[test]
 fn whole_number_fields_are_written_whole_and_refuse_fractions() {
     let bare = "(fps: 1, frames: 1, size: (8, 8))";
-    // A palette stop's fields need the stop written first.
+    // A palette stop's fields need the stop written first; a fisheye's
+    // angle and stereo's separation are fields of parts of the camera a
+    // bare scene lacks (a track on them is refused there).
     let in_bare = |p: &&Parameter| p.shape == Shape::Number && p.name != ZOOM_TRACK;
+    let bare_has = |p: &&Parameter| {
+        parameters::camera_lacks(&crate::scene::Scene::default(), p.name).is_none()
+    };
     for parameter in parameters::all()
         .filter(in_bare)
         .filter(|p| !p.name.contains('['))
+        .filter(bare_has)
     {
         let set = |v| Edit::SetScene {
             parameter: parameter.name.into(),

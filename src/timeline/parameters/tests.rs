@@ -12,6 +12,14 @@ fn every_parameter_sets_its_field() {
             motion_blur: None,
             path_tracing: None,
         },
+        camera: crate::camera::Camera {
+            projection: Projection::Fisheye { degrees: 180.0 },
+            stereo: Some(crate::camera::Stereo {
+                eye_separation: 0.03,
+                layout: crate::camera::StereoLayout::SideBySide,
+            }),
+            ..Default::default()
+        },
         ..Scene::default()
     };
     let mut all_effects = all_effects;
