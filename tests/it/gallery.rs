@@ -22,8 +22,15 @@ fn the_gallery_script_renders_times_and_strips_every_example() {
         .output()
         .expect("sh runs");
     let table = String::from_utf8_lossy(&out.stdout);
-    assert!(out.status.success(), "{table}{}", String::from_utf8_lossy(&out.stderr));
-    let rows: Vec<&str> = table.lines().filter(|l| l.starts_with("| ") && !l.starts_with("| film")).collect();
+    assert!(
+        out.status.success(),
+        "{table}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let rows: Vec<&str> = table
+        .lines()
+        .filter(|l| l.starts_with("| ") && !l.starts_with("| film"))
+        .collect();
     assert_eq!(rows.len(), 12, "{table}");
     for film in ["zoom", "julia_morph", "deep_zoom"] {
         let strip = image::open(d.path().join(format!("docs/{film}_strip.png"))).expect("a strip");
@@ -39,6 +46,11 @@ fn the_gallery_script_renders_times_and_strips_every_example() {
             })
             .count();
         assert_eq!(jpegs, 4, "{film}");
-        assert!(rows.iter().filter(|r| r.starts_with(&format!("| {film} |"))).count() == 4);
+        assert!(
+            rows.iter()
+                .filter(|r| r.starts_with(&format!("| {film} |")))
+                .count()
+                == 4
+        );
     }
 }
