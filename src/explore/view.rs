@@ -73,6 +73,7 @@ impl View {
         for scene in &mut scenes {
             self.lay_over(scene)?;
         }
+        self.auto_count_over(&timeline, &mut scenes);
         let hash = crate::output::frames::frame_hash(&scenes, self.frame, width, height);
         Ok(Prepared {
             scenes,
@@ -81,6 +82,23 @@ impl View {
             height,
             hash,
         })
+    }
+
+    /// With `iterations: Auto` and overrides, the count the edited view
+    /// chooses (the frame's saved scene chose the one it has), shared by
+    /// the frame's samples as a render shares it.
+    fn auto_count_over(&self, timeline: &Timeline, scenes: &mut [Scene]) {
+        let Some(first) = scenes.first() else {
+            return;
+        };
+        let Some(auto) = first.fractal.auto.filter(|_| !self.overrides.is_empty()) else {
+            return;
+        };
+        let size = [timeline.width, timeline.height];
+        let count = crate::timeline::auto::resolve(first, auto, size).count;
+        for scene in scenes {
+            scene.fractal.iterations = count;
+        }
     }
 
     /// The overrides written into `scene`, which must stay valid. The zoom's
@@ -242,6 +260,24 @@ mod tests {
     fn zoom() -> Timeline {
         let text = std::fs::read_to_string("timelines/zoom.ron").unwrap();
         Timeline::parse(&text, Path::new("zoom.ron")).unwrap()
+    }
+
+    #[test]
+    fn an_edited_view_under_auto_renders_the_count_its_own_scene_chooses() {
+        let text = std::fs::read_to_string("timelines/deep_zoom.ron").unwrap();
+        let t = Timeline::parse(&text, Path::new("deep_zoom.ron")).unwrap();
+        let saved = t.auto_count(300).unwrap().count;
+        let mut view = View {
+            frame: 300,
+            ..View::default()
+        };
+        view.overrides.insert("camera.distance".into(), vec![1e-25]);
+        let prepared = view.prepare(&t).unwrap();
+        let scene = &prepared.scenes[0];
+        let auto = scene.fractal.auto.unwrap();
+        let own = crate::timeline::auto::resolve(scene, auto, [t.width, t.height]).count;
+        assert!(own > saved, "a camera far closer needs more than {saved}");
+        assert_eq!(scene.fractal.iterations, own);
     }
 
     #[test]

@@ -29,6 +29,7 @@ pub use tracks::Track;
 pub use validate::validate_scene;
 
 use crate::error::{Error, Result};
+use crate::fractal::AutoIterations;
 use crate::math::Real;
 use crate::scene::Scene;
 use rayon::prelude::*;
@@ -239,11 +240,28 @@ impl Timeline {
             }
             track.apply(&mut scene, time_seconds);
         }
-        if let Some(auto) = scene.fractal.auto {
-            let size = [self.width, self.height];
-            scene.fractal.iterations = self.auto_counts.at(time_seconds, &scene, auto, size).count;
+        // Validation needs no count (Auto's are in range by construction),
+        // so a scene about to be refused is never marched for one.
+        if let Some(auto) = scene.fractal.auto.filter(|_| !check) {
+            scene.fractal.iterations = self.auto_at(time_seconds, &scene, auto).count;
         }
         Ok(scene)
+    }
+
+    /// `Auto`'s count at `time_seconds`, whose scene is `scene`: the count
+    /// of the frame the instant belongs to, at the frame's own time, so a
+    /// frame's motion-blur samples share one count (and one reference).
+    fn auto_at(&self, time_seconds: Real, scene: &Scene, auto: AutoIterations) -> auto::Resolved {
+        let size = [self.width, self.height];
+        let frame_time = (time_seconds * self.fps + 1e-9).floor() / self.fps;
+        if frame_time == time_seconds || frame_time < 0.0 {
+            return self.auto_counts.at(time_seconds, scene, auto, size);
+        }
+        let mut own = self.base.clone();
+        for track in &self.tracks {
+            track.apply(&mut own, frame_time);
+        }
+        self.auto_counts.at(frame_time, &own, auto, size)
     }
 
     /// The instants a frame's samples see: the frame's own, or with motion

@@ -1059,3 +1059,30 @@ fn a_count_and_auto_hash_alike_where_auto_chose_that_count() {
         serde_json::to_string(&fixed).unwrap()
     );
 }
+
+#[test]
+fn a_frames_motion_blur_samples_share_its_auto_count() {
+    // A fast zoom: over the open shutter the distance falls a decade, so
+    // each sample's own scene would ask for another count.
+    let text = "(fps: 10, frames: 4, size: (64, 36), scene: (samples_per_pixel: 4,
+        camera: (position: (0, 2, 2), target: (0, 0.6505, 0)),
+        fractal: (iterations: Auto), effects: (motion_blur: (shutter: 1))),
+        tracks: { \"camera.distance\": (interpolation: Linear, keys: [(time: 0, value: 1), (time: 0.3, value: 1e-4)]) })";
+    let t = parse(text).unwrap();
+    for frame in 0..4 {
+        let own = t.auto_count(frame).unwrap().count;
+        let counts: Vec<u32> = t
+            .scenes_for_frame(frame)
+            .iter()
+            .map(|s| s.fractal.iterations)
+            .collect();
+        assert!(
+            counts.iter().all(|&c| c == own),
+            "frame {frame}: {counts:?} against {own}"
+        );
+    }
+    // The samples' own scenes do differ: the test can fail.
+    let late = t.scene_at_time(0.1 + 0.09);
+    let own = crate::timeline::auto::resolve(&late, late.fractal.auto.unwrap(), [64, 36]);
+    assert_ne!(own.count, t.auto_count(1).unwrap().count);
+}
