@@ -199,7 +199,9 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
 }
 
 /// Membership-reference hit distance for every pixel centre (None for a
-/// miss), stepping `step_fraction` of a footprint, with the tests spent.
+/// miss, and for a pixel the camera does not cover, which the render
+/// leaves empty), stepping `step_fraction` of a footprint, with the tests
+/// spent.
 pub fn reference_depths(
     scene: &Scene,
     width: u32,
@@ -219,6 +221,9 @@ pub fn reference_depths(
             let mut tests = 0u64;
             let row = (0..width)
                 .map(|x| {
+                    if !camera.covers(x, y, width, height) {
+                        return None;
+                    }
                     let ray = camera.ray(x as Real + 0.5, y as Real + 0.5, width, height);
                     let (t, n) = march_by_membership(
                         &ray,
@@ -724,6 +729,22 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_reference_has_no_depth_outside_a_fisheye_circle() {
+        // A fisheye narrow enough that the bulb fills the whole image,
+        // corners included: only the circle is the picture.
+        let mut scene = Scene::default();
+        scene.camera.projection = crate::camera::Projection::Fisheye { degrees: 4.0 };
+        let (w, h) = (12, 8);
+        let (depths, _) = reference_depths(&scene, w, h, 1.0);
+        let camera = scene.camera.frame();
+        for (i, depth) in depths.iter().enumerate() {
+            let (x, y) = (i as u32 % w, i as u32 / w);
+            let inside = camera.covers(x, y, w, h);
+            assert_eq!(depth.is_some(), inside, "pixel ({x}, {y}): {depth:?}");
+        }
+    }
 
     #[test]
     fn depth_errors_of_known_hits() {

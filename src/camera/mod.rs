@@ -167,6 +167,34 @@ impl Camera {
         [w.max(1), h.max(1)]
     }
 
+    /// Why a `width`×`height` image cannot hold this camera's stereo pair,
+    /// if it cannot: a side a pair splits must be even, or one eye would
+    /// have a column (or row) more than the other.
+    pub fn uneven_eyes(&self, [width, height]: [u32; 2]) -> Option<String> {
+        let (side, length, layout) = match self.stereo.map(|s| s.layout) {
+            Some(StereoLayout::SideBySide) => ("width", width, "SideBySide"),
+            Some(StereoLayout::TopBottom) => ("height", height, "TopBottom"),
+            None => return None,
+        };
+        (length % 2 == 1).then(|| {
+            format!(
+                "a {layout} stereo pair splits the {side} in two halves, so it must be \
+                 even, got {width}x{height}"
+            )
+        })
+    }
+
+    /// `width`×`height` with the side a stereo pair splits rounded down to
+    /// an even length (at least 2), for sizes derived from the one given.
+    pub fn even_eyes(&self, [width, height]: [u32; 2]) -> [u32; 2] {
+        let even = |n: u32| (n & !1).max(2);
+        match self.stereo.map(|s| s.layout) {
+            Some(StereoLayout::SideBySide) => [even(width), height],
+            Some(StereoLayout::TopBottom) => [width, even(height)],
+            None => [width, height],
+        }
+    }
+
     /// The angle a pixel spans on the view's axis in a `width`×`height`
     /// image (of one eye where the image holds two).
     pub fn axis_pixel_angle(&self, [width, height]: [u32; 2]) -> Real {
@@ -266,29 +294,19 @@ impl CameraFrame {
     pub fn ray(&self, x: Real, y: Real, width: u32, height: u32) -> Ray {
         let eye = self.eye(x, y, width, height);
         let half = self.stereo.map_or(0.0, |(half, _)| half);
-        let (dir, pixel_angle, offset) = match self.projection {
-            Projection::Perspective => {
-                let sx = (2.0 * eye.x / eye.w - 1.0) * self.tan_half_fov * (eye.w / eye.h);
-                let sy = (1.0 - 2.0 * eye.y / eye.h) * self.tan_half_fov;
-                let dir = (self.forward + self.right * sx + self.up * sy).normalize();
-                let angle = 2.0 * self.tan_half_fov / eye.h;
-                (dir, angle, self.right * (eye.side * half))
+        let position = [eye.x, eye.y, eye.w, eye.h];
+        let d = projection::direction(self.projection, self.tan_half_fov, position);
+        // Forward first: a pinhole's is 1, so its sum is the plane's exactly.
+        let dir = (self.forward * d.forward + self.right * d.right + self.up * d.up).normalize();
+        let pixel_angle = d.pixel_angle;
+        let offset = match self.projection {
+            // Omni-directional stereo: each column's eyes.
+            Projection::Equirectangular => {
+                let (longitude, _) = projection::longitude_latitude(eye.x, eye.y, eye.w, eye.h);
+                let (r, f) = (self.right, self.forward);
+                projection::ods_offset(longitude, half, eye.side, r, f)
             }
-            other => {
-                let d = projection::direction(other, eye.x, eye.y, eye.w, eye.h);
-                let dir = self.right * d.right + self.up * d.up + self.forward * d.forward;
-                let offset = match other {
-                    // Omni-directional stereo: each column's eyes.
-                    Projection::Equirectangular => {
-                        let (longitude, _) =
-                            projection::longitude_latitude(eye.x, eye.y, eye.w, eye.h);
-                        let (r, f) = (self.right, self.forward);
-                        projection::ods_offset(longitude, half, eye.side, r, f)
-                    }
-                    _ => self.right * (eye.side * half),
-                };
-                (dir.normalize(), d.pixel_angle, offset)
-            }
+            Projection::Perspective | Projection::Fisheye { .. } => self.right * (eye.side * half),
         };
         // One eye's rays leave from the centre itself, to the bit.
         let origin = match self.stereo {

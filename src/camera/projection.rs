@@ -45,7 +45,7 @@ impl Projection {
 #[serde(deny_unknown_fields)]
 pub struct Stereo {
     /// The distance between the eyes as a share of the camera–target
-    /// distance, so a zoom keeps its depth: 0.03 is a viewer two metres
+    /// distance, so a zoom keeps its depth: 0.0325 is a viewer two metres
     /// from something with 6.5 cm between the eyes.
     pub eye_separation: Real,
     pub layout: StereoLayout,
@@ -71,13 +71,24 @@ pub struct Direction {
 }
 
 /// The direction through image position (`x`, `y`) of a `w`×`h` eye image
-/// (pixels from the top-left corner) of a non-perspective projection.
-pub fn direction(projection: Projection, x: Real, y: Real, w: Real, h: Real) -> Direction {
+/// (pixels from the top-left corner), not normalised; `tan_half_fov` is
+/// the pinhole's.
+pub fn direction(projection: Projection, tan_half_fov: Real, [x, y, w, h]: [Real; 4]) -> Direction {
     match projection {
+        Projection::Perspective => perspective(tan_half_fov, x, y, w, h),
         Projection::Fisheye { degrees } => fisheye(degrees, x, y, w, h),
-        // Perspective is made by `CameraFrame::ray` itself; equirectangular
-        // covers every direction.
-        _ => equirectangular(x, y, w, h),
+        Projection::Equirectangular => equirectangular(x, y, w, h),
+    }
+}
+
+/// The pinhole's direction: through the image plane one unit ahead, which
+/// spans `tan_half_fov` above and below the axis.
+fn perspective(tan_half_fov: Real, x: Real, y: Real, w: Real, h: Real) -> Direction {
+    Direction {
+        right: (2.0 * x / w - 1.0) * tan_half_fov * (w / h),
+        up: (1.0 - 2.0 * y / h) * tan_half_fov,
+        forward: 1.0,
+        pixel_angle: 2.0 * tan_half_fov / h,
     }
 }
 

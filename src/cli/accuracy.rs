@@ -3,7 +3,7 @@
 
 use super::AccuracyArgs;
 use crate::error::Error;
-use crate::job::request::{check_frame, parse_size, set_threads};
+use crate::job::request::{check_eyes, check_frame, parse_size, set_threads};
 use crate::timeline::Timeline;
 use std::path::Path;
 
@@ -16,12 +16,12 @@ pub fn accuracy(args: AccuracyArgs) -> anyhow::Result<()> {
         Some(s) => parse_size("--size", s)?,
         None => {
             let w = t.width.min(160);
-            (
-                w,
-                ((w as u64 * t.height as u64) / t.width as u64).max(1) as u32,
-            )
+            let h = ((w as u64 * t.height as u64) / t.width as u64).max(1) as u32;
+            let [w, h] = t.base.camera.even_eyes([w, h]);
+            (w, h)
         }
     };
+    check_eyes(&t, (width, height))?;
     check_frame(&t, args.frame)?;
     let out_dir = args
         .out

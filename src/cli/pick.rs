@@ -3,7 +3,7 @@
 
 use super::PickArgs;
 use crate::error::Error;
-use crate::job::request::{check_frame, parse_size};
+use crate::job::request::{check_eyes, check_frame, parse_size};
 use crate::timeline::Timeline;
 
 /// Checks the frame and pixel, picks, and prints.
@@ -13,6 +13,7 @@ pub fn pick(args: PickArgs) -> anyhow::Result<()> {
         Some(s) => parse_size("--size", s)?,
         None => (t.width, t.height),
     };
+    check_eyes(&t, (width, height))?;
     check_frame(&t, args.frame)?;
     let Some(pixel) = &args.pixel else {
         return refine(&t, &args, [width, height]);

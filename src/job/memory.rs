@@ -19,8 +19,10 @@ impl Plan {
             (false, Some(_)) => crate::render::Sums::Adaptive,
         };
         let exr = self.formats.contains(&Format::Exr);
-        let (w, h) = (self.width, self.height);
-        let need = crate::render::frame_bytes(w, h, self.layers(), exr, sums);
+        let size = [self.width, self.height];
+        // No track changes the projection: the base scene's is every frame's.
+        let partial = !base.camera.frame().covers_all();
+        let need = crate::render::frame_bytes(size, self.layers(), exr, sums, partial);
         let Some((have, whose)) = memory_available() else {
             return Ok(());
         };

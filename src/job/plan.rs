@@ -4,7 +4,7 @@
 
 use crate::error::Error;
 use crate::job::frames::{frames_text, parse_frames};
-use crate::job::request::{parse_size, Sequence};
+use crate::job::request::{check_eyes, parse_size, Sequence};
 use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use crate::timeline::Timeline;
@@ -82,6 +82,7 @@ impl Plan {
             Some(s) => parse_size("--size", s)?,
             None => (timeline.width, timeline.height),
         };
+        check_eyes(&timeline, (width, height))?;
         let range = match &args.frames {
             Some(f) => parse_frames(f, timeline.frame_count)?,
             None => 0..timeline.frame_count,
@@ -93,8 +94,9 @@ impl Plan {
             .unwrap_or_else(|| Path::new("out").join(&timeline.name));
         let preview = args.preview;
         if preview {
-            width = (width / 2).max(1);
-            height = (height / 2).max(1);
+            // Halved, a stereo pair's side stays even.
+            let half = [(width / 2).max(1), (height / 2).max(1)];
+            [width, height] = timeline.base.camera.even_eyes(half);
             out_dir = out_dir.join("preview");
         }
         Ok(Plan {

@@ -82,6 +82,14 @@ pub fn parse_size(option: &str, text: &str) -> Result<(u32, u32)> {
     Ok((w, h))
 }
 
+/// Refuses a `--size` that splits `t`'s stereo pair unevenly.
+pub fn check_eyes(t: &Timeline, (width, height): (u32, u32)) -> Result<()> {
+    match t.base.camera.uneven_eyes([width, height]) {
+        Some(message) => Err(Error::usage("--size", message)),
+        None => Ok(()),
+    }
+}
+
 /// Parses `--shard I/N` or `auto` from the scheduler's environment.
 pub fn parse_shard(text: &str, env: &dyn Fn(&str) -> Option<String>) -> Result<(u32, u32)> {
     let bad = |why: String| Error::usage("--shard", why);

@@ -21,17 +21,12 @@ const INSIDE_CHECK_SECONDS: f64 = 0.4;
 /// An equirectangular eye's image that is not twice as wide as high:
 /// its pixels are not square, and 360° players stretch it.
 fn equirectangular_shape(timeline: &Timeline) -> Option<String> {
-    use crate::camera::{Projection, StereoLayout};
+    use crate::camera::Projection;
     let camera = &timeline.base.camera;
     if camera.projection != Projection::Equirectangular {
         return None;
     }
-    let (mut w, mut h) = (timeline.width, timeline.height);
-    match camera.stereo.map(|s| s.layout) {
-        Some(StereoLayout::SideBySide) => w /= 2,
-        Some(StereoLayout::TopBottom) => h /= 2,
-        None => {}
-    }
+    let [w, h] = camera.eye_size([timeline.width, timeline.height]);
     (w != 2 * h).then(|| {
         format!(
             "an equirectangular image is twice as wide as high, and each eye's here is {w}×{h}: \

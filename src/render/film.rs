@@ -112,15 +112,24 @@ impl Layers {
 /// compressed data; and for a frame of several samples per pixel the
 /// running sums (colour in f64, hits, depth and estimates spent, 40 bytes a
 /// pixel, and the layers, and under adaptive sampling each pixel's spread).
+/// A `partial` frame (a fisheye's, which covers only its circle) adds its
+/// coverage to the film (an f32 a pixel) and to the sums (a u32 a pixel).
 /// What a size can be checked against before it is rendered.
-pub fn frame_bytes(width: u32, height: u32, layers: Layers, exr: bool, sums: Sums) -> u64 {
-    let film = 24 + layers.bytes_per_pixel();
+pub fn frame_bytes(
+    [width, height]: [u32; 2],
+    layers: Layers,
+    exr: bool,
+    sums: Sums,
+    partial: bool,
+) -> u64 {
+    let coverage = 4 * partial as u64;
+    let film = 24 + layers.bytes_per_pixel() + coverage;
     let encoding = if exr { film } else { 4 };
     let spread = std::mem::size_of::<super::adaptive::Spread>() as u64;
     let sums = match sums {
         Sums::None => 0,
-        Sums::Uniform => 40 + layers.bytes_per_pixel(),
-        Sums::Adaptive => 40 + layers.bytes_per_pixel() + spread,
+        Sums::Uniform => 40 + layers.bytes_per_pixel() + coverage,
+        Sums::Adaptive => 40 + layers.bytes_per_pixel() + spread + coverage,
     };
     width as u64 * height as u64 * (film + encoding + sums)
 }

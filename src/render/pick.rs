@@ -114,13 +114,15 @@ const REFINE_STEP: f64 = 1e-3;
 /// surface. Each hit is within a pixel of the surface at that depth, so the
 /// last places the target as finely as the scene's pixels. `Err` says at
 /// which distance the centre ray missed, or the camera was inside the set.
-pub fn refine(scene: &Scene, [width, height]: [u32; 2]) -> Result<Refined, String> {
+pub fn refine(scene: &Scene, image_size: [u32; 2]) -> Result<Refined, String> {
     let relative = scene.camera.relative_position();
     let (last, away) = (relative.length(), relative.normalize());
     let size = scene.camera.target.abs().max_element();
     let mut distance = (REFINE_STEP * size).max(last);
     let mut s = scene.clone();
-    // The centre ray of one eye at the camera itself: the view's axis.
+    // The centre ray of one eye at the camera itself: the view's axis, in
+    // an image of an eye's size, whose pixels those of the frame are.
+    let [width, height] = s.camera.eye_size(image_size);
     s.camera.stereo = None;
     let mut steps = Vec::new();
     loop {
@@ -189,4 +191,27 @@ fn onto_the_set(ray: &crate::march::Ray, t: f64, scene: &Scene) -> f64 {
         1 << 14,
     );
     crossing.unwrap_or(0.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::{Stereo, StereoLayout};
+
+    #[test]
+    fn refine_of_a_stereo_pair_works_at_one_eyes_size() {
+        // The default view: its centre ray meets the bulb.
+        let mono = Scene::default();
+        let stereo = Stereo {
+            eye_separation: 0.03,
+            layout: StereoLayout::TopBottom,
+        };
+        let mut pair = mono.clone();
+        pair.camera.stereo = Some(stereo);
+        let one = refine(&mono, [64, 48]);
+        assert!(one.is_ok(), "{:?}", one.err());
+        let two = refine(&pair, [64, 96]);
+        let json = |r: Result<Refined, String>| r.map(|r| serde_json::to_string(&r).ok());
+        assert_eq!(json(two), json(one));
+    }
 }

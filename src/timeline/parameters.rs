@@ -318,12 +318,20 @@ pub const FISHEYE_DEGREES: &str = "camera.projection.degrees";
 /// The stereo eyes' separation, animatable.
 pub const EYE_SEPARATION: &str = "camera.stereo.eye_separation";
 
+/// A fisheye's angle: its pixels span `degrees` over the circle's
+/// diameter, so `MIN_FOV_DEGREES` bounds it for the same reason as a
+/// pinhole's field of view.
 fn fisheye_degrees(degrees: Real) -> Checked {
-    let ok = degrees.is_finite() && degrees > 0.0 && degrees <= 360.0;
+    let ok = degrees.is_finite() && (MIN_FOV_DEGREES..=360.0).contains(&degrees);
     rule(ok, || {
         format!(
-            "a fisheye's angle must be above 0 and at most 360 degrees, got {}",
-            degrees.shown()
+            "a fisheye's angle must be from {MIN_FOV_DEGREES:e} to 360 degrees, got {}{}",
+            degrees.shown(),
+            if degrees > 0.0 && degrees < MIN_FOV_DEGREES {
+                " (narrower, a pixel would span less than f64 can tell apart along a ray)"
+            } else {
+                ""
+            }
         )
     })
 }

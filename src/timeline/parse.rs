@@ -37,6 +37,9 @@ impl Timeline {
         if let Err((field, message)) = validate_scene(&file.scene) {
             return Err(source.value(&format!("scene.{field}"), message));
         }
+        if let Some(message) = file.scene.camera.uneven_eyes([width, height]) {
+            return Err(source.top("size", message));
+        }
         // Too many instants to check, or too many track values at them.
         let too_many = |(field, message): TooMany| source.value(field, message);
         check_scene_count(&file.scene, frame_count, 0).map_err(too_many)?;

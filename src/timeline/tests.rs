@@ -724,6 +724,19 @@ fn a_word_in_a_comment_does_not_move_a_keys_line() {
 }
 
 #[test]
+fn a_fisheye_narrower_than_the_narrowest_field_of_view_is_refused() {
+    let text = "(fps: 24, frames: 3, size: (8, 6), \
+                scene: (camera: (projection: Fisheye(degrees: 1e-12))))";
+    let column = text.find("1e-12").expect("the value is in the text") + 1;
+    let e = error_of(text);
+    let place = format!("test.ron:1:{column}: scene.camera.projection.degrees: ");
+    assert!(e.starts_with(&place), "{e}");
+    assert!(e.contains("from 1e-7 to 360 degrees, got 1e-12"), "{e}");
+    let at_floor = text.replace("1e-12", "1e-7");
+    assert!(parse(&at_floor).is_ok());
+}
+
+#[test]
 fn non_positive_fps_size_fov_are_rejected() {
     assert!(error_of("(fps: 0, frames: 3, size: (8, 6))").contains("fps"));
     assert!(error_of("(fps: -24, frames: 3, size: (8, 6))").contains("fps"));

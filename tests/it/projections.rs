@@ -198,3 +198,40 @@ fn a_track_animates_the_fisheyes_angle_and_needs_a_fisheye() {
         );
     }
 }
+
+/// A stereo pair's split side must be even, or one eye would have a pixel
+/// more: an odd timeline size is an invalid timeline at its `size`, an odd
+/// `--size` a bad argument, and --preview halves to an even side.
+#[test]
+fn a_stereo_pair_refuses_an_odd_side() {
+    let d = Dir::new();
+    let pair = |layout: &str| format!("stereo: (eye_separation: 0.03, layout: {layout})");
+    for (size, layout, side) in [
+        ("(47, 28)", "SideBySide", "width"),
+        ("(48, 27)", "TopBottom", "height"),
+    ] {
+        d.write("t.ron", &timeline(size, &pair(layout)));
+        let out = d.run(&["render", "t.ron"]);
+        let e = stderr(&out);
+        assert_eq!(out.status.code(), Some(3), "{e}");
+        assert!(e.contains("t.ron:4:11: size: "), "{e}");
+        assert!(e.contains(layout) && e.contains(side), "{e}");
+    }
+    d.write("t.ron", &timeline("(48, 28)", &pair("SideBySide")));
+    let out = d.run(&["render", "t.ron", "--size", "47x28"]);
+    let e = stderr(&out);
+    assert_eq!(out.status.code(), Some(2), "{e}");
+    assert!(e.contains("--size") && e.contains("SideBySide"), "{e}");
+    assert!(d.files("out").is_empty(), "nothing is left behind");
+    // 50x28 halves to 25x14: the preview renders 24x14.
+    d.ok(&[
+        "render",
+        "t.ron",
+        "--size",
+        "50x28",
+        "--preview",
+        "--format",
+        "exr",
+    ]);
+    assert_eq!(d.exr("out/t/preview/frame_00000.exr").size, (24, 14));
+}

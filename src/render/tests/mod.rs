@@ -312,3 +312,18 @@ fn a_frame_rendered_in_waves_equals_one_rendered_at_once() {
 }
 
 mod zoom;
+
+#[test]
+fn a_fisheye_frames_memory_estimate_holds_its_film() {
+    let mut scene = Scene::default();
+    scene.camera.projection = crate::camera::Projection::Fisheye { degrees: 180.0 };
+    let (w, h) = (16, 12);
+    let film = render_frame(&scene, 0, w, h, &|| {});
+    let coverage = film.coverage.as_ref().expect("a fisheye film has coverage");
+    let held = 12 * film.colour.len()
+        + 4 * (film.alpha.len() + film.depth.len() + film.evaluations.len() + coverage.len());
+    // A PNG's encoding takes 4 bytes a pixel beside the film.
+    let png = 4 * (w * h) as u64;
+    let estimate = frame_bytes([w, h], Layers::default(), false, Sums::None, true);
+    assert!(held as u64 + png <= estimate, "{held} + {png} > {estimate}");
+}
