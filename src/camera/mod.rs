@@ -366,7 +366,7 @@ impl CameraFrame {
         }
         let (across, above, along) = match self.projection {
             Projection::Perspective => (self.right, self.up, pinhole.dir.dot(self.forward)),
-            _ => {
+            Projection::Fisheye { .. } | Projection::Equirectangular => {
                 let across = crate::math::normalize_or(pinhole.dir.cross(self.up), self.right);
                 (across, across.cross(pinhole.dir), 1.0)
             }
