@@ -22,8 +22,7 @@ use serde::{Deserialize, Serialize};
 use std::fs::OpenOptions;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
+use std::sync::mpsc::{channel, RecvTimeoutError, Sender};
 use std::time::{Duration, SystemTime, UNIX_EPOCH};
 
 /// What a claim file holds.
@@ -172,6 +171,10 @@ pub enum Attempt {
     Held(ClaimRecord),
 }
 
+/// The shortest time between heartbeats: a tiny `--claim-timeout` must
+/// not turn the thread into a loop of writes.
+const HEARTBEAT_FLOOR: Duration = Duration::from_millis(50);
+
 /// A held claim; a thread keeps its heartbeat fresh until it is dropped,
 /// which also removes the claim file, as an interrupt (Ctrl-C) does: so
 /// another worker can take the frame at once.
@@ -181,7 +184,9 @@ pub struct Claim {
     /// ones of earlier generations before it.
     markers: Vec<PathBuf>,
     token: String,
-    stop: Arc<AtomicBool>,
+    /// Dropped (or sent on) to stop the heartbeat: its thread wakes at once,
+    /// so a render's end waits for no tick.
+    stop: Option<Sender<()>>,
     heartbeat: Option<std::thread::JoinHandle<()>>,
     _released_on_interrupt: crate::interrupt::Registered,
 }
@@ -230,22 +235,16 @@ impl Claim {
         contested: bool,
         released_on_interrupt: Registered,
     ) -> Claim {
-        let stop = Arc::new(AtomicBool::new(false));
+        let interval = interval.max(HEARTBEAT_FLOOR);
+        let (stop, stopped) = channel::<()>();
         let heartbeat = {
-            let (path, stop, mut record) = (path.clone(), stop.clone(), record.clone());
+            let (path, mut record) = (path.clone(), record.clone());
             std::thread::spawn(move || {
-                let tick = Duration::from_millis(50);
-                let mut waited = Duration::ZERO;
-                while !stop.load(Ordering::Relaxed) {
-                    std::thread::sleep(tick);
-                    waited += tick;
-                    if waited >= interval {
-                        waited = Duration::ZERO;
-                        let ours = || read_claim(&path).is_some_and(|r| r.token == record.token);
-                        if !contested || ours() {
-                            record.heartbeat_ms = now_ms();
-                            let _ = write_record(&path, &record);
-                        }
+                while let Err(RecvTimeoutError::Timeout) = stopped.recv_timeout(interval) {
+                    let ours = || read_claim(&path).is_some_and(|r| r.token == record.token);
+                    if !contested || ours() {
+                        record.heartbeat_ms = now_ms();
+                        let _ = write_record(&path, &record);
                     }
                 }
             })
@@ -254,7 +253,7 @@ impl Claim {
             path,
             markers,
             token: record.token,
-            stop,
+            stop: Some(stop),
             heartbeat: Some(heartbeat),
             _released_on_interrupt: released_on_interrupt,
         }
@@ -263,7 +262,7 @@ impl Claim {
 
 impl Drop for Claim {
     fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
+        drop(self.stop.take());
         if let Some(h) = self.heartbeat.take() {
             let _ = h.join();
         }
