@@ -1406,7 +1406,9 @@ pub fn run_and_write(options: &Options) -> Result<String> {
     Ok(md_text)
 }
 
-/// A file-name-safe default machine name: cores and CPU model.
+/// A file-name-safe default machine name: cores, CPU model and vector
+/// width, so two machines that report one model name (AMD EPYCs with and
+/// without AVX-512) keep their results apart.
 pub fn default_machine_name(peak: &Peak) -> String {
     let model: String = peak
         .cpu
@@ -1419,7 +1421,12 @@ pub fn default_machine_name(peak: &Peak) -> String {
         .filter(|s| !s.is_empty() && *s != "r" && *s != "tm")
         .collect::<Vec<_>>()
         .join("-");
-    format!("{}core-{model}", peak.cores)
+    let width = match peak.lanes {
+        8 => "avx512",
+        4 => "avx2",
+        _ => "sse",
+    };
+    format!("{}core-{model}-{width}", peak.cores)
 }
 
 #[cfg(test)]
@@ -1537,7 +1544,9 @@ mod tests {
         // More threads than cores get no more peak.
         assert_eq!(p.gflops_for(1), p.gflops() / 2.0);
         assert_eq!(p.gflops_for(8), p.gflops());
-        assert_eq!(default_machine_name(&p), "2core-test");
+        assert_eq!(default_machine_name(&p), "2core-test-avx2");
+        let wide = Peak { lanes: 8, ..p };
+        assert_eq!(default_machine_name(&wide), "2core-test-avx512");
     }
 
     #[test]
