@@ -235,6 +235,15 @@ impl Fractal {
         }
     }
 
+    /// Whether an estimate's `end` is where `orbit_at::<f64>(p,
+    /// self.iterations, true)` ends, bit for bit: the f64 estimators finish
+    /// that orbit (`estimate_raw`; the vector kernels repeat it), but for
+    /// the Jacobian method, whose dual numbers divide by multiplying with
+    /// an inverse.
+    pub fn ends_f64_orbits(&self) -> bool {
+        self.precision == Precision::F64 && self.de != DeMethod::Jacobian
+    }
+
     /// The world position of the frame's point `p` (to f64, for bounds).
     #[inline(always)]
     pub fn world(&self, p: DVec3) -> DVec3 {
@@ -429,6 +438,7 @@ impl Fractal {
             iterations: centre.iterations,
             escaped: centre.escaped,
             orbits,
+            end: centre.z.map(|c| c.value()),
         }
     }
 }
