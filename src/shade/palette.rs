@@ -5,8 +5,8 @@
 //!
 //! The stops are converted to OKLab once, at a palette's first hit
 //! (`Prepared`), and the smooth count and angle come from the hit's own
-//! estimate, whose orbit already ended where they are read: a hit costs no
-//! more orbit and no colour conversion.
+//! estimate, whose orbit already ended where they are read: a hit iterates
+//! no more orbit and converts no stop.
 //!
 //! OKLab: Ottosson, "A perceptual color space for image processing" (2020),
 //! by the `oklab` crate. The smooth escape count: Vepstas, "Renormalizing
@@ -59,7 +59,8 @@ pub(crate) struct Prepared {
 }
 
 impl PartialEq for Prepared {
-    /// Always equal: what it holds follows from the stops, which are compared.
+    /// Always equal: a cache, each entry checked against what it was made
+    /// from at every use.
     fn eq(&self, _: &Prepared) -> bool {
         true
     }
