@@ -16,7 +16,7 @@ impl Fractal {
     /// bailout above 237 for power 8. Lowering the escape radius above the
     /// set's own radius (`set_radius`) keeps the set but for orbits that
     /// would have escaped an iteration or two later. Cheap: a power is taken
-    /// only where the bailout is that large.
+    /// only where the bailout is that large (`lowered`).
     #[inline]
     pub fn escape_radius<T: Number>(&self) -> Real {
         let limit_log2 = 0.5 * T::MAX_LOG2 - 14.0;
@@ -25,7 +25,7 @@ impl Fractal {
         if self.power * e <= limit_log2 {
             self.bailout
         } else {
-            self.bailout.min((limit_log2 / self.power).exp2())
+            lowered(self.bailout, limit_log2 / self.power)
         }
     }
 
@@ -235,6 +235,15 @@ impl Fractal {
         }
     }
 
+    /// Whether an estimate's `end` is where `orbit_at::<f64>(p,
+    /// self.iterations, true)` ends, bit for bit: the f64 estimators finish
+    /// that orbit (`estimate_raw`; the vector kernels repeat it), but for
+    /// the Jacobian method, whose dual numbers divide by multiplying with
+    /// an inverse.
+    pub fn ends_f64_orbits(&self) -> bool {
+        self.precision == Precision::F64 && self.de != DeMethod::Jacobian
+    }
+
     /// The world position of the frame's point `p` (to f64, for bounds).
     #[inline(always)]
     pub fn world(&self, p: DVec3) -> DVec3 {
@@ -429,6 +438,7 @@ impl Fractal {
             iterations: centre.iterations,
             escaped: centre.escaped,
             orbits,
+            end: centre.z.map(|c| c.value()),
         }
     }
 }
@@ -469,6 +479,15 @@ pub fn spectral_norm(m: glam::DMat3) -> Real {
 /// stop early but never skips surface.
 pub(super) fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
     as_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
+}
+
+/// `bailout`, or 2^`log2` where that is lower. Out of line: inlined, the
+/// compiler took the power before the test on every call (the kernel asks
+/// for the escape radius once per register), as it may with `exp2`.
+#[cold]
+#[inline(never)]
+fn lowered(bailout: Real, log2: Real) -> Real {
+    bailout.min(log2.exp2())
 }
 
 /// An estimate `d` as a distance: `d` where it is above 0 and finite, else

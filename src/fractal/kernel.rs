@@ -541,6 +541,7 @@ impl<S: pulp::Simd> Register<S> {
         let store = Self::store;
         let (distance, origin) = (store(distance), store(origin));
         let (i, escaped) = (store(self.i), store(self.select(escaped, one, zero)));
+        let end = self.z.map(store);
         for (k, out) in out.iter_mut().enumerate() {
             *out = Estimate {
                 distance: distance[k],
@@ -551,6 +552,7 @@ impl<S: pulp::Simd> Register<S> {
                 iterations: i[k] as u32,
                 escaped: escaped[k] != 0.0,
                 orbits: 1,
+                end: [end[0][k], end[1][k], end[2][k]],
             };
         }
         if self.any(rare) {

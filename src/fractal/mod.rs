@@ -200,6 +200,11 @@ pub struct Estimate {
     pub escaped: bool,
     /// Orbits computed for this estimate (the cost: 1 for analytic, 5 for gradient methods).
     pub orbits: u32,
+    /// Where the estimate's orbit (of its point, stopping at the bailout)
+    /// ended, in the estimator's precision: shading reads a hit's escape
+    /// radius and final angle here instead of iterating the orbit again
+    /// (`Fractal::ends_f64_orbits` says when it is the f64 orbit's).
+    pub end: Triplex<Real>,
 }
 
 impl Estimate {
@@ -214,7 +219,14 @@ impl Estimate {
         iterations: 0,
         escaped: false,
         orbits: 0,
+        end: [0.0; 3],
     };
+
+    /// |z| where the orbit ended, as every orbit loop takes it (the root
+    /// of `length_squared`), so it is their `Orbit::r` to the bit.
+    pub fn end_radius(&self) -> Real {
+        power::length_squared(self.end).sqrt()
+    }
 }
 
 /// A point of the kernel's number type.

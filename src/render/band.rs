@@ -152,7 +152,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
                 stats.normal_evaluations += evals as u64;
                 sums.spent[order[i]] += evals as u64;
                 let at = SurfacePoint::from_hit(ray, hit, nrm);
-                surfaces[i] = Some(at.coloured(&scene.look, &scene.fractal));
+                surfaces[i] = Some(at.coloured(&scene.look, &scene.fractal, &hit.estimate));
             },
         );
         band_shadows(scene, surfaces, walks, shadows);

@@ -132,10 +132,16 @@ impl SurfacePoint {
     }
 
     /// This point with the orbit quantity `look`'s palette needs, where it
-    /// has a palette with some mix: a palette that is off runs no orbit.
-    pub fn coloured(mut self, look: &Look, fractal: &crate::fractal::Fractal) -> Self {
+    /// has a palette with some mix, from `estimate`, the one taken at the
+    /// point (the hit's).
+    pub fn coloured(
+        mut self,
+        look: &Look,
+        fractal: &crate::fractal::Fractal,
+        estimate: &crate::fractal::Estimate,
+    ) -> Self {
         if let Some(palette) = look.palette.as_ref().filter(|p| p.mix > 0.0) {
-            self.palette_quantity = Some(palette.quantity(fractal, self.point, &self.traps));
+            self.palette_quantity = Some(palette.quantity(fractal, self.point, estimate));
         }
         self
     }

@@ -3,14 +3,20 @@
 //! or its final point's angle) picks the surface colour, mixed over the
 //! trap colours.
 //!
+//! The stops are converted to OKLab once, at a palette's first hit
+//! (`Prepared`), and the smooth count and angle come from the hit's own
+//! estimate, whose orbit already ended where they are read: a hit iterates
+//! no more orbit and converts no stop.
+//!
 //! OKLab: Ottosson, "A perceptual color space for image processing" (2020),
 //! by the `oklab` crate. The smooth escape count: Vepstas, "Renormalizing
 //! the Mandelbrot escape" (1997), for a power n and escape radius E.
 
-use crate::fractal::{Formula, Fractal, OrbitTraps};
+use crate::fractal::{Estimate, Formula, Fractal};
 use crate::math::{DVec3, Real, Vec3};
 use oklab::{linear_srgb_to_oklab, oklab_to_linear_srgb, Oklab, Rgb};
 use serde::{Deserialize, Serialize};
+use std::sync::OnceLock;
 
 /// The most stops a palette may have: each stop's position and colour is a
 /// parameter a track can animate, and the table lists every one.
@@ -34,6 +40,57 @@ pub struct Palette {
     pub mix: f32,
     /// What the gradient does past its ends.
     pub wrap: Wrap,
+    /// What every hit would work out alike, made at the first; not part
+    /// of the timeline.
+    #[serde(skip)]
+    pub(crate) prepared: Prepared,
+}
+
+/// What a palette's hits share, worked out at the first hit that needs it:
+/// each stop's colour in OKLab (converting two stops at every hit took the
+/// cube roots that were most of the palette's cost), and the logarithms of
+/// the escape radius and power the smooth count divides by. Each is kept
+/// with the bits it was made from; a stop or fractal that has changed
+/// since (a scene edited after shading) is worked out where it is used.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Prepared {
+    lab: OnceLock<Vec<([u32; 3], Oklab)>>,
+    logs: OnceLock<([u64; 2], [Real; 2])>,
+}
+
+impl PartialEq for Prepared {
+    /// Always equal: a cache, each entry checked against what it was made
+    /// from at every use.
+    fn eq(&self, _: &Prepared) -> bool {
+        true
+    }
+}
+
+impl Prepared {
+    /// Stop `i` of `stops` (the palette's) in OKLab.
+    fn lab(&self, stops: &[Stop], i: usize) -> Oklab {
+        let colour = stops[i].colour;
+        let table = self.lab.get_or_init(|| {
+            stops
+                .iter()
+                .map(|s| (s.colour.to_array().map(f32::to_bits), to_lab(s.colour)))
+                .collect()
+        });
+        match table.get(i) {
+            Some(&(bits, lab)) if bits == colour.to_array().map(f32::to_bits) => lab,
+            _ => to_lab(colour),
+        }
+    }
+
+    /// ln E and ln n, for escape radius `escape` and power `power`.
+    fn logs(&self, escape: Real, power: Real) -> [Real; 2] {
+        let key = [escape.to_bits(), power.to_bits()];
+        let logs = || [escape.ln(), power.ln()];
+        match self.logs.get_or_init(|| (key, logs())) {
+            &(made_from, made) if made_from == key => made,
+            _ => logs(),
+        }
+    }
 }
 
 /// One stop of a gradient: a linear-RGB colour at a position in [0, 1].
@@ -89,6 +146,7 @@ impl Default for Palette {
             offset: 0.0,
             mix: 1.0,
             wrap: Wrap::Repeat,
+            prepared: Prepared::default(),
         }
     }
 }
@@ -108,41 +166,46 @@ impl Palette {
         let (Some(first), Some(last)) = (stops.first(), stops.last()) else {
             return Vec3::ZERO;
         };
+        let (last_index, n) = (stops.len() - 1, stops.len());
         let next = stops.partition_point(|s| s.position <= t);
-        let (a, b) = match (next, self.wrap) {
-            (0, Wrap::Repeat) => (shifted(last, -1.0), *first),
+        // The stops either side of `t` (by index) and their positions, the
+        // neighbour across a repeating gradient's seam moved a gradient along.
+        let (a, at_a, b, at_b) = match (next, self.wrap) {
+            (0, Wrap::Repeat) => (last_index, last.position - 1.0, 0, first.position),
             (0, _) => return first.colour,
-            (n, Wrap::Repeat) if n == stops.len() => (*last, shifted(first, 1.0)),
-            (n, _) if n == stops.len() => return last.colour,
-            (n, _) => (stops[n - 1], stops[n]),
+            (k, Wrap::Repeat) if k == n => (last_index, last.position, 0, first.position + 1.0),
+            (k, _) if k == n => return last.colour,
+            (k, _) => (k - 1, stops[k - 1].position, k, stops[k].position),
         };
-        let span = b.position - a.position;
-        let f = if span > 0.0 {
-            (t - a.position) / span
-        } else {
-            1.0
-        };
-        mix_oklab(a.colour, b.colour, f.clamp(0.0, 1.0))
+        let span = at_b - at_a;
+        let f = if span > 0.0 { (t - at_a) / span } else { 1.0 };
+        let lab = |i| self.prepared.lab(stops, i);
+        mix_lab(lab(a), lab(b), f.clamp(0.0, 1.0))
     }
 
-    /// The orbit quantity `by` names for the frame's point `point`, whose
-    /// orbit met `traps`: the trap's at once, the others from one more orbit.
-    pub fn quantity(&self, fractal: &Fractal, point: DVec3, traps: &OrbitTraps) -> f32 {
-        match self.by {
-            OrbitQuantity::Trap => traps.origin.sqrt() as f32,
+    /// The orbit quantity `by` names for the frame's point `point`, given
+    /// the estimate taken there (a hit's): the trap's and, in f64, the
+    /// others from where its orbit ended; in f32 from one more orbit.
+    pub fn quantity(&self, fractal: &Fractal, point: DVec3, estimate: &Estimate) -> f32 {
+        let (iterations, end, r) = match self.by {
+            OrbitQuantity::Trap => return estimate.traps.origin.sqrt() as f32,
+            _ if fractal.ends_f64_orbits() => {
+                (estimate.iterations, estimate.end, estimate.end_radius())
+            }
             OrbitQuantity::SmoothIterations | OrbitQuantity::Angle => {
                 // In a deep frame `point` is an offset from the anchor, and
                 // `orbit_at` iterates it by perturbation.
                 let orbit = fractal.orbit_at([point.x, point.y, point.z], fractal.iterations, true);
-                match self.by {
-                    OrbitQuantity::Angle => azimuth_turns(fractal.formula, orbit.z),
-                    _ => smooth_iterations(
-                        orbit.iterations,
-                        orbit.r,
-                        fractal.escape_radius::<Real>(),
-                        fractal.power,
-                    ),
-                }
+                (orbit.iterations, orbit.z, orbit.r)
+            }
+        };
+        match self.by {
+            OrbitQuantity::Angle => azimuth_turns(fractal.formula, end),
+            _ => {
+                let logs = self
+                    .prepared
+                    .logs(fractal.escape_radius::<Real>(), fractal.power);
+                smooth_count(iterations, r, logs)
             }
         }
     }
@@ -166,20 +229,29 @@ impl Wrap {
     }
 }
 
-/// `stop` moved by `by` along the gradient: the neighbour across the seam
-/// of a repeating one.
-fn shifted(stop: &Stop, by: f32) -> Stop {
-    Stop {
-        position: stop.position + by,
-        ..*stop
-    }
-}
-
 /// The colour a fraction `f` of the way from `a` to `b`, interpolated in
 /// OKLab, where equal steps look equal; never negative.
 pub fn mix_oklab(a: Vec3, b: Vec3, f: f32) -> Vec3 {
-    let lab = |c: Vec3| linear_srgb_to_oklab(Rgb::new(c.x, c.y, c.z));
-    let (p, q) = (lab(a), lab(b));
+    mix_lab(to_lab(a), to_lab(b), f)
+}
+
+/// A linear-RGB colour in OKLab.
+fn to_lab(c: Vec3) -> Oklab {
+    #[cfg(test)]
+    CONVERSIONS.with(|n| n.set(n.get() + 1));
+    linear_srgb_to_oklab(Rgb::new(c.x, c.y, c.z))
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Colours `to_lab` converted on this thread: how the tests see that a
+    /// palette converts its stops once.
+    pub(super) static CONVERSIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// The colour a fraction `f` of the way from `p` to `q` (in OKLab), in
+/// linear RGB; never negative.
+fn mix_lab(p: Oklab, q: Oklab, f: f32) -> Vec3 {
     let lerp = |x: f32, y: f32| x + (y - x) * f;
     let c = oklab_to_linear_srgb(Oklab {
         l: lerp(p.l, q.l),
@@ -194,8 +266,13 @@ pub fn mix_oklab(a: Vec3, b: Vec3, f: f32) -> Vec3 {
 /// that never escaped (r ≤ E) counts `iterations + 1`, where its escaping
 /// neighbours' counts tend.
 pub fn smooth_iterations(iterations: u32, r: Real, escape: Real, power: Real) -> f32 {
-    let ratio = (r.ln() / escape.ln()).max(1.0);
-    (iterations as Real + 1.0 - ratio.ln() / power.ln()) as f32
+    smooth_count(iterations, r, [escape.ln(), power.ln()])
+}
+
+/// `smooth_iterations`, given ln E and ln n.
+fn smooth_count(iterations: u32, r: Real, [ln_escape, ln_power]: [Real; 2]) -> f32 {
+    let ratio = (r.ln() / ln_escape).max(1.0);
+    (iterations as Real + 1.0 - ratio.ln() / ln_power) as f32
 }
 
 /// The azimuth of `z` about `formula`'s pole axis, in turns from 0 to 1.

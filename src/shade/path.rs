@@ -372,7 +372,7 @@ pub fn trace_paths(
             let path = paths[i].as_mut().expect("a path that goes on");
             path.here = SurfacePoint {
                 t: path.here.t + hit.t,
-                ..SurfacePoint::from_hit(ray, hit, nrm).coloured(look, fractal)
+                ..SurfacePoint::from_hit(ray, hit, nrm).coloured(look, fractal, &hit.estimate)
             };
         });
     }

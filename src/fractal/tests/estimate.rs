@@ -329,3 +329,79 @@ fn check_jacobian(f: &Fractal) {
         f.power
     );
 }
+
+/// Shading reads a hit's escape radius and final angle from its estimate
+/// (`Estimate::end`) instead of iterating again, wherever `ends_f64_orbits`:
+/// one estimate or 16 side by side, deep or not, every estimator that says
+/// so ends where the f64 orbit ends, to the bit.
+#[test]
+fn an_estimate_ends_where_its_f64_orbit_ends() {
+    let mut fractals = variants();
+    for de in [
+        DeMethod::Potential,
+        DeMethod::SinhPotential,
+        DeMethod::EscapeLength,
+    ] {
+        fractals.push(Fractal {
+            de,
+            ..Fractal::default()
+        });
+    }
+    let mut pts = points(320, 0.0..2.5, 9);
+    pts.extend([
+        DVec3::new(0.0, 0.0, 0.7),
+        DVec3::ZERO,
+        DVec3::new(4.1, 0.3, -0.2),
+    ]);
+    for f in &fractals {
+        assert!(f.ends_f64_orbits());
+        assert_ends(f, &pts);
+    }
+    // A deep frame's points are offsets from its anchor, near the surface.
+    let anchor = DVec3::new(0.31, 0.62, 0.58);
+    let big = anchor
+        .to_array()
+        .map(|c| crate::exact::big_from_f64(c, 128));
+    let plain = Fractal {
+        iterations: 24,
+        ..Fractal::default()
+    };
+    let reference = deep::Reference::new(&plain, big, 128).expect("a whole power");
+    let deep = Fractal {
+        deep: Some(std::sync::Arc::new(reference)),
+        ..plain
+    };
+    let offsets: Vec<DVec3> = points(64, 0.0..1.0, 4).iter().map(|p| *p * 1e-7).collect();
+    assert_ends(&deep, &offsets);
+    // f32 estimates end on f32's orbit, and the Jacobian method's on its
+    // dual numbers': shading iterates again for those.
+    assert!(!Fractal {
+        precision: Precision::F32,
+        ..Fractal::default()
+    }
+    .ends_f64_orbits());
+    assert!(!Fractal {
+        de: DeMethod::Jacobian,
+        ..Fractal::default()
+    }
+    .ends_f64_orbits());
+}
+
+/// Each of `pts`, estimated alone and 16 at a time, ends where `f`'s f64
+/// orbit of it ends.
+fn assert_ends(f: &Fractal, pts: &[DVec3]) {
+    for chunk in pts.chunks(16) {
+        let mut lanes = [IDLE_POINT; 16];
+        lanes[..chunk.len()].copy_from_slice(chunk);
+        let together = f.estimate_lanes(lanes, [1e-4; 16]);
+        for (p, lane) in chunk.iter().zip(together) {
+            let orbit = f.orbit_at([p.x, p.y, p.z], f.iterations, true);
+            for e in [lane, f.estimate(*p, 1e-4)] {
+                let bits = |z: [Real; 3]| z.map(Real::to_bits);
+                assert_eq!(bits(e.end), bits(orbit.z), "{f:?} at {p}");
+                assert_eq!(e.end_radius().to_bits(), orbit.r.to_bits(), "at {p}");
+                assert_eq!(e.iterations, orbit.iterations, "at {p}");
+            }
+        }
+    }
+}

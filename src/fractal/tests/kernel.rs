@@ -4,19 +4,7 @@ use super::*;
 
 #[test]
 fn lanes_are_bit_identical_to_one_estimate_at_a_time() {
-    let mut fractals = vec![];
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
-        for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
-            for power in [8.0, 3.0, 7.5] {
-                fractals.push(Fractal {
-                    formula,
-                    julia,
-                    power,
-                    ..Fractal::default()
-                });
-            }
-        }
-    }
+    let mut fractals = variants();
     fractals.push(Fractal {
         de: DeMethod::Potential,
         ..Fractal::default()

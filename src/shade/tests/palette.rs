@@ -1,5 +1,6 @@
 //! Palettes: OKLab interpolation, the stops and wrap modes, the orbit
-//! quantities (deep frames' among them), and what a palette does to albedo.
+//! quantities (deep frames' among them), what a palette does to albedo,
+//! and that what its hits share is worked out once, to the bit.
 
 use super::*;
 
@@ -213,19 +214,151 @@ fn a_deep_frames_quantities_are_the_plain_orbits() {
         deep: Some(std::sync::Arc::new(reference)),
         ..plain.clone()
     };
-    let traps = OrbitTraps {
-        origin: 1.0,
-        planes: DVec3::ONE,
-    };
     for by in [OrbitQuantity::SmoothIterations, OrbitQuantity::Angle] {
         let p = Palette {
             by,
             ..Palette::default()
         };
         for delta in [DVec3::new(1e-7, -2e-7, 3e-8), DVec3::new(-4e-9, 1e-9, 2e-9)] {
-            let a = p.quantity(&deep, delta, &traps);
-            let b = p.quantity(&plain, anchor + delta, &traps);
+            let a = p.quantity(&deep, delta, &deep.estimate(delta, 1e-9));
+            let q = anchor + delta;
+            let b = p.quantity(&plain, q, &plain.estimate(q, 1e-9));
             assert!((a - b).abs() < 1e-3, "{by:?}: deep {a}, plain {b}");
+        }
+    }
+}
+
+/// `Palette::at` as it stood with no table: both stops converted at the
+/// call (`mix_oklab`), the neighbour across a repeating seam shifted.
+fn at_converting(p: &Palette, t: f32) -> Vec3 {
+    let (first, last, n) = (p.stops[0], p.stops[p.stops.len() - 1], p.stops.len());
+    let shifted = |s: Stop, by: f32| stop(s.position + by, s.colour);
+    let next = p.stops.partition_point(|s| s.position <= t);
+    let (a, b) = match (next, p.wrap) {
+        (0, Wrap::Repeat) => (shifted(last, -1.0), first),
+        (0, _) => return first.colour,
+        (k, Wrap::Repeat) if k == n => (last, shifted(first, 1.0)),
+        (k, _) if k == n => return last.colour,
+        (k, _) => (p.stops[k - 1], p.stops[k]),
+    };
+    let span = b.position - a.position;
+    let f = if span > 0.0 {
+        (t - a.position) / span
+    } else {
+        1.0
+    };
+    mix_oklab(a.colour, b.colour, f.clamp(0.0, 1.0))
+}
+
+/// Gradient places from before the first stop to past the last.
+fn places() -> impl Iterator<Item = f32> {
+    (0..=1000).map(|i| i as f32 / 1000.0 * 1.2 - 0.1)
+}
+
+#[test]
+fn a_palette_converts_each_stop_once_not_at_every_hit() {
+    let p = Palette::default();
+    let before = crate::shade::palette::CONVERSIONS.with(|n| n.get());
+    for t in places() {
+        p.colour(t);
+    }
+    let converted = crate::shade::palette::CONVERSIONS.with(|n| n.get()) - before;
+    assert_eq!(converted, p.stops.len() as u64);
+}
+
+#[test]
+fn the_converted_stops_give_every_colour_to_the_bit() {
+    let bits = |c: Vec3| c.to_array().map(f32::to_bits);
+    for wrap in [Wrap::Repeat, Wrap::Mirror, Wrap::Clamp] {
+        let mut uneven = Palette {
+            wrap,
+            ..Palette::default()
+        };
+        uneven.stops.push(stop(0.85, GREEN));
+        for p in [two_stops(wrap), uneven] {
+            for t in places() {
+                assert_eq!(bits(p.at(t)), bits(at_converting(&p, t)), "{wrap:?} at {t}");
+            }
+        }
+    }
+}
+
+#[test]
+fn a_stop_edited_after_shading_shows_its_new_colour() {
+    let mut p = two_stops(Wrap::Clamp);
+    let before = p.at(0.5);
+    p.stops[1].colour = GREEN;
+    let fresh = two_stops(Wrap::Clamp);
+    let fresh = Palette {
+        stops: vec![fresh.stops[0], stop(0.75, GREEN)],
+        ..fresh
+    };
+    assert_eq!(p.at(0.5), fresh.at(0.5));
+    assert_ne!(p.at(0.5), before);
+}
+
+/// The quantities as the hit's orbit, iterated again in f64, gives them.
+fn quantity_from_orbit(by: OrbitQuantity, fractal: &Fractal, point: DVec3) -> f32 {
+    let o = fractal.orbit_at([point.x, point.y, point.z], fractal.iterations, true);
+    match by {
+        OrbitQuantity::Angle => {
+            let phi = match fractal.formula {
+                crate::fractal::Formula::Quilez => o.z[0].atan2(o.z[2]),
+                _ => o.z[1].atan2(o.z[0]),
+            };
+            (phi / std::f64::consts::TAU + 0.5) as f32
+        }
+        _ => smooth_iterations(
+            o.iterations,
+            o.r,
+            fractal.escape_radius::<Real>(),
+            fractal.power,
+        ),
+    }
+}
+
+#[test]
+fn a_hits_quantities_from_its_estimate_are_its_orbits_to_the_bit() {
+    use crate::fractal::{DeMethod, Formula, Precision};
+    let mut fractals = vec![];
+    for formula in [Formula::Quilez, Formula::WhiteNylander] {
+        for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
+            fractals.push(Fractal {
+                formula,
+                julia,
+                ..Fractal::default()
+            });
+        }
+    }
+    // Those whose estimates end elsewhere iterate again.
+    for (de, precision) in [
+        (DeMethod::Potential, Precision::F64),
+        (DeMethod::Jacobian, Precision::F64),
+        (DeMethod::Analytic, Precision::F32),
+    ] {
+        fractals.push(Fractal {
+            de,
+            precision,
+            power: 7.5,
+            ..Fractal::default()
+        });
+    }
+    let points = crate::math::shell_points(192, 0.9..1.3, 3);
+    for f in &fractals {
+        for by in [OrbitQuantity::SmoothIterations, OrbitQuantity::Angle] {
+            let p = Palette {
+                by,
+                ..Palette::default()
+            };
+            for chunk in points.chunks(16) {
+                let lanes: [DVec3; 16] = chunk.try_into().expect("192 points, 16 at a time");
+                let estimates = f.estimate_lanes(lanes, [1e-4; 16]);
+                for (q, e) in lanes.iter().zip(&estimates) {
+                    let want = quantity_from_orbit(by, f, *q);
+                    let got = p.quantity(f, *q, e);
+                    assert_eq!(got.to_bits(), want.to_bits(), "{by:?} {f:?} at {q}");
+                }
+            }
         }
     }
 }
