@@ -140,7 +140,7 @@ impl Fractal {
         // in few operations: every estimate of a march comes through here.
         let critical = near_critical && self.julia.is_some();
         let p = self.world(p);
-        if no_bound_applies(p, iterations, escape.min(2.0), critical) {
+        if no_bound_applies(p, iterations, escape.min(2.0), critical, distance) {
             return (distance, 0);
         }
         let scaled = p.abs().max_element();
@@ -502,12 +502,28 @@ pub(super) fn as_distance(d: Real) -> Real {
 }
 
 /// Whether none of `Fractal::bounded`'s bounds applies at `p`: its orbit
-/// iterated, it lies within `near` (the escape radius, at most 2), and it
-/// is not near Julia's critical point (`critical`). The test every
-/// estimate of a march takes, so it is kept to a few operations.
+/// iterated, it lies within `near` (the escape radius, at most 2), and,
+/// near Julia's critical point (`critical`), its `distance` is shorter
+/// than |p|. The test every estimate of a march takes, so it is kept to a
+/// few operations: squares, not square roots.
 #[inline(always)]
-pub(super) fn no_bound_applies(p: DVec3, iterations: u32, near: Real, critical: bool) -> bool {
-    iterations > 0 && p.length_squared() <= near * near && !critical
+pub(super) fn no_bound_applies(
+    p: DVec3,
+    iterations: u32,
+    near: Real,
+    critical: bool,
+    distance: Real,
+) -> bool {
+    let r2 = p.length_squared();
+    // A NaN |p|² is no more within `near` than a large one.
+    let within = r2 <= near * near;
+    if iterations == 0 || !within {
+        return false;
+    }
+    // Short of the bound by a margin far above rounding, so that wherever
+    // this says no bound applies, `bounded`'s tests on |p| agree.
+    const MARGIN: Real = 1.0 - 1.0 / (1u64 << 40) as Real;
+    !critical || (r2 < MARGIN * near * near && distance > 0.0 && distance * distance < MARGIN * r2)
 }
 
 /// The distance from `p` to the bailout ball, for a point outside it before

@@ -77,7 +77,7 @@ impl Fractal {
         let near = self.escape_radius::<f64>().min(2.0);
         let critical = self.julia.is_some();
         for (out, &p) in out.iter_mut().zip(points) {
-            if out.escaped && !no_bound_applies(p, out.iterations, near, critical) {
+            if out.escaped && !no_bound_applies(p, out.iterations, near, critical, out.distance) {
                 let (distance, orbits) =
                     self.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
                 out.distance = distance;

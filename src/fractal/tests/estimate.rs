@@ -405,3 +405,34 @@ fn assert_ends(f: &Fractal, pts: &[DVec3]) {
         }
     }
 }
+
+#[test]
+fn julia_lanes_off_the_critical_point_skip_the_bound_as_bounded_would() {
+    // Julia's critical-point bound keeps an estimate shorter than |p|; the
+    // squared test must let those lanes through without `bounded`, and
+    // never let through one that `bounded`'s square roots would catch.
+    assert!(no_bound_applies(DVec3::new(1.0, 0.0, 0.0), 5, 2.0, true, 0.1));
+    assert!(!no_bound_applies(DVec3::new(0.1, 0.0, 0.0), 5, 2.0, true, 0.2));
+    let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as Real / (1u64 << 53) as Real
+    };
+    let near = 1.5;
+    for _ in 0..200_000 {
+        let p = DVec3::new(next(), next(), next()) * (2.0 * near / 3f64.sqrt());
+        let length = p.length();
+        // Distances on both sides of |p|, some within rounding of it.
+        let distance = match (next() * 3.0) as u32 {
+            0 => length * (1.0 + (next() - 0.5) * 1e-15),
+            1 => length * 2.0 * next(),
+            _ => -next(),
+        };
+        let by_roots = length <= near && distance > 0.0 && distance < length;
+        if no_bound_applies(p, 3, near, true, distance) {
+            assert!(by_roots, "p {p}, distance {distance}");
+        }
+    }
+}
