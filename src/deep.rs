@@ -17,8 +17,9 @@ use std::sync::Arc;
 /// of the target's coordinates: 2²⁶ times f64's resolution there. Orbits
 /// near a repelling fixed point amplify f64's rounding far more than their
 /// pixels' offsets: on `deep_zoom.ron`'s tip f64 frames turn to noise from
-/// 2⁻³⁰, so this keeps a margin of 16 over the worst case seen.
-pub const DEEP_BELOW: Real = 1.0 / (1u64 << 26) as Real;
+/// 2⁻³⁰, so this keeps a margin of 16 over the worst case seen. Within a
+/// deep frame, points whose footprints pass it are estimated in f64 alone.
+pub const DEEP_BELOW: Real = crate::fractal::deep::F64_RESOLVES;
 
 /// The closest a camera may come to its target: a frame's offsets are f64,
 /// and lengths square them, which leaves f64's range below about 1e-154.
@@ -54,7 +55,7 @@ pub fn steps_of(scene: &Scene, size: [u32; 2]) -> u32 {
 
 /// The hash a deep frame's file adds to its scene's: what rendering it by
 /// perturbation means changes with it, as `RENDERER_REVISION` does for all.
-pub const DEEP_REVISION: u32 = 1;
+pub const DEEP_REVISION: u32 = 2;
 
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;

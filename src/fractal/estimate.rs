@@ -266,6 +266,9 @@ impl Fractal {
     /// detail that matters there (the pixel footprint); the finite-difference
     /// methods step a fraction of it.
     pub fn estimate(&self, p: DVec3, scale: Real) -> Estimate {
+        if let Some(estimate) = self.plain_estimate(p, scale) {
+            return estimate;
+        }
         match self.precision {
             Precision::F64 => self.estimate_in::<f64>(p, scale, true),
             Precision::F32 => self.estimate_in::<f32>(p, scale, true),

@@ -6,10 +6,10 @@
 //! Both do the same operations in the same order, so a lane's orbit is
 //! bit-identical to the scalar one.
 
-use super::super::kernel::{Register as Kernel, Stored, REGISTER, VECTOR};
+use super::super::kernel::{Register as Kernel, Stored, IDLE_POINT, REGISTER, VECTOR};
 use super::super::orbit::Orbit;
 use super::super::power::{length_squared, powi};
-use super::super::{Fractal, OrbitTraps};
+use super::super::{Estimate, Fractal, OrbitTraps};
 use super::{add, Reference, State};
 use crate::math::{Arith, DVec3, Real, Vector};
 
@@ -225,31 +225,80 @@ impl<S: pulp::Simd> State<Vector<S>> {
 impl Reference {
     /// The analytic estimates at `points` (offsets from the anchor), a
     /// register of orbits at a time: bit-identical to `Fractal::estimate`
-    /// at each.
+    /// at each. The points f64 resolves (`resolves_in_f64`) go to the plain
+    /// kernel at their world positions, the others to perturbed orbits.
     pub(in crate::fractal) fn estimates_into(
         &self,
         fractal: &Fractal,
         points: &[DVec3],
         scales: &[Real],
-        out: &mut [crate::fractal::Estimate],
+        out: &mut [Estimate],
     ) {
         let arch = pulp::Arch::new();
+        let plain = fractal.plain();
         for ((points, scales), out) in points
             .chunks(VECTOR)
             .zip(scales.chunks(VECTOR))
             .zip(out.chunks_mut(VECTOR))
         {
+            let mut world = [IDLE_POINT; VECTOR];
+            let mut deep = Partition::default();
+            for (k, (&p, &scale)) in points.iter().zip(scales).enumerate() {
+                match self.resolves_in_f64(p, scale) {
+                    true => world[k] = self.anchor + p,
+                    false => deep.push(k, p, scale),
+                }
+            }
+            if deep.count < points.len() {
+                let mut estimates = [Estimate::IDLE; VECTOR];
+                let mut padded = [0.0; VECTOR];
+                padded[..scales.len()].copy_from_slice(scales);
+                plain.estimate_lanes_into(&world, &padded, &mut estimates);
+                out.copy_from_slice(&estimates[..out.len()]);
+            }
+            let count = deep.count;
             let mut orbits = [Orbit::IDLE; VECTOR];
-            arch.dispatch(Lanes {
-                reference: self,
-                fractal,
-                points,
-                out: &mut orbits[..points.len()],
-            });
-            for (((out, orbit), &p), &scale) in out.iter_mut().zip(&orbits).zip(points).zip(scales)
-            {
-                *out = fractal.estimate_finished(p, scale, orbit);
+            if count > 0 {
+                arch.dispatch(Lanes {
+                    reference: self,
+                    fractal,
+                    points: &deep.points[..count],
+                    out: &mut orbits[..count],
+                });
+            }
+            for (j, orbit) in orbits[..count].iter().enumerate() {
+                let (k, p, scale) = (deep.index[j], deep.points[j], deep.scales[j]);
+                out[k] = fractal.estimate_finished(p, scale, orbit);
             }
         }
+    }
+}
+
+/// The points of a register's worth that need perturbed orbits, packed,
+/// with where each came from.
+struct Partition {
+    index: [usize; VECTOR],
+    points: [DVec3; VECTOR],
+    scales: [Real; VECTOR],
+    count: usize,
+}
+
+impl Default for Partition {
+    fn default() -> Self {
+        Partition {
+            index: [0; VECTOR],
+            points: [DVec3::ZERO; VECTOR],
+            scales: [0.0; VECTOR],
+            count: 0,
+        }
+    }
+}
+
+impl Partition {
+    #[inline(always)]
+    fn push(&mut self, k: usize, p: DVec3, scale: Real) {
+        (self.index[self.count], self.points[self.count]) = (k, p);
+        self.scales[self.count] = scale;
+        self.count += 1;
     }
 }

@@ -14,7 +14,7 @@
 
 use super::orbit::{Orbit, ITERATIONS};
 use super::power::{length_squared, powi, whole_power, whole_power_step};
-use super::{Formula, Fractal, OrbitTraps, Triplex};
+use super::{DeMethod, Estimate, Formula, Fractal, OrbitTraps, Precision, Triplex};
 use crate::exact::{big_from_f64, Big};
 use crate::math::{DVec3, Number, Real};
 use step::Delta;
@@ -272,6 +272,55 @@ impl Reference {
         let zt = z.map(T::from_real);
         let (a, b) = (power(add(z, d)), power(zt));
         [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+}
+
+/// The least footprint, as a share of a point's largest coordinate, at
+/// which a deep frame's analytic estimate is left to f64 alone: the share
+/// below which a frame is deep (`crate::deep::DEEP_BELOW`), point by point. Points far from the anchor
+/// (rays leaving for the rest of the bulb, occlusion's reach) pass it; their
+/// perturbed orbits part from the reference at once and are rebased, to
+/// finish one at a time at several times the plain kernel's cost.
+pub const F64_RESOLVES: Real = 1.0 / (1u64 << 26) as Real;
+
+impl Reference {
+    /// Whether f64 alone resolves the point `p` (an offset from the anchor)
+    /// where detail of size `scale` matters (`F64_RESOLVES`).
+    #[inline(always)]
+    pub(super) fn resolves_in_f64(&self, p: DVec3, scale: Real) -> bool {
+        scale >= F64_RESOLVES * (self.anchor + p).abs().max_element()
+    }
+}
+
+impl Fractal {
+    /// This fractal in world coordinates, without the deep frame's
+    /// reference: what estimates the points f64 resolves. Field by field,
+    /// so that a new field must be placed here.
+    pub(super) fn plain(&self) -> Fractal {
+        Fractal {
+            formula: self.formula,
+            power: self.power,
+            iterations: self.iterations,
+            auto: self.auto,
+            bailout: self.bailout,
+            julia: self.julia,
+            julia_digits: None,
+            de: self.de,
+            precision: self.precision,
+            deep: None,
+            perturbation: self.perturbation,
+        }
+    }
+
+    /// The analytic estimate at the deep frame's point `p` where f64 alone
+    /// resolves it (`F64_RESOLVES`), from the plain fractal at its world
+    /// position; `None` where the frame is not deep or `p` needs the
+    /// reference.
+    pub(in crate::fractal) fn plain_estimate(&self, p: DVec3, scale: Real) -> Option<Estimate> {
+        let reference = self.deep.as_ref()?;
+        let analytic = self.de == DeMethod::Analytic && self.precision == Precision::F64;
+        (analytic && reference.resolves_in_f64(p, scale))
+            .then(|| self.plain().estimate(reference.anchor + p, scale))
     }
 }
 

@@ -263,19 +263,31 @@ fn deep_estimates_match_plain_ones_where_f64_is_exact() {
     }
 }
 
+/// `plain` with a 160-bit reference at a point of its surface, and the point.
+fn deep_on_the_surface(plain: &Fractal) -> (Fractal, DVec3) {
+    let bits = 160;
+    let anchor = surface_point(plain, DVec3::new(0.4, 0.7, 0.5));
+    let reference = Reference::new(plain, big(anchor, bits), bits).unwrap();
+    let fractal = Fractal {
+        deep: Some(Arc::new(reference)),
+        ..plain.clone()
+    };
+    (fractal, anchor)
+}
+
+/// `N` offsets along `directions`, the `i`th 10^`decade(i)` long.
+fn offsets<const N: usize>(decade: impl Fn(usize) -> i32) -> [DVec3; N] {
+    let dirs = directions(N);
+    std::array::from_fn(|i| dirs[i] * 10f64.powi(decade(i)))
+}
+
 #[test]
 fn lanes_are_bit_identical_to_the_scalar_orbit() {
-    let bits = 160;
     let mut compared = 0;
-    for mut fractal in fractals() {
-        let anchor = surface_point(&fractal, DVec3::new(0.4, 0.7, 0.5));
-        fractal.deep = Some(Arc::new(
-            Reference::new(&fractal, big(anchor, bits), bits).unwrap(),
-        ));
+    for plain in fractals() {
+        let (fractal, _) = deep_on_the_surface(&plain);
         // Offsets from far below a pixel to ones that rebase and escape.
-        let dirs = directions(48);
-        let points: [DVec3; 48] =
-            std::array::from_fn(|i| dirs[i] * 10f64.powi(-(i as i32 % 12) * 3));
+        let points: [DVec3; 48] = offsets(|i| -(i as i32 % 12) * 3);
         let scales = [1e-12; 48];
         for chunk in [&points[..16], &points[16..32], &points[32..]] {
             let lanes = fractal
@@ -297,6 +309,33 @@ fn lanes_are_bit_identical_to_the_scalar_orbit() {
         }
     }
     assert_eq!(compared, 8 * 48);
+}
+
+#[test]
+fn points_f64_resolves_are_the_plain_kernels() {
+    let mut perturbed = 0;
+    for plain in fractals() {
+        let (fractal, anchor) = deep_on_the_surface(&plain);
+        // Offsets of a whole to a thousandth of the anchor's size, their
+        // footprints at `F64_RESOLVES` (even) and half of it (odd).
+        let points: [DVec3; 32] = offsets(|i| -(i as i32 % 4));
+        let scales: [Real; 32] = std::array::from_fn(|i| {
+            let size = (anchor + points[i]).abs().max_element() * F64_RESOLVES;
+            size * [1.0, 0.5][i % 2]
+        });
+        let lanes = fractal.estimate_lanes::<32>(points, scales);
+        for (i, lane) in lanes.into_iter().enumerate() {
+            let one = fractal.estimate(points[i], scales[i]);
+            assert_eq!(lane, one, "{:?} at {}", fractal.formula, points[i]);
+            let f64_alone = plain.estimate(anchor + points[i], scales[i]);
+            match i % 2 {
+                0 => assert_eq!(one, f64_alone, "{:?} at {}", fractal.formula, points[i]),
+                _ => perturbed += usize::from(one != f64_alone),
+            }
+        }
+    }
+    // Below the footprint the estimates stay perturbed, whose last bits differ.
+    assert!(perturbed > 8, "{perturbed}");
 }
 
 #[test]
