@@ -6,12 +6,15 @@
 //! anchor in high precision (`fractal::deep`). Frames that f64 resolves
 //! render as they always have.
 
-use crate::exact::{big_from_f64, big_point, decimal};
+use crate::camera::Camera;
+use crate::exact::{big_from_f64, big_point, decimal, Digits};
 pub use crate::fractal::deep::Derivative;
 use crate::fractal::deep::Reference;
+use crate::fractal::Fractal;
 use crate::math::{DVec3, Real};
 use crate::scene::Scene;
-use std::sync::Arc;
+use std::collections::VecDeque;
+use std::sync::{Arc, Mutex};
 
 /// A frame is deep where a pixel at its target is narrower than this share
 /// of the target's coordinates: 2²⁶ times f64's resolution there. Orbits
@@ -97,37 +100,20 @@ pub fn bits(scene: &Scene, size: [u32; 2]) -> usize {
 /// and for powers that are not whole, which perturbation does not cover
 /// (they render in f64, and `info` says so).
 pub fn prepare(scene: &Scene, size: [u32; 2]) -> Option<Scene> {
-    prepare_sharing(scene, size, &mut Vec::new())
+    prepare_with(scene, size, &References::default())
 }
 
-/// `prepare`, taking the reference from `built` where a scene there has
+/// `prepare`, taking the reference from `references` where one there has
 /// the same target, fractal and precision (a motion-blurred frame's
-/// instants), and adding the one it builds.
-fn prepare_sharing(
-    scene: &Scene,
-    size: [u32; 2],
-    built: &mut Vec<(Scene, usize, Arc<Reference>)>,
-) -> Option<Scene> {
+/// instants, a film's frames at one precision), and adding the one it
+/// builds.
+pub fn prepare_with(scene: &Scene, size: [u32; 2], references: &References) -> Option<Scene> {
     if !needed(scene, size) || !scene.fractal.perturbation {
         return None;
     }
     let bits = bits(scene, size);
     let c = &scene.camera;
-    let same = |(s, b, _): &&(Scene, usize, Arc<Reference>)| {
-        *b == bits
-            && s.fractal == scene.fractal
-            && s.camera.target == c.target
-            && s.camera.target_digits == c.target_digits
-    };
-    let reference = match built.iter().find(same) {
-        Some((_, _, r)) => r.clone(),
-        None => {
-            let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
-            let r = Arc::new(Reference::new(&scene.fractal, anchor, bits)?);
-            built.push((scene.clone(), bits, r.clone()));
-            r
-        }
-    };
+    let reference = references.get(&scene.fractal, c, bits)?;
     let mut deep = scene.clone();
     deep.quality.centre = -reference.anchor;
     deep.quality.max_steps = max_steps(scene, size);
@@ -141,14 +127,72 @@ fn prepare_sharing(
     Some(deep)
 }
 
+/// Reference orbits already followed, by fractal, target and precision,
+/// shared by clones: the frames of a film at one precision (a deep zoom's
+/// for a third of a decade or so) and a frame's instants share one, so
+/// its high-precision orbit is followed once.
+#[derive(Clone, Debug, Default)]
+pub struct References(Arc<Mutex<VecDeque<Followed>>>);
+
+/// One reference orbit and what it was followed from (`None` where the
+/// power is not whole).
+#[derive(Debug)]
+struct Followed {
+    fractal: Fractal,
+    target: DVec3,
+    target_digits: Option<Digits>,
+    bits: usize,
+    reference: Option<Arc<Reference>>,
+}
+
+/// The references kept for each thread, the oldest dropped first: a
+/// thread takes a film's frames in order, and each precision's run of
+/// them in turn, so a few each hold every one still asked for, and no
+/// more than a few times what the threads hold at once (a non-escaping
+/// orbit of 2000 points is a megabyte).
+const KEPT_PER_THREAD: usize = 4;
+
+impl References {
+    /// The reference orbit of `fractal` from `camera`'s target in `bits`:
+    /// followed once, then kept.
+    fn get(&self, fractal: &Fractal, camera: &Camera, bits: usize) -> Option<Arc<Reference>> {
+        let same = |f: &&Followed| {
+            f.bits == bits
+                && f.fractal == *fractal
+                && f.target == camera.target
+                && f.target_digits == camera.target_digits
+        };
+        // A panic elsewhere while holding the lock leaves whole entries.
+        let lock = || self.0.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = lock().iter().find(same).map(|f| f.reference.clone());
+        if let Some(reference) = kept {
+            return reference;
+        }
+        let anchor = big_point(camera.target, camera.target_digits.as_ref(), bits);
+        let reference = Reference::new(fractal, anchor, bits).map(Arc::new);
+        let mut followed = lock();
+        if followed.len() >= KEPT_PER_THREAD * rayon::current_num_threads() {
+            followed.pop_front();
+        }
+        followed.push_back(Followed {
+            fractal: fractal.clone(),
+            target: camera.target,
+            target_digits: camera.target_digits.clone(),
+            bits,
+            reference: reference.clone(),
+        });
+        reference
+    }
+}
+
 /// `scenes` (a frame's instants) as they render at `size`: `None`
 /// where none is deep, so the caller keeps its own. Instants that share a
 /// target and fractal share one reference orbit.
 pub fn prepare_all(scenes: &[Scene], size: [u32; 2]) -> Option<Vec<Scene>> {
-    let mut built = Vec::new();
+    let references = References::default();
     let prepared: Vec<Option<Scene>> = scenes
         .iter()
-        .map(|s| prepare_sharing(s, size, &mut built))
+        .map(|s| prepare_with(s, size, &references))
         .collect();
     if prepared.iter().all(Option::is_none) {
         return None;
@@ -190,12 +234,19 @@ pub fn digits_for(size: Real, footprint: Real) -> usize {
 /// is about 1/dr; or what the target's orbit does instead. `None` for a
 /// power that is not whole.
 pub fn iterations_for(scene: &Scene, size: [u32; 2]) -> Option<Derivative> {
+    iterations_with(scene, size, &References::default())
+}
+
+/// `iterations_for`, following the orbit once for every frame of
+/// `references` at the same precision.
+pub fn iterations_with(
+    scene: &Scene,
+    size: [u32; 2],
+    references: &References,
+) -> Option<Derivative> {
     let mut probe = scene.fractal.clone();
     probe.iterations = MOST_ITERATIONS;
-    let bits = bits(scene, size);
-    let c = &scene.camera;
-    let anchor = big_point(c.target, c.target_digits.as_ref(), bits);
-    let reference = Reference::new(&probe, anchor, bits)?;
+    let reference = references.get(&probe, &scene.camera, bits(scene, size))?;
     Some(reference.derivative_passes(&probe, 1.0 / footprint(scene, size)))
 }
 

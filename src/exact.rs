@@ -7,8 +7,9 @@
 use crate::math::DVec3;
 use dashu_float::{DBig, FBig};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
 use std::str::FromStr;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 /// A binary float of any precision: what reference orbits are computed in.
 pub type Big = FBig;
@@ -80,8 +81,46 @@ pub fn parse_digits(text: &str) -> Result<f64, String> {
     text.parse::<f64>().map_err(|_| bad())
 }
 
-/// `digits` (already checked by `parse_digits`) as a binary float of `bits`.
+/// `digits` (already checked by `parse_digits`) as a binary float of `bits`:
+/// converted once per string and precision (`CONVERTED`).
 pub fn big_from_digits(digits: &str, bits: usize) -> Big {
+    let kept = lock(&CONVERTED)
+        .get(digits)
+        .and_then(|by_bits| by_bits.get(&bits).cloned());
+    if let Some(big) = kept {
+        return big;
+    }
+    let big = convert(digits, bits);
+    let mut converted = lock(&CONVERTED);
+    if converted.values().map(BTreeMap::len).sum::<usize>() >= MOST_CONVERTED {
+        converted.clear();
+    }
+    let by_bits = converted.entry(digits.to_string()).or_default();
+    by_bits.insert(bits, big.clone());
+    big
+}
+
+/// Digit strings already converted, by string and precision. Every scene
+/// of a film holds its target's digits, and a decimal-to-binary conversion
+/// (at up to `DIFFERENCE_BITS`) costs hundreds of times the arithmetic
+/// done with its result: converted once, they cost nothing per frame.
+static CONVERTED: Mutex<BTreeMap<String, BTreeMap<usize, Big>>> = Mutex::new(BTreeMap::new());
+
+/// The most conversions kept (a few hundred bytes each): a film's digits
+/// take one per precision its deep frames ask for, a few hundred at most;
+/// past this (an explorer session trying many targets) they start over.
+const MOST_CONVERTED: usize = 4096;
+
+/// The memo's contents, whole even where a thread panicked holding it
+/// (each entry is inserted whole).
+fn lock<T>(memo: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
+    memo.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// `digits` as a binary float of `bits`, converted from decimal.
+fn convert(digits: &str, bits: usize) -> Big {
+    #[cfg(test)]
+    tally::count(digits);
     let decimal = DBig::from_str(digits.strip_prefix('+').unwrap_or(digits))
         .unwrap_or_else(|_| unreachable!("checked by parse_digits"));
     decimal
@@ -107,6 +146,10 @@ pub fn big_point(value: DVec3, digits: Option<&Digits>, bits: usize) -> [Big; 3]
     }
 }
 
+/// The precision `difference` works in: enough for every digit a
+/// coordinate may have, and f64's own.
+const DIFFERENCE_BITS: usize = 64 + MAX_DIGITS * 4;
+
 /// `a − b` for points held as f64 values with their digits where given,
 /// computed in enough bits that a difference far below f64's resolution
 /// of either point survives.
@@ -114,7 +157,9 @@ pub fn difference(a: (DVec3, Option<&Digits>), b: (DVec3, Option<&Digits>)) -> D
     if a.1.is_none() && b.1.is_none() {
         return a.0 - b.0;
     }
-    let bits = 64 + MAX_DIGITS * 4;
+    #[cfg(test)]
+    [a.1, b.1].into_iter().flatten().for_each(tally::differ);
+    let bits = DIFFERENCE_BITS;
     let (p, q) = (big_point(a.0, a.1, bits), big_point(b.0, b.1, bits));
     DVec3::from_array([0, 1, 2].map(|i| (&p[i] - &q[i]).to_f64().value()))
 }
@@ -220,6 +265,37 @@ impl Serialize for Coordinates {
             Some(d) => d.serialize(s),
             None => self.value.serialize(s),
         }
+    }
+}
+
+/// How often tests' digit strings were converted and subtracted: each
+/// test's strings are its own, so tests running at once do not mix.
+#[cfg(test)]
+pub(crate) mod tally {
+    use super::{lock, BTreeMap, Digits, Mutex};
+
+    static CONVERSIONS: Mutex<BTreeMap<String, usize>> = Mutex::new(BTreeMap::new());
+    static DIFFERENCES: Mutex<BTreeMap<String, usize>> = Mutex::new(BTreeMap::new());
+
+    pub(super) fn count(digits: &str) {
+        *lock(&CONVERSIONS).entry(digits.to_string()).or_default() += 1;
+    }
+
+    pub(super) fn differ(digits: &Digits) {
+        let mut differences = lock(&DIFFERENCES);
+        for d in digits.iter() {
+            *differences.entry(d.clone()).or_default() += 1;
+        }
+    }
+
+    /// Conversions of `digits` from decimal so far.
+    pub fn conversions(digits: &str) -> usize {
+        lock(&CONVERSIONS).get(digits).copied().unwrap_or(0)
+    }
+
+    /// High-precision differences of points written with `digits`.
+    pub fn differences(digits: &str) -> usize {
+        lock(&DIFFERENCES).get(digits).copied().unwrap_or(0)
     }
 }
 

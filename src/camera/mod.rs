@@ -218,13 +218,12 @@ impl Camera {
             let (s, c) = self.roll_degrees.to_radians().sin_cos();
             (right, up) = (right * c + up * s, up * c - right * s);
         }
-        let distance = self.relative_position().length();
+        // Only a pair's eyes need the distance, exactly where digits give it.
+        let half = |s: Stereo| 0.5 * s.eye_separation * self.relative_position().length();
         CameraFrame {
             origin: self.position,
             projection: self.projection,
-            stereo: self
-                .stereo
-                .map(|s| (0.5 * s.eye_separation * distance, s.layout)),
+            stereo: self.stereo.map(|s| (half(s), s.layout)),
             forward,
             right,
             up,

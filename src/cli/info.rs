@@ -191,22 +191,32 @@ fn print_auto(t: &Timeline) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The deep frames of `t` at its size, in order, each with its resolution
+/// (`deep::resolution`): every frame's scene built and measured once.
+fn deep_frames(t: &Timeline) -> Vec<(u32, f64)> {
+    use rayon::prelude::*;
+    let size = [t.width, t.height];
+    let resolution = |f| (f, crate::deep::resolution(&t.scene_at(f), size));
+    (0..t.frame_count)
+        .into_par_iter()
+        .map(resolution)
+        .filter(|&(_, r)| r < crate::deep::DEEP_BELOW)
+        .collect()
+}
+
 /// Which frames are deep (`crate::deep`) at the timeline's size, the
 /// precision their reference orbits take, and the iterations that resolve
 /// the deepest; nothing where every frame is within f64's reach.
 fn print_deep(t: &Timeline) -> anyhow::Result<()> {
-    let deep: Vec<u32> = (0..t.frame_count)
-        .filter(|&f| crate::deep::needed(&t.scene_at(f), [t.width, t.height]))
-        .collect();
-    let (Some(&first), Some(&last)) = (deep.first(), deep.last()) else {
+    let deep = deep_frames(t);
+    let (Some(&(first, _)), Some(&(last, _))) = (deep.first(), deep.last()) else {
         return Ok(());
     };
     // The deepest: the finest pixel against the target's size.
-    let resolution = |f: &u32| crate::deep::resolution(&t.scene_at(*f), [t.width, t.height]);
-    let deepest = *deep
+    let deepest = deep
         .iter()
-        .min_by(|a, b| resolution(a).total_cmp(&resolution(b)))
-        .unwrap_or(&last);
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(last, |&(f, _)| f);
     let scene = t.scene_at(deepest);
     let frames = format!("{} frame(s) ({first}..={last})", deep.len());
     let size = format!("{}x{}", t.width, t.height);
@@ -238,4 +248,73 @@ fn print_deep(t: &Timeline) -> anyhow::Result<()> {
         None => {}
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exact::tally;
+    use std::collections::BTreeSet;
+
+    /// A dive of `frames` frames at 64×36 from 2 units to 1e-30 onto the
+    /// power-8 bulb's tip, written as `y` (`timelines/deep_zoom.ron`'s,
+    /// turning as it falls), with `iterations: Auto`.
+    fn dive(y: &str, frames: u32) -> Timeline {
+        let end = (frames - 1) as f64 / 24.0;
+        let text = format!(
+            r#"(
+    fps: 24, frames: {frames}, size: (64, 36),
+    scene: (
+        camera: (position: (0.575, -2.4, 0.482), target: ("0", "{y}", "0"), up: (0, 1, 0)),
+        fractal: (power: 8, iterations: Auto, bailout: 4),
+    ),
+    tracks: {{
+        "camera.distance": (interpolation: Linear,
+            keys: [(time: 0, value: 2.0), (time: {end}, value: 1e-30)]),
+        "camera.position": (interpolation: CatmullRom,
+            keys: [(time: 0, value: (0.575, -2.4, 0.482)), (time: {end}, value: (0.482, -2.4, -0.575))]),
+    }},
+)"#
+        );
+        Timeline::parse(&text, Path::new("dive.ron")).unwrap()
+    }
+
+    #[test]
+    fn planning_a_deep_film_does_each_frames_high_precision_work_once() {
+        // Digits of this test's own: the tallies count by string.
+        let y = "-1.1040895136738123376495053876233447213253266007801241655145";
+        let (frames, size) = (48, [64, 36]);
+        let t = dive(y, frames);
+        let all: Vec<u32> = (0..frames).collect();
+        // What validation, `info`, `render`'s plan and `status` ask of
+        // every frame, several times over.
+        for f in 0..frames {
+            t.invalid_instant(f);
+            t.auto_count(f);
+            let scenes = t.scenes_for_frame(f);
+            crate::output::frames::frame_hash(&scenes, f, size[0], size[1]);
+        }
+        let deep = deep_frames(&t);
+        crate::job::warnings::warnings(&t, &all, true);
+        let precisions: BTreeSet<usize> = deep
+            .iter()
+            .map(|&(f, _)| crate::deep::bits(&t.scene_at(f), size))
+            .collect();
+        assert!(deep.len() > 10 && deep.len() < frames as usize, "{deep:?}");
+        // One difference of the position and the target a frame (and one
+        // for the scene as written, checked before the tracks), and one
+        // conversion of the target's digits for them all (at the precision
+        // of differences) and for each precision a reference orbit takes.
+        let differences = tally::differences(y);
+        assert!(
+            differences <= frames as usize + 1,
+            "{differences} differences"
+        );
+        let conversions = tally::conversions(y);
+        let most = precisions.len() + 1;
+        assert!(
+            conversions <= most,
+            "{conversions} conversions, {most} precisions"
+        );
+    }
 }

@@ -8,6 +8,7 @@ use crate::job::request::{check_eyes, parse_size, Sequence};
 use crate::output::names::FrameName;
 use crate::output::{self, Format};
 use crate::timeline::Timeline;
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 /// A validated render job: what to render, how big, in which formats, where.
@@ -211,6 +212,8 @@ impl Plan {
 
     /// The scenes of one frame (one per sample under motion blur) and its content hash.
     pub fn frame(&self, frame: u32) -> (Vec<crate::scene::Scene>, String) {
+        #[cfg(test)]
+        tally::count(&self.out_dir);
         let scenes = if self.preview {
             // A quick look: one sample, one instant.
             let mut scene = self.timeline.scene_at(frame);
@@ -241,6 +244,35 @@ impl Plan {
     pub fn video_format(&self) -> Format {
         let png = self.formats.iter().find(|f| f.is_png());
         png.copied().unwrap_or(Format::Exr)
+    }
+
+    /// The names in the output folder, read once, so that a long film's
+    /// frames with nothing on disk are told apart without a look-up each;
+    /// `None` where the folder cannot be listed (each is then looked for).
+    pub fn listing(&self) -> Option<HashSet<String>> {
+        let entries = match std::fs::read_dir(&self.out_dir) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Some(HashSet::new()),
+            entries => entries.ok()?,
+        };
+        let names = entries.map(|e| e.map(|e| e.file_name().into_string().ok()));
+        names
+            .filter_map(Result::transpose)
+            .collect::<Result<_, _>>()
+            .ok()
+    }
+
+    /// Whether `frame` may have a file, a claim or a checkpoint in `listed`
+    /// (`listing`): where nothing was listed, it may.
+    pub fn has_files(&self, frame: u32, listed: Option<&HashSet<String>>) -> bool {
+        let Some(names) = listed else {
+            return true;
+        };
+        let hidden = ["claim", "ckpt"].map(|kind| self.frame_name.hidden(frame, kind));
+        let files = self
+            .formats
+            .iter()
+            .map(|&f| self.frame_name.file_name(frame, f));
+        files.chain(hidden).any(|name| names.contains(&name))
     }
 
     /// Whether `frame`'s file in `format` is whole and current (no hash
@@ -345,6 +377,28 @@ pub fn ffmpeg_command(
         input = shell_quote(&input.to_string_lossy()),
         movie = shell_quote(&movie.to_string_lossy()),
     )
+}
+
+/// How many frames' scenes and hashes were made for each output folder:
+/// each test's folder is its own, so tests running at once do not mix.
+#[cfg(test)]
+pub(crate) mod tally {
+    use std::collections::BTreeMap;
+    use std::path::{Path, PathBuf};
+    use std::sync::Mutex;
+
+    static FRAMES: Mutex<BTreeMap<PathBuf, usize>> = Mutex::new(BTreeMap::new());
+
+    pub(super) fn count(out_dir: &Path) {
+        let mut frames = FRAMES.lock().unwrap_or_else(|e| e.into_inner());
+        *frames.entry(out_dir.to_path_buf()).or_default() += 1;
+    }
+
+    /// Frames made for `out_dir` so far.
+    pub fn frames(out_dir: &Path) -> usize {
+        let frames = FRAMES.lock().unwrap_or_else(|e| e.into_inner());
+        frames.get(out_dir).copied().unwrap_or(0)
+    }
 }
 
 #[cfg(test)]

@@ -215,12 +215,17 @@ fn frame_states(
         .iter()
         .map(crate::job::claim::ClaimRecord::who)
         .collect();
+    let listed = plan.listing();
     for frame in plan.range.clone() {
         let mut states = Vec::new();
         let each = parts.iter().zip(&mut by_format).zip(&writing).zip(counted);
         for (((part, by_state), writing), &counted) in each {
             if part.range.contains(&frame) {
-                let (state, worker) = frame_state(part, frame, writing, claim_timeout);
+                // Nothing of it on disk: missing, its scene never built.
+                let (state, worker) = match part.has_files(frame, listed.as_ref()) {
+                    false if !writing.contains(&frame) => (FrameState::Missing, None),
+                    _ => frame_state(part, frame, writing, claim_timeout),
+                };
                 workers.extend(worker);
                 by_state.entry(state).or_insert_with(Vec::new).push(frame);
                 states.extend(Some(state).filter(|_| counted));
@@ -369,5 +374,29 @@ impl<'a> FormatStatus<'a> {
             complete: by_state.get(&FrameState::Complete).map_or(0, Vec::len),
             states: by_state.iter().map(|(s, f)| (s.name(), f)).collect(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_with_nothing_on_disk_are_missing_without_their_scenes() {
+        let dir = tempfile::tempdir().unwrap();
+        let timeline = dir.path().join("t.ron");
+        std::fs::write(&timeline, "(fps: 24, frames: 300, size: (8, 6))").unwrap();
+        let out = dir.path().join("out");
+        std::fs::create_dir(&out).unwrap();
+        // Not a PNG: damaged, which its inputs' hash is made to tell.
+        std::fs::write(out.join("frame_00007.png"), "not a PNG").unwrap();
+        let sequence = Sequence {
+            out: Some(out.clone()),
+            ..Sequence::default()
+        };
+        let scan = scan(&timeline, &sequence, Duration::from_secs(60), false).unwrap();
+        assert_eq!(scan.by_state[&FrameState::Damaged], [7]);
+        assert_eq!(scan.by_state[&FrameState::Missing].len(), 299);
+        assert_eq!(crate::job::plan::tally::frames(&out), 1);
     }
 }

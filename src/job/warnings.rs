@@ -208,7 +208,7 @@ fn frames_inside(timeline: &Timeline, frames: &[u32]) -> (Vec<usize>, usize) {
                     }
                     // A deep frame's camera is placed from its target more
                     // finely than f64 holds its position.
-                    let is = match crate::deep::prepare(&s, [timeline.width, timeline.height]) {
+                    let is = match timeline.prepare_deep(&s) {
                         Some(d) => d.fractal.contains(d.camera.position),
                         None => s.fractal.contains(s.camera.position),
                     };

@@ -11,6 +11,7 @@ use crate::fractal::{AutoIterations, MAX_ITERATIONS};
 use crate::math::Real;
 use crate::scene::Scene;
 use std::collections::HashMap;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 
 /// The fewest iterations `Auto` chooses: below this the bulb has not yet
@@ -55,9 +56,20 @@ pub struct Resolved {
 
 /// The count `auto` chooses for `scene` at `width`×`height`.
 pub fn resolve(scene: &Scene, auto: AutoIterations, size: [u32; 2]) -> Resolved {
-    let (passes, decided) = match target_passes(scene, size) {
+    resolve_with(scene, auto, size, &deep::References::default())
+}
+
+/// `resolve`, sharing the high-precision orbits of deep frames through
+/// `references` with the other frames at the same precision.
+fn resolve_with(
+    scene: &Scene,
+    auto: AutoIterations,
+    size: [u32; 2],
+    references: &deep::References,
+) -> Resolved {
+    let (passes, decided) = match target_passes(scene, size, references) {
         Derivative::Passes(n) => (Some(n), Decided::Target),
-        _ => match centre_passes(scene, size) {
+        _ => match centre_passes(scene, size, references) {
             Some(n) => (Some(n), Decided::Centre),
             None => (None, Decided::Floor),
         },
@@ -72,9 +84,9 @@ pub fn resolve(scene: &Scene, auto: AutoIterations, size: [u32; 2]) -> Resolved 
 /// Where the target's orbit's derivative passes one over the pixel's
 /// width at the target (the projection's pixel on the view's axis): in
 /// high precision where the frame is deep.
-fn target_passes(scene: &Scene, size: [u32; 2]) -> Derivative {
+fn target_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -> Derivative {
     if deep::needed(scene, size) {
-        if let Some(d) = deep::iterations_for(scene, size) {
+        if let Some(d) = deep::iterations_with(scene, size, references) {
             return d;
         }
     }
@@ -89,11 +101,11 @@ fn target_passes(scene: &Scene, size: [u32; 2]) -> Derivative {
 /// from the target that f64 cannot iterate alone: there the iterations its
 /// orbit took to escape stand in (at a hit, within half a pixel of the
 /// surface, the derivative has passed one over a pixel by its escape).
-fn centre_passes(scene: &Scene, size: [u32; 2]) -> Option<u32> {
+fn centre_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -> Option<u32> {
     let mut probe = scene.clone();
     probe.fractal.iterations = CENTRE_ITERATIONS;
     probe.quality.max_steps = deep::steps_of(scene, size).saturating_mul(4);
-    let prepared = deep::prepare(&probe, size);
+    let prepared = deep::prepare_with(&probe, size, references);
     let marched = prepared.as_ref().unwrap_or(&probe);
     // One eye's centre: a stereo image's centre is where its eyes meet.
     let [width, height] = scene.camera.eye_size(size);
@@ -117,38 +129,82 @@ fn centre_passes(scene: &Scene, size: [u32; 2]) -> Option<u32> {
     }
 }
 
-/// Each instant's resolved count, kept by the timeline so that a frame's
+/// Each frame's resolved count, kept by the timeline so that a frame's
 /// high-precision orbit is followed once however often its scene is made
 /// (validation, the plan, hashes, `info`).
 #[derive(Clone, Debug, Default)]
-pub(super) struct Counts(Arc<Mutex<HashMap<u64, Resolved>>>);
+pub(super) struct Counts {
+    /// By frame index (`pack`ed, 0 while unresolved): a long film's
+    /// frames are looked up by every pass over it, in order, without a
+    /// lock or a hash.
+    frames: Arc<[AtomicU64]>,
+    /// Instants of no frame of the film (before it, or after its end),
+    /// by their time's bits.
+    others: Arc<Mutex<HashMap<u64, Resolved>>>,
+}
 
 impl Counts {
-    /// The count at time `time_seconds`, whose scene is `scene`: resolved
-    /// once, then kept.
+    /// Room for the counts of `frame_count` frames.
+    pub(super) fn new(frame_count: u32) -> Counts {
+        Counts {
+            frames: (0..frame_count).map(|_| AtomicU64::new(0)).collect(),
+            others: Default::default(),
+        }
+    }
+
+    /// The count at time `time_seconds`, frame `frame_index`'s own time
+    /// where given, whose scene is `scene`: resolved once (sharing orbits
+    /// through `references`), then kept.
     pub(super) fn at(
         &self,
-        time_seconds: Real,
+        (time_seconds, frame_index): (Real, Option<usize>),
         scene: &Scene,
         auto: AutoIterations,
         size: [u32; 2],
+        references: &deep::References,
     ) -> Resolved {
+        let resolve = || resolve_with(scene, auto, size, references);
+        if let Some(slot) = frame_index.and_then(|i| self.frames.get(i)) {
+            // Two threads may both resolve a frame: they find the same.
+            return unpack(slot.load(Ordering::Relaxed)).unwrap_or_else(|| {
+                let r = resolve();
+                slot.store(pack(r), Ordering::Relaxed);
+                r
+            });
+        }
         let key = time_seconds.to_bits();
         // A panic elsewhere while holding the lock leaves whole entries.
-        let kept = |c: &Counts| {
-            c.0.lock()
-                .unwrap_or_else(|e| e.into_inner())
-                .get(&key)
-                .copied()
-        };
-        if let Some(r) = kept(self) {
-            return r;
-        }
-        let r = resolve(scene, auto, size);
-        let mut map = self.0.lock().unwrap_or_else(|e| e.into_inner());
-        map.insert(key, r);
-        r
+        let lock = || self.others.lock().unwrap_or_else(|e| e.into_inner());
+        let kept = lock().get(&key).copied();
+        kept.unwrap_or_else(|| {
+            let r = resolve();
+            lock().insert(key, r);
+            r
+        })
     }
+}
+
+/// A count and what decided it in one word, with a bit set so that no
+/// resolved count is 0.
+fn pack(r: Resolved) -> u64 {
+    let decided = match r.decided {
+        Decided::Target => 0,
+        Decided::Centre => 1,
+        Decided::Floor => 2,
+    };
+    1 << 63 | decided << 32 | u64::from(r.count)
+}
+
+/// What `pack` packed, if anything.
+fn unpack(word: u64) -> Option<Resolved> {
+    let decided = match (word >> 32) & 0xff {
+        _ if word == 0 => return None,
+        0 => Decided::Target,
+        1 => Decided::Centre,
+        _ => Decided::Floor,
+    };
+    let count = (word & 0xffff_ffff) as u32;
+    Some(Resolved { count, decided })
 }
 
 #[cfg(test)]

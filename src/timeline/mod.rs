@@ -15,6 +15,7 @@ pub use limits::{MAX_SAMPLES, MAX_SIDE};
 mod messages;
 pub mod parameters;
 mod parse;
+mod relative;
 mod scan;
 mod schema;
 mod tracks;
@@ -51,8 +52,13 @@ pub struct Timeline {
     /// `loop: true`: the film is one period of a seamless loop, and frame
     /// `frame_count` would be frame 0 again. The period is `duration_seconds`.
     pub looping: bool,
-    /// `fractal.iterations: Auto`'s count at each instant made so far.
+    /// `fractal.iterations: Auto`'s count at each frame made so far.
     auto_counts: auto::Counts,
+    /// The camera's exact position relative to its target at each instant
+    /// made so far, where digits give either.
+    relatives: relative::Relatives,
+    /// The high-precision orbits its deep frames' scenes have followed.
+    references: crate::deep::References,
 }
 
 /// The longest file read as a timeline: real ones are a few kilobytes, and
@@ -130,17 +136,21 @@ impl Timeline {
     /// `iterations: Auto` every track is kept: the count depends on them.
     pub fn with_tracks(&self, keep: impl Fn(&str) -> bool) -> Timeline {
         let auto = self.base.fractal.auto.is_some();
+        let kept = |t: &&Track| auto || keep(&t.name);
+        // Instants whose cameras are placed alike share what was computed.
+        let moves = |t: &&Track| ["camera.position", "camera.target"].contains(&t.name.as_str());
+        let same_camera = self.tracks.iter().filter(moves).all(|t| kept(&t));
         Timeline {
             source: self.source.clone(),
             name: self.name.clone(),
             base: self.base.clone(),
-            tracks: self
-                .tracks
-                .iter()
-                .filter(|t| auto || keep(&t.name))
-                .cloned()
-                .collect(),
+            tracks: self.tracks.iter().filter(kept).cloned().collect(),
             auto_counts: self.auto_counts.clone(),
+            references: self.references.clone(),
+            relatives: match same_camera {
+                true => self.relatives.clone(),
+                false => Default::default(),
+            },
             ..*self
         }
     }
@@ -151,10 +161,19 @@ impl Timeline {
         let time = self.time_of(frame_index);
         let scene = self.scene_built(time, false).ok()?;
         let auto = scene.fractal.auto?;
-        Some(
-            self.auto_counts
-                .at(time, &scene, auto, [self.width, self.height]),
-        )
+        let (size, instant) = (
+            [self.width, self.height],
+            (time, Some(frame_index as usize)),
+        );
+        let references = &self.references;
+        Some(self.auto_counts.at(instant, &scene, auto, size, references))
+    }
+
+    /// `scene` (one of this timeline's) as it renders at the timeline's
+    /// size where it is deep (`deep::prepare`), sharing the reference
+    /// orbits its other scenes have followed.
+    pub fn prepare_deep(&self, scene: &Scene) -> Option<Scene> {
+        crate::deep::prepare_with(scene, [self.width, self.height], &self.references)
     }
 
     /// The error of this timeline's value at `field`, a path into its file,
@@ -227,19 +246,7 @@ impl Timeline {
         check: bool,
     ) -> std::result::Result<Scene, (String, String)> {
         let mut scene = self.base.clone();
-        for track in &self.tracks {
-            if check && track.name == ZOOM_TRACK {
-                let c = &scene.camera;
-                let away = c.position - c.target;
-                if away.length() <= 8.0 * Real::EPSILON * c.target.abs().max_element().max(1.0) {
-                    return Err((
-                        "camera.target".into(),
-                        "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
-                    ));
-                }
-            }
-            track.apply(&mut scene, time_seconds);
-        }
+        self.apply_tracks(&mut scene, time_seconds, check)?;
         // Validation needs no count (Auto's are in range by construction),
         // so a scene about to be refused is never marched for one.
         if let Some(auto) = scene.fractal.auto.filter(|_| !check) {
@@ -248,20 +255,53 @@ impl Timeline {
         Ok(scene)
     }
 
+    /// Applies every track to `scene` at `time_seconds`, the zoom last,
+    /// which starts from the camera's exact relative position (`relatives`).
+    /// With `check`, refuses a zoom with no direction (`scene_built`).
+    fn apply_tracks(
+        &self,
+        scene: &mut Scene,
+        time_seconds: Real,
+        check: bool,
+    ) -> std::result::Result<(), (String, String)> {
+        for track in &self.tracks {
+            if track.name == ZOOM_TRACK {
+                let c = &scene.camera;
+                let away = c.position - c.target;
+                let scale = c.target.abs().max_element().max(1.0);
+                if check && away.length() <= 8.0 * Real::EPSILON * scale {
+                    return Err((
+                        "camera.target".into(),
+                        "the camera position and target coincide, so camera.distance has no direction to place the camera along".into(),
+                    ));
+                }
+                self.relatives.carry(time_seconds, &mut scene.camera);
+            }
+            track.apply(scene, time_seconds);
+        }
+        Ok(())
+    }
+
     /// `Auto`'s count at `time_seconds`, whose scene is `scene`: the count
     /// of the frame the instant belongs to, at the frame's own time, so a
     /// frame's motion-blur samples share one count (and one reference).
     fn auto_at(&self, time_seconds: Real, scene: &Scene, auto: AutoIterations) -> auto::Resolved {
-        let size = [self.width, self.height];
-        let frame_time = (time_seconds * self.fps + 1e-9).floor() / self.fps;
-        if frame_time == time_seconds || frame_time < 0.0 {
-            return self.auto_counts.at(time_seconds, scene, auto, size);
+        let (size, references) = ([self.width, self.height], &self.references);
+        let frame = (time_seconds * self.fps + 1e-9).floor();
+        let frame_time = frame / self.fps;
+        if frame_time < 0.0 {
+            return self
+                .auto_counts
+                .at((time_seconds, None), scene, auto, size, references);
+        }
+        let instant = (frame_time, Some(frame as usize));
+        if frame_time == time_seconds {
+            return self.auto_counts.at(instant, scene, auto, size, references);
         }
         let mut own = self.base.clone();
-        for track in &self.tracks {
-            track.apply(&mut own, frame_time);
-        }
-        self.auto_counts.at(frame_time, &own, auto, size)
+        self.apply_tracks(&mut own, frame_time, false)
+            .unwrap_or_else(|_| unreachable!("only the check fails"));
+        self.auto_counts.at(instant, &own, auto, size, references)
     }
 
     /// The instants a frame's samples see: the frame's own, or with motion

@@ -51,6 +51,10 @@ impl Timeline {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_else(|| "timeline".into());
+        let auto_counts = match file.scene.fractal.auto {
+            Some(_) => super::auto::Counts::new(frame_count),
+            None => Default::default(),
+        };
         let timeline = Timeline {
             source: path.to_path_buf(),
             name,
@@ -61,7 +65,9 @@ impl Timeline {
             base: file.scene,
             tracks,
             looping: file.looping,
-            auto_counts: Default::default(),
+            auto_counts,
+            relatives: Default::default(),
+            references: Default::default(),
         };
         // Splines can overshoot their keys: check every scene the frames
         // render; the first frame that fails is told.
