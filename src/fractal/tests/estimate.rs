@@ -411,8 +411,20 @@ fn julia_lanes_off_the_critical_point_skip_the_bound_as_bounded_would() {
     // Julia's critical-point bound keeps an estimate shorter than |p|; the
     // squared test must let those lanes through without `bounded`, and
     // never let through one that `bounded`'s square roots would catch.
-    assert!(no_bound_applies(DVec3::new(1.0, 0.0, 0.0), 5, 2.0, true, 0.1));
-    assert!(!no_bound_applies(DVec3::new(0.1, 0.0, 0.0), 5, 2.0, true, 0.2));
+    assert!(no_bound_applies(
+        DVec3::new(1.0, 0.0, 0.0),
+        5,
+        2.0,
+        true,
+        0.1
+    ));
+    assert!(!no_bound_applies(
+        DVec3::new(0.1, 0.0, 0.0),
+        5,
+        2.0,
+        true,
+        0.2
+    ));
     let mut seed = 0x9e37_79b9_7f4a_7c15_u64;
     let mut next = || {
         seed ^= seed << 13;
