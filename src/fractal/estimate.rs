@@ -235,11 +235,12 @@ impl Fractal {
         }
     }
 
-    /// Whether an estimate's `end` is where `orbit_at::<f64>(p,
-    /// self.iterations, true)` ends, bit for bit: the f64 estimators finish
-    /// that orbit (`estimate_raw`; the vector kernels repeat it), but for
-    /// the Jacobian method, whose dual numbers divide by multiplying with
-    /// an inverse.
+    /// Whether an estimate's `end` is where its f64 orbit ends, bit for
+    /// bit: `orbit_at::<f64>(p, self.iterations, true)`, or in a deep frame
+    /// at a footprint f64 resolves, the plain orbit of `p`'s world position.
+    /// The f64 estimators finish that orbit (the vector kernels repeat it),
+    /// but for the Jacobian method, whose dual numbers divide by
+    /// multiplying with an inverse.
     pub fn ends_f64_orbits(&self) -> bool {
         self.precision == Precision::F64 && self.de != DeMethod::Jacobian
     }

@@ -47,8 +47,8 @@ pub struct Palette {
 }
 
 /// What a palette's hits share, worked out at the first hit that needs it:
-/// each stop's colour in OKLab (converting two stops at every hit took the
-/// cube roots that were most of the palette's cost), and the logarithms of
+/// each stop's colour in OKLab (its cube roots are most of a conversion's
+/// cost), and the logarithms of
 /// the escape radius and power the smooth count divides by. Each is kept
 /// with the bits it was made from; a stop or fractal that has changed
 /// since (a scene edited after shading) is worked out where it is used.

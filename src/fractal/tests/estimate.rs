@@ -355,7 +355,7 @@ fn an_estimate_ends_where_its_f64_orbit_ends() {
     ]);
     for f in &fractals {
         assert!(f.ends_f64_orbits());
-        assert_ends(f, &pts);
+        assert_ends(f, &pts, 1e-4);
     }
     // A deep frame's points are offsets from its anchor, near the surface.
     let anchor = DVec3::new(0.31, 0.62, 0.58);
@@ -369,10 +369,22 @@ fn an_estimate_ends_where_its_f64_orbit_ends() {
     let reference = deep::Reference::new(&plain, big, 128).expect("a whole power");
     let deep = Fractal {
         deep: Some(std::sync::Arc::new(reference)),
-        ..plain
+        ..plain.clone()
     };
     let offsets: Vec<DVec3> = points(64, 0.0..1.0, 4).iter().map(|p| *p * 1e-7).collect();
-    assert_ends(&deep, &offsets);
+    // At a footprint finer than f64 resolves there, on the perturbed orbit;
+    // at a coarser one, the frame hands the point to the plain f64 orbit.
+    assert_ends(&deep, &offsets, 1e-12);
+    for p in &offsets {
+        let world = anchor + *p;
+        let orbit = plain.orbit_at([world.x, world.y, world.z], plain.iterations, true);
+        let e = deep.estimate(*p, 1e-4);
+        assert_eq!(
+            e.end.map(Real::to_bits),
+            orbit.z.map(Real::to_bits),
+            "at {p}"
+        );
+    }
     // f32 estimates end on f32's orbit, and the Jacobian method's on its
     // dual numbers': shading iterates again for those.
     assert!(!Fractal {
@@ -387,16 +399,16 @@ fn an_estimate_ends_where_its_f64_orbit_ends() {
     .ends_f64_orbits());
 }
 
-/// Each of `pts`, estimated alone and 16 at a time, ends where `f`'s f64
-/// orbit of it ends.
-fn assert_ends(f: &Fractal, pts: &[DVec3]) {
+/// Each of `pts`, estimated alone and 16 at a time at footprint `scale`,
+/// ends where `f`'s f64 orbit of it ends.
+fn assert_ends(f: &Fractal, pts: &[DVec3], scale: Real) {
     for chunk in pts.chunks(16) {
         let mut lanes = [IDLE_POINT; 16];
         lanes[..chunk.len()].copy_from_slice(chunk);
-        let together = f.estimate_lanes(lanes, [1e-4; 16]);
+        let together = f.estimate_lanes(lanes, [scale; 16]);
         for (p, lane) in chunk.iter().zip(together) {
             let orbit = f.orbit_at([p.x, p.y, p.z], f.iterations, true);
-            for e in [lane, f.estimate(*p, 1e-4)] {
+            for e in [lane, f.estimate(*p, scale)] {
                 let bits = |z: [Real; 3]| z.map(Real::to_bits);
                 assert_eq!(bits(e.end), bits(orbit.z), "{f:?} at {p}");
                 assert_eq!(e.end_radius().to_bits(), orbit.r.to_bits(), "at {p}");
