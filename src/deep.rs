@@ -149,8 +149,10 @@ struct Followed {
 /// thread takes a film's frames in order, and each precision's run of
 /// them in turn, so a few each hold every one still asked for, and no
 /// more than a few times what the threads hold at once (a non-escaping
-/// orbit of 2000 points is a megabyte).
+/// orbit of 2000 points is a megabyte). Past `KEPT_THREADS` threads the
+/// total stays put: a miss costs a recomputation, never memory.
 const KEPT_PER_THREAD: usize = 4;
+const KEPT_THREADS: usize = 8;
 
 impl References {
     /// The reference orbit of `fractal` from `camera`'s target in `bits`:
@@ -171,7 +173,7 @@ impl References {
         let anchor = big_point(camera.target, camera.target_digits.as_ref(), bits);
         let reference = Reference::new(fractal, anchor, bits).map(Arc::new);
         let mut followed = lock();
-        if followed.len() >= KEPT_PER_THREAD * rayon::current_num_threads() {
+        if followed.len() >= KEPT_PER_THREAD * rayon::current_num_threads().min(KEPT_THREADS) {
             followed.pop_front();
         }
         followed.push_back(Followed {

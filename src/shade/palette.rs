@@ -108,11 +108,11 @@ pub enum OrbitQuantity {
     /// crevices, about 1 on the outer skin). Free: the march gathered it.
     Trap,
     /// The continuous escape count i + 1 − ln(ln|z|/ln E)/ln n, which an
-    /// orbit that escapes one step later continues without a jump. One
-    /// more orbit per hit.
+    /// orbit that escapes one step later continues without a jump. Read
+    /// from where the hit's last estimate's orbit ended.
     SmoothIterations,
     /// The azimuth of the orbit's last point about the formula's pole
-    /// axis, in turns (0 to 1). One more orbit per hit.
+    /// axis, in turns (0 to 1).
     Angle,
 }
 
