@@ -111,7 +111,7 @@ pub fn march_camera_rays(
 }
 
 /// The indices of each run of `runs` (the lengths of consecutive runs).
-pub(super) fn run_spans(runs: &[u32]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+pub fn run_spans(runs: &[u32]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
     runs.iter().scan(0, |start, &n| {
         let span = *start..*start + n as usize;
         *start = span.end;

@@ -22,7 +22,7 @@ mod normal;
 mod walk;
 
 pub use cone::{
-    cone_block, cone_blocks, march_camera_rays, ConeScratch, CONE_BLOCK_ROWS, CONE_TRUST,
+    cone_block, cone_blocks, march_camera_rays, run_spans, ConeScratch, CONE_BLOCK_ROWS, CONE_TRUST,
 };
 use membership::bisect_membership;
 pub use membership::march_by_membership;

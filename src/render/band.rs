@@ -6,7 +6,7 @@ use super::accumulation::{Accumulation, RowSums};
 use super::adaptive::progressive_subpixel;
 use super::stats::FrameStats;
 use super::subpixel;
-use crate::march::{normals_many, walk_many, MarchResult};
+use crate::march::{normals_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
@@ -124,6 +124,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
             surfaces,
             walks,
             shadows,
+            bundles,
             occluded,
             cone_free,
             paths,
@@ -155,7 +156,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
                 surfaces[i] = Some(at.coloured(&scene.look, &scene.fractal, &hit.estimate));
             },
         );
-        band_shadows(scene, surfaces, walks, shadows);
+        band_shadows(scene, surfaces, runs, walks, shadows, bundles);
         let mut outcomes = shadows.iter().copied();
         band_occlusion(scene, surfaces, occluded);
         let traced = band_paths(frame, scene, camera, y0, s, order, surfaces, paths);
@@ -361,25 +362,36 @@ impl RowScratch {
     }
 }
 
-/// The band's shadow rays, walked side by side. Shading takes their
-/// outcomes back in the same order, pixel after pixel.
+/// The band's shadow rays, walked side by side, a cone block's rays to a
+/// bundle (`walk_shadows`; where camera rays march alone, each shadow ray
+/// does too). Shading takes their outcomes back in the same order, pixel
+/// after pixel.
 fn band_shadows(
     scene: &Scene,
     surfaces: &[Option<SurfacePoint>],
+    runs: &[u32],
     walks: &mut Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     shadows: &mut Vec<(f32, u64)>,
+    bundles: &mut crate::shade::BundleScratch,
 ) {
     shadows.clear();
-    if scene.effects.path_tracing.is_none() && scene.effects.shadows.is_some() {
-        walks.clear();
-        for at in surfaces.iter().flatten() {
+    if scene.effects.path_tracing.is_some() || scene.effects.shadows.is_none() {
+        return;
+    }
+    walks.clear();
+    let mut groups = Vec::with_capacity(runs.len());
+    for span in crate::march::run_spans(runs) {
+        let (first, alone) = (walks.len(), span.len() == 1);
+        for at in surfaces[span].iter().flatten() {
             walks.extend(scene.look.shadow_walks(&scene.effects, &scene.quality, at));
         }
-        shadows.resize(walks.len(), (1.0, 0));
-        walk_many(walks.drain(..), &scene.fractal, &scene.quality, |i, out| {
-            shadows[i] = out
-        });
+        if !alone {
+            groups.push(first..walks.len());
+        }
     }
+    shadows.resize(walks.len(), (1.0, 0));
+    let (f, q) = (&scene.fractal, &scene.quality);
+    crate::shade::walk_shadows(walks, groups.into_iter(), f, q, shadows, bundles);
 }
 
 /// The band's path-traced samples, a bounce at a time side by side (none
@@ -468,6 +480,8 @@ pub(super) struct RowScratch {
     pub(super) surfaces: Vec<Option<SurfacePoint>>,
     pub(super) walks: Vec<Result<crate::shade::ShadowWalk, (f32, u64)>>,
     pub(super) shadows: Vec<(f32, u64)>,
+    /// The shadow bundles' scratch space.
+    pub(super) bundles: crate::shade::BundleScratch,
     /// Each pixel's ambient occlusion and its cost, where it hit.
     pub(super) occluded: Vec<Option<(f32, u64)>>,
     /// Each camera ray's bounding-sphere interval; where each run of them

@@ -15,6 +15,7 @@ use crate::fractal::OrbitTraps;
 use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};
 
+mod bundle;
 mod fog;
 mod lighting;
 mod look;
@@ -23,6 +24,7 @@ mod path;
 mod shadow;
 mod sky;
 
+pub use bundle::{walk_shadows, BundleScratch};
 pub use fog::{fogged, glow, Fog, Glow};
 pub use lighting::{Light, Specular, MAX_LIGHTS};
 pub use look::Look;

@@ -75,16 +75,16 @@ pub(super) fn shadow_origin(at: &SurfacePoint) -> DVec3 {
 /// side by side (`march::walk_many`).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowWalk {
-    from: DVec3,
-    to_light: DVec3,
-    footprint: Real,
-    t: Real,
-    t_exit: Real,
-    eps: Real,
-    softness: Real,
+    pub(super) from: DVec3,
+    pub(super) to_light: DVec3,
+    pub(super) footprint: Real,
+    pub(super) t: Real,
+    pub(super) t_exit: Real,
+    pub(super) eps: Real,
+    pub(super) softness: Real,
     light: Real,
-    steps_left: u32,
-    spent: u64,
+    pub(super) steps_left: u32,
+    pub(super) spent: u64,
 }
 
 impl ShadowWalk {

@@ -47,6 +47,7 @@ fn unit_ball() -> Fractal {
     Fractal::unit_ball()
 }
 
+mod bundle;
 mod fog;
 mod lighting;
 mod look;
