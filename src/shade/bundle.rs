@@ -203,6 +203,7 @@ fn march_axes(fractal: &Fractal, settings: &MarchSettings, s: &mut BundleScratch
             Some(steps) => Ok(AxisWalk {
                 bundle: Bundle { steps, ..*bundle },
                 u: bundle.start,
+                previous: bundle.start,
                 taken: 0,
                 spent: 0,
             }),
@@ -300,6 +301,8 @@ struct Stop {
 struct AxisWalk {
     bundle: Bundle,
     u: Real,
+    /// Where the axis was before its last step.
+    previous: Real,
     taken: u32,
     spent: u64,
 }
@@ -324,12 +327,21 @@ impl Walk for AxisWalk {
         let clear = settings.fudge * CONE_TRUST * e.distance - b.radius;
         let farthest = self.u - b.nearest;
         let dims = b.softness > 0.0 && b.softness * clear < farthest;
-        if !e.escaped || clear < b.eps || dims {
+        if !e.escaped {
+            // Inside: the rays go on alone from the last point outside.
+            return Some(Some(self.stop(Some(self.previous))));
+        }
+        if clear < b.eps || dims {
             return Some(Some(self.stop(Some(self.u))));
         }
+        self.previous = self.u;
         self.u += clear;
         self.taken += 1;
-        (self.u > b.end || self.taken >= b.steps).then(|| Some(self.stop(None)))
+        if self.u > b.end {
+            return Some(Some(self.stop(None)));
+        }
+        // Out of the fewest steps a member has left: the others go on.
+        (self.taken >= b.steps).then(|| Some(self.stop(Some(self.u))))
     }
 }
 
