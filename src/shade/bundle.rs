@@ -32,8 +32,11 @@ pub struct BundleScratch {
     paused: Vec<Option<ShadowWalk>>,
     members: Vec<Member>,
     bundles: Vec<Bundle>,
-    stops: Vec<Option<Stop>>,
+    stops: Vec<Stop>,
     resumed: Vec<(usize, ShadowWalk)>,
+    /// One group's walks towards one light, and the lights it has seen.
+    set: Vec<(usize, ShadowWalk)>,
+    lights: Vec<DVec3>,
 }
 
 /// A walk of a bundle: its index in the caller's list and where its
@@ -130,20 +133,20 @@ fn form_bundles(
             .clone()
             .filter_map(|i| Some((i, *walks[i].as_ref().ok()?)))
     };
-    let mut set = Vec::with_capacity(group.len());
-    let mut done: Vec<DVec3> = Vec::new();
+    s.lights.clear();
     for (_, first) in live() {
-        if done.contains(&first.to_light) {
+        if s.lights.contains(&first.to_light) {
             continue;
         }
-        done.push(first.to_light);
-        set.clear();
-        set.extend(live().filter(|(_, w)| w.to_light == first.to_light));
-        let Some(mut bundle) = bundle_of(&set) else {
+        s.lights.push(first.to_light);
+        s.set.clear();
+        s.set
+            .extend(live().filter(|(_, w)| w.to_light == first.to_light));
+        let Some(mut bundle) = bundle_of(&s.set) else {
             continue;
         };
-        bundle.members = (s.members.len(), s.members.len() + set.len());
-        for &(index, w) in &set {
+        bundle.members = (s.members.len(), s.members.len() + s.set.len());
+        for &(index, w) in &s.set {
             let along = (w.from - bundle.centre).dot(bundle.to_light);
             s.pause[index] = bundle.start - along;
             s.members.push(Member { index, along });
@@ -193,7 +196,7 @@ fn bundle_of(set: &[(usize, ShadowWalk)]) -> Option<Bundle> {
 /// Marches the axis of each bundle that has a member paused on it.
 fn march_axes(fractal: &Fractal, settings: &MarchSettings, s: &mut BundleScratch) {
     s.stops.clear();
-    s.stops.resize(s.bundles.len(), None);
+    s.stops.resize(s.bundles.len(), Stop::NONE);
     let (members, paused) = (&s.members, &s.paused);
     let axes = s.bundles.iter().map(|bundle| {
         let waiting = members[bundle.members.0..bundle.members.1]
@@ -207,7 +210,7 @@ fn march_axes(fractal: &Fractal, settings: &MarchSettings, s: &mut BundleScratch
                 taken: 0,
                 spent: 0,
             }),
-            None => Err(None),
+            None => Err(Stop::NONE),
         }
     });
     let stops = &mut s.stops;
@@ -224,10 +227,10 @@ fn resume(s: &mut BundleScratch, out: &mut [(f32, u64)]) {
         bundles,
         stops,
         resumed,
+        ..
     } = s;
     resumed.clear();
     for (bundle, stop) in bundles.iter_mut().zip(stops.iter()) {
-        let Some(stop) = stop else { continue };
         if let Some(next) = stop.next {
             bundle.start = next;
         }
@@ -293,6 +296,16 @@ struct Stop {
     spent: u64,
 }
 
+impl Stop {
+    /// A bundle with no member waiting on it marches nothing.
+    const NONE: Stop = Stop {
+        at: None,
+        next: None,
+        taken: 0,
+        spent: 0,
+    };
+}
+
 /// The shared march along a bundle's axis. A step is the share of the
 /// estimate a cone trusts less the bundle's radius, so every member's own
 /// path to its next point stays in the ball the estimate clears; it goes
@@ -308,7 +321,7 @@ struct AxisWalk {
 }
 
 impl Walk for AxisWalk {
-    type Output = Option<Stop>;
+    type Output = Stop;
 
     fn next_point(&self) -> (DVec3, Real) {
         let b = &self.bundle;
@@ -329,19 +342,19 @@ impl Walk for AxisWalk {
         let dims = b.softness > 0.0 && b.softness * clear < farthest;
         if !e.escaped {
             // Inside: the rays go on alone from the last point outside.
-            return Some(Some(self.stop(Some(self.previous))));
+            return Some(self.stop(Some(self.previous)));
         }
         if clear < b.eps || dims {
-            return Some(Some(self.stop(Some(self.u))));
+            return Some(self.stop(Some(self.u)));
         }
         self.previous = self.u;
         self.u += clear;
         self.taken += 1;
         if self.u > b.end {
-            return Some(Some(self.stop(None)));
+            return Some(self.stop(None));
         }
         // Out of the fewest steps a member has left: the others go on.
-        (self.taken >= b.steps).then(|| Some(self.stop(Some(self.u))))
+        (self.taken >= b.steps).then(|| self.stop(Some(self.u)))
     }
 }
 
