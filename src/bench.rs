@@ -1424,7 +1424,8 @@ pub fn default_machine_name(peak: &Peak) -> String {
     let width = match peak.lanes {
         8 => "avx512",
         4 => "avx2",
-        _ => "sse",
+        _ if cfg!(target_arch = "x86_64") => "sse",
+        lanes => return format!("{}core-{model}-{lanes}lane", peak.cores),
     };
     format!("{}core-{model}-{width}", peak.cores)
 }

@@ -143,6 +143,20 @@ impl Fractal {
         if no_bound_applies(p, iterations, escape.min(2.0), critical, distance) {
             return (distance, 0);
         }
+        self.bounded_by_roots::<T>(p, escape, scale, distance, iterations, near_critical)
+    }
+
+    /// `bounded`'s tests taken on |p| itself, at the world position `p`:
+    /// where `no_bound_applies` holds, they keep the estimate as it is.
+    pub(super) fn bounded_by_roots<T: Number>(
+        &self,
+        p: DVec3,
+        escape: Real,
+        scale: Real,
+        distance: Real,
+        iterations: u32,
+        near_critical: bool,
+    ) -> (Real, u32) {
         let scaled = p.abs().max_element();
         let length = if scaled < 1e150 {
             p.length()
@@ -242,7 +256,14 @@ impl Fractal {
     /// but for the Jacobian method, whose dual numbers divide by
     /// multiplying with an inverse.
     pub fn ends_f64_orbits(&self) -> bool {
-        self.precision == Precision::F64 && self.de != DeMethod::Jacobian
+        let plain_orbit = match self.de {
+            DeMethod::Analytic
+            | DeMethod::Potential
+            | DeMethod::SinhPotential
+            | DeMethod::EscapeLength => true,
+            DeMethod::Jacobian => false,
+        };
+        self.precision == Precision::F64 && plain_orbit
     }
 
     /// The world position of the frame's point `p` (to f64, for bounds).
@@ -315,8 +336,9 @@ impl Fractal {
     /// The estimator's formula at `p`, without `bounded`'s bounds.
     pub(super) fn estimate_raw<T: Number>(&self, p: DVec3, scale: Real) -> Estimate {
         let at = |q: DVec3| [T::from_real(q.x), T::from_real(q.y), T::from_real(q.z)];
-        // The Jacobian method runs its one orbit in dual numbers: their values
-        // are the plain orbit, so no second orbit is needed.
+        // The Jacobian method runs its one orbit in dual numbers, whose values
+        // follow the plain orbit closely enough to estimate from: no second
+        // orbit is needed (though not bit for bit: `ends_f64_orbits`).
         let (centre, jacobian): (Orbit<T>, Option<glam::DMat3>) = if self.de == DeMethod::Jacobian {
             let dual: Orbit<Dual<T>> = self.orbit_at(
                 [

@@ -28,7 +28,9 @@ pub use bundle::{walk_shadows, BundleScratch};
 pub use fog::{fogged, glow, Fog, Glow};
 pub use lighting::{Light, Specular, MAX_LIGHTS};
 pub use look::Look;
-pub use palette::{mix_oklab, smooth_iterations, OrbitQuantity, Palette, Stop, Wrap, MAX_STOPS};
+#[cfg(test)]
+pub use palette::{mix_oklab, smooth_iterations};
+pub use palette::{OrbitQuantity, Palette, Stop, Wrap, MAX_STOPS};
 #[cfg(test)]
 pub use path::trace_path;
 pub use path::{cone_direction, cosine_direction, trace_paths, PathScratch, PathTracing};

@@ -5,8 +5,9 @@
 //!
 //! The stops are converted to OKLab once, at a palette's first hit
 //! (`Prepared`), and the smooth count and angle come from the hit's own
-//! estimate, whose orbit already ended where they are read: a hit iterates
-//! no more orbit and converts no stop.
+//! estimate, whose orbit already ended where they are read: in f64 with
+//! any estimator but the Jacobian one, a hit iterates no more orbit and
+//! converts no stop.
 //!
 //! OKLab: Ottosson, "A perceptual color space for image processing" (2020),
 //! by the `oklab` crate. The smooth escape count: Vepstas, "Renormalizing
@@ -48,8 +49,8 @@ pub struct Palette {
 
 /// What a palette's hits share, worked out at the first hit that needs it:
 /// each stop's colour in OKLab (its cube roots are most of a conversion's
-/// cost), and the logarithms of
-/// the escape radius and power the smooth count divides by. Each is kept
+/// cost), and the logarithms of the escape radius and power the smooth
+/// count divides by. Each is kept
 /// with the bits it was made from; a stop or fractal that has changed
 /// since (a scene edited after shading) is worked out where it is used.
 #[derive(Clone, Debug, Default)]
@@ -231,6 +232,7 @@ impl Wrap {
 
 /// The colour a fraction `f` of the way from `a` to `b`, interpolated in
 /// OKLab, where equal steps look equal; never negative.
+#[cfg(test)]
 pub fn mix_oklab(a: Vec3, b: Vec3, f: f32) -> Vec3 {
     mix_lab(to_lab(a), to_lab(b), f)
 }
@@ -265,6 +267,7 @@ fn mix_lab(p: Oklab, q: Oklab, f: f32) -> Vec3 {
 /// at radius `r`, for escape radius `escape` and power `power`. An orbit
 /// that never escaped (r ≤ E) counts `iterations + 1`, where its escaping
 /// neighbours' counts tend.
+#[cfg(test)]
 pub fn smooth_iterations(iterations: u32, r: Real, escape: Real, power: Real) -> f32 {
     smooth_count(iterations, r, [escape.ln(), power.ln()])
 }

@@ -445,6 +445,13 @@ fn julia_lanes_off_the_critical_point_skip_the_bound_as_bounded_would() {
         (seed >> 11) as Real / (1u64 << 53) as Real
     };
     let near = 1.5;
+    // `bounded`'s own tests on |p| keep every estimate this lets through.
+    let julia = Fractal {
+        julia: Some(DVec3::new(0.3, -0.2, 0.1)),
+        ..Fractal::default()
+    };
+    let escape = julia.escape_radius::<Real>();
+    assert!(escape.min(2.0) >= near, "escape radius {escape}");
     for _ in 0..200_000 {
         let p = DVec3::new(next(), next(), next()) * (2.0 * near / 3f64.sqrt());
         let length = p.length();
@@ -457,6 +464,8 @@ fn julia_lanes_off_the_critical_point_skip_the_bound_as_bounded_would() {
         let by_roots = length <= near && distance > 0.0 && distance < length;
         if no_bound_applies(p, 3, near, true, distance) {
             assert!(by_roots, "p {p}, distance {distance}");
+            let kept = julia.bounded_by_roots::<Real>(p, escape, 0.0, distance, 3, true);
+            assert_eq!(kept, (distance, 0), "p {p}");
         }
     }
 }

@@ -228,8 +228,8 @@ fn a_deep_frames_quantities_are_the_plain_orbits() {
     }
 }
 
-/// `Palette::at` as it stood with no table: both stops converted at the
-/// call (`mix_oklab`), the neighbour across a repeating seam shifted.
+/// `Palette::at` worked out without the OKLab table: both stops converted
+/// at the call (`mix_oklab`), the neighbour across a repeating seam shifted.
 fn at_converting(p: &Palette, t: f32) -> Vec3 {
     let (first, last, n) = (p.stops[0], p.stops[p.stops.len() - 1], p.stops.len());
     let shifted = |s: Stop, by: f32| stop(s.position + by, s.colour);
