@@ -14,15 +14,11 @@ use crate::fractal::Fractal;
 use crate::math::{DVec3, Real};
 use crate::scene::Scene;
 use std::collections::VecDeque;
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// A frame is deep where a pixel at its target is narrower than this share
-/// of the target's coordinates: 2²⁶ times f64's resolution there. Orbits
-/// near a repelling fixed point amplify f64's rounding far more than their
-/// pixels' offsets: on `deep_zoom.ron`'s tip f64 frames turn to noise from
-/// 2⁻³⁰, so this keeps a margin of 16 over the worst case seen. Within a
-/// deep frame, points whose footprints pass it are estimated in f64 alone.
-pub const DEEP_BELOW: Real = crate::fractal::deep::F64_RESOLVES;
+/// of the target's coordinates (`F64_RESOLVES`).
+pub use crate::fractal::deep::F64_RESOLVES as DEEP_BELOW;
 
 /// The closest a camera may come to its target: a frame's offsets are f64,
 /// and lengths square them, which leaves f64's range below about 1e-154.
@@ -128,21 +124,22 @@ pub fn prepare_with(scene: &Scene, size: [u32; 2], references: &References) -> O
 }
 
 /// Reference orbits already followed, by fractal, target and precision,
-/// shared by clones: the frames of a film at one precision (a deep zoom's
-/// for a third of a decade or so) and a frame's instants share one, so
-/// its high-precision orbit is followed once.
+/// shared by clones: in planning, the frames of a film at one precision (a
+/// deep zoom's for a third of a decade or so) share one, and in rendering,
+/// a frame's instants do, so each high-precision orbit is followed once.
 #[derive(Clone, Debug, Default)]
 pub struct References(Arc<Mutex<VecDeque<Followed>>>);
 
 /// One reference orbit and what it was followed from (`None` where the
-/// power is not whole).
+/// power is not whole, or until the thread that first asked has followed
+/// it: others asking meanwhile wait rather than follow it too).
 #[derive(Debug)]
 struct Followed {
     fractal: Fractal,
     target: DVec3,
     target_digits: Option<Digits>,
     bits: usize,
-    reference: Option<Arc<Reference>>,
+    reference: Arc<OnceLock<Option<Arc<Reference>>>>,
 }
 
 /// The references kept for each thread, the oldest dropped first: a
@@ -164,26 +161,35 @@ impl References {
                 && f.target == camera.target
                 && f.target_digits == camera.target_digits
         };
-        // A panic elsewhere while holding the lock leaves whole entries.
-        let lock = || self.0.lock().unwrap_or_else(|e| e.into_inner());
-        let kept = lock().iter().find(same).map(|f| f.reference.clone());
-        if let Some(reference) = kept {
-            return reference;
-        }
-        let anchor = big_point(camera.target, camera.target_digits.as_ref(), bits);
-        let reference = Reference::new(fractal, anchor, bits).map(Arc::new);
-        let mut followed = lock();
-        if followed.len() >= KEPT_PER_THREAD * rayon::current_num_threads().min(KEPT_THREADS) {
-            followed.pop_front();
-        }
-        followed.push_back(Followed {
-            fractal: fractal.clone(),
-            target: camera.target,
-            target_digits: camera.target_digits.clone(),
-            bits,
-            reference: reference.clone(),
-        });
-        reference
+        let slot = {
+            // A panic elsewhere while holding the lock leaves whole entries.
+            let mut followed = self.0.lock().unwrap_or_else(|e| e.into_inner());
+            match followed.iter().find(same) {
+                Some(f) => f.reference.clone(),
+                None => {
+                    if followed.len()
+                        >= KEPT_PER_THREAD * rayon::current_num_threads().min(KEPT_THREADS)
+                    {
+                        followed.pop_front();
+                    }
+                    let slot = Arc::new(OnceLock::new());
+                    followed.push_back(Followed {
+                        fractal: fractal.clone(),
+                        target: camera.target,
+                        target_digits: camera.target_digits.clone(),
+                        bits,
+                        reference: slot.clone(),
+                    });
+                    slot
+                }
+            }
+        };
+        // Followed outside the lock, so other references are not held up.
+        slot.get_or_init(|| {
+            let anchor = big_point(camera.target, camera.target_digits.as_ref(), bits);
+            Reference::new(fractal, anchor, bits).map(Arc::new)
+        })
+        .clone()
     }
 }
 

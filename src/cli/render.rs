@@ -283,12 +283,7 @@ fn print_video_command(plan: &Plan, known: &[u32], quiet: bool) -> anyhow::Resul
     let format = plan.video_format();
     let known: std::collections::HashSet<u32> = known.iter().copied().collect();
     let listed = plan.listing();
-    // A frame not listed is missing, with no look-up of its own.
-    let current = |f: u32| {
-        let name = plan.frame_name.file_name(f, format);
-        let listed = listed.as_ref().is_none_or(|names| names.contains(&name));
-        listed && plan.is_current_in(f, format)
-    };
+    let current = |f: u32| plan.is_current_in(f, format, listed.as_ref());
     let missing: Vec<u32> = (0..plan.timeline.frame_count)
         .filter(|&f| !known.contains(&f) && !current(f))
         .collect();

@@ -52,9 +52,7 @@ impl Fractal {
         scales: &[Real; N],
         out: &mut [Estimate; N],
     ) {
-        if let (Some(reference), DeMethod::Analytic, Precision::F64) =
-            (&self.deep, self.de, self.precision)
-        {
+        if let Some(reference) = self.perturbed_analytic() {
             return reference.estimates_into(self, points, scales, out);
         }
         if self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()

@@ -276,10 +276,20 @@ impl Plan {
     }
 
     /// Whether `frame`'s file in `format` is whole and current (no hash
-    /// is computed where there is no file).
-    pub fn is_current_in(&self, frame: u32, format: Format) -> bool {
+    /// is computed where there is no file): looked for in `listed`
+    /// (`listing`) where given, else on disk.
+    pub fn is_current_in(
+        &self,
+        frame: u32,
+        format: Format,
+        listed: Option<&HashSet<String>>,
+    ) -> bool {
         let path = self.path(frame, format);
-        if !path.exists() {
+        let there = match listed {
+            Some(names) => names.contains(&self.frame_name.file_name(frame, format)),
+            None => path.exists(),
+        };
+        if !there {
             return false;
         }
         let (_, hash) = self.frame(frame);

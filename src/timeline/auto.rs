@@ -11,8 +11,7 @@ use crate::fractal::{AutoIterations, MAX_ITERATIONS};
 use crate::math::Real;
 use crate::scene::Scene;
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// The fewest iterations `Auto` chooses: below this the bulb has not yet
 /// taken its shape (at 3 it is a lumpy ball), whatever a pixel resolves.
@@ -131,23 +130,23 @@ fn centre_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -
 
 /// Each frame's resolved count, kept by the timeline so that a frame's
 /// high-precision orbit is followed once however often its scene is made
-/// (validation, the plan, hashes, `info`).
+/// (validation, the plan, hashes, `info`): a thread that asks while
+/// another resolves the same instant waits for its answer.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Counts {
-    /// By frame index (`pack`ed, 0 while unresolved): a long film's
-    /// frames are looked up by every pass over it, in order, without a
-    /// lock or a hash.
-    frames: Arc<[AtomicU64]>,
+    /// By frame index: a long film's frames are looked up by every pass
+    /// over it, in order, without a lock or a hash.
+    frames: Arc<[OnceLock<Resolved>]>,
     /// Instants of no frame of the film (before it, or after its end),
     /// by their time's bits.
-    others: Arc<Mutex<HashMap<u64, Resolved>>>,
+    others: Arc<Mutex<HashMap<u64, Arc<OnceLock<Resolved>>>>>,
 }
 
 impl Counts {
     /// Room for the counts of `frame_count` frames.
     pub(super) fn new(frame_count: u32) -> Counts {
         Counts {
-            frames: (0..frame_count).map(|_| AtomicU64::new(0)).collect(),
+            frames: (0..frame_count).map(|_| OnceLock::new()).collect(),
             others: Default::default(),
         }
     }
@@ -165,46 +164,15 @@ impl Counts {
     ) -> Resolved {
         let resolve = || resolve_with(scene, auto, size, references);
         if let Some(slot) = frame_index.and_then(|i| self.frames.get(i)) {
-            // Two threads may both resolve a frame: they find the same.
-            return unpack(slot.load(Ordering::Relaxed)).unwrap_or_else(|| {
-                let r = resolve();
-                slot.store(pack(r), Ordering::Relaxed);
-                r
-            });
+            return *slot.get_or_init(resolve);
         }
-        let key = time_seconds.to_bits();
-        // A panic elsewhere while holding the lock leaves whole entries.
-        let lock = || self.others.lock().unwrap_or_else(|e| e.into_inner());
-        let kept = lock().get(&key).copied();
-        kept.unwrap_or_else(|| {
-            let r = resolve();
-            lock().insert(key, r);
-            r
-        })
+        let slot = {
+            // A panic elsewhere while holding the lock leaves whole entries.
+            let mut others = self.others.lock().unwrap_or_else(|e| e.into_inner());
+            others.entry(time_seconds.to_bits()).or_default().clone()
+        };
+        *slot.get_or_init(resolve)
     }
-}
-
-/// A count and what decided it in one word, with a bit set so that no
-/// resolved count is 0.
-fn pack(r: Resolved) -> u64 {
-    let decided = match r.decided {
-        Decided::Target => 0,
-        Decided::Centre => 1,
-        Decided::Floor => 2,
-    };
-    1 << 63 | decided << 32 | u64::from(r.count)
-}
-
-/// What `pack` packed, if anything.
-fn unpack(word: u64) -> Option<Resolved> {
-    let decided = match (word >> 32) & 0xff {
-        _ if word == 0 => return None,
-        0 => Decided::Target,
-        1 => Decided::Centre,
-        _ => Decided::Floor,
-    };
-    let count = (word & 0xffff_ffff) as u32;
-    Some(Resolved { count, decided })
 }
 
 #[cfg(test)]

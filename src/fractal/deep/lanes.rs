@@ -276,22 +276,12 @@ impl Reference {
 
 /// The points of a register's worth that need perturbed orbits, packed,
 /// with where each came from.
+#[derive(Default)]
 struct Partition {
     index: [usize; VECTOR],
     points: [DVec3; VECTOR],
     scales: [Real; VECTOR],
     count: usize,
-}
-
-impl Default for Partition {
-    fn default() -> Self {
-        Partition {
-            index: [0; VECTOR],
-            points: [DVec3::ZERO; VECTOR],
-            scales: [0.0; VECTOR],
-            count: 0,
-        }
-    }
 }
 
 impl Partition {

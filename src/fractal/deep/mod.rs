@@ -275,12 +275,16 @@ impl Reference {
     }
 }
 
-/// The least footprint, as a share of a point's largest coordinate, at
-/// which a deep frame's analytic estimate is left to f64 alone: the share
-/// below which a frame is deep (`crate::deep::DEEP_BELOW`), point by point. Points far from the anchor
-/// (rays leaving for the rest of the bulb, occlusion's reach) pass it; their
-/// perturbed orbits part from the reference at once and are rebased, to
-/// finish one at a time at several times the plain kernel's cost.
+/// The least footprint, as a share of a point's largest coordinate, that
+/// f64 resolves: 2²⁶ times its resolution there. Orbits near a repelling
+/// fixed point amplify f64's rounding far more than their pixels' offsets:
+/// on `deep_zoom.ron`'s tip f64 frames turn to noise from 2⁻³⁰, so this
+/// keeps a margin of 16 over the worst case seen. A frame whose pixel at
+/// its target is finer is deep; within a deep frame, a point whose
+/// footprint passes it is estimated in f64 alone. Such points lie far from
+/// the anchor (rays leaving for the rest of the bulb, occlusion's reach):
+/// their perturbed orbits would part from the reference at once and be
+/// rebased, to finish one at a time outside the vector kernel.
 pub const F64_RESOLVES: Real = 1.0 / (1u64 << 26) as Real;
 
 impl Reference {
@@ -293,6 +297,13 @@ impl Reference {
 }
 
 impl Fractal {
+    /// The deep frame's reference, where its estimates go through the
+    /// perturbed analytic kernel (f64 offsets).
+    pub(in crate::fractal) fn perturbed_analytic(&self) -> Option<&Reference> {
+        let analytic = self.de == DeMethod::Analytic && self.precision == Precision::F64;
+        self.deep.as_deref().filter(|_| analytic)
+    }
+
     /// This fractal in world coordinates, without the deep frame's
     /// reference: what estimates the points f64 resolves. Field by field,
     /// so that a new field must be placed here.
@@ -317,9 +328,9 @@ impl Fractal {
     /// position; `None` where the frame is not deep or `p` needs the
     /// reference.
     pub(in crate::fractal) fn plain_estimate(&self, p: DVec3, scale: Real) -> Option<Estimate> {
-        let reference = self.deep.as_ref()?;
-        let analytic = self.de == DeMethod::Analytic && self.precision == Precision::F64;
-        (analytic && reference.resolves_in_f64(p, scale))
+        let reference = self.perturbed_analytic()?;
+        reference
+            .resolves_in_f64(p, scale)
             .then(|| self.plain().estimate(reference.anchor + p, scale))
     }
 }
