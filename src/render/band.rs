@@ -25,6 +25,8 @@ pub(super) struct FrameSetup<'a> {
     pub(super) cameras: Vec<crate::camera::CameraFrame>,
     /// Fog is measured in camera–target distances, so zooms keep their haze.
     pub(super) scales: Vec<Real>,
+    /// Each instant's palette table (`shade::palette_table`).
+    pub(super) palettes: Vec<Option<crate::shade::PaletteTable>>,
     /// An environment map is looked up once per frame, not per ray.
     pub(super) environment: Option<std::sync::Arc<crate::environment::EnvironmentMap>>,
     /// Under adaptive sampling, the pixels (of the whole frame) that take
@@ -63,6 +65,10 @@ impl<'a> FrameSetup<'a> {
             scales: scenes
                 .iter()
                 .map(|s| (s.camera.position - s.camera.target).length())
+                .collect(),
+            palettes: scenes
+                .iter()
+                .map(|s| crate::shade::palette_table(&s.look, &s.fractal))
                 .collect(),
             environment: scenes[0]
                 .effects
@@ -153,7 +159,8 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
                 stats.normal_evaluations += evals as u64;
                 sums.spent[order[i]] += evals as u64;
                 let at = SurfacePoint::from_hit(ray, hit, nrm);
-                surfaces[i] = Some(at.coloured(&scene.look, &scene.fractal, &hit.estimate));
+                let palette = frame.palettes[k].as_ref();
+                surfaces[i] = Some(at.coloured(palette, &scene.fractal, &hit.estimate));
             },
         );
         band_shadows(scene, surfaces, runs, walks, shadows, bundles);
@@ -248,7 +255,7 @@ impl RowSums<'_> {
             t,
             normal: nrm,
             traps,
-            palette_quantity,
+            palette_colour,
             ..
         } = at;
         self.hits[p] += 1;
@@ -258,7 +265,7 @@ impl RowSums<'_> {
         }
         // Only a requested albedo layer pays for the albedo.
         if let Some(row) = self.albedo.as_deref_mut() {
-            row[p] += scene.look.albedo(&traps, palette_quantity);
+            row[p] += scene.look.albedo(&traps, palette_colour);
         }
         if let Some(row) = self.traps.as_deref_mut() {
             let v = [

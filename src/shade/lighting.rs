@@ -68,17 +68,17 @@ impl Look {
     }
 
     /// Albedo of the surface from its orbit traps, and the palette's
-    /// colour at `palette_quantity` (`SurfacePoint::palette_quantity`) where
-    /// the look has a palette.
-    pub fn albedo(&self, traps: &OrbitTraps, palette_quantity: Option<f32>) -> Vec3 {
+    /// colour there (`SurfacePoint::palette_colour`) where the look has a
+    /// palette.
+    pub fn albedo(&self, traps: &OrbitTraps, palette_colour: Option<Vec3>) -> Vec3 {
         // A plane trap pulls hardest when the orbit passed close to that plane.
         let pull = |d: Real| (1.0 - (d * 4.0).min(1.0)) as f32;
         let mut c = self.base_colour;
         c = mix(c, self.trap_x_colour, pull(traps.planes.x));
         c = mix(c, self.trap_y_colour, pull(traps.planes.y) * 0.8);
         c = mix(c, self.trap_z_colour, pull(traps.planes.z) * 0.6);
-        if let (Some(palette), Some(x)) = (&self.palette, palette_quantity) {
-            c = mix(c, palette.colour(x), palette.mix);
+        if let (Some(palette), Some(colour)) = (&self.palette, palette_colour) {
+            c = mix(c, colour, palette.mix);
         }
         // Orbits that dive near the origin lie deep in crevices.
         let depth = (traps.origin.sqrt() as f32).clamp(0.0, 1.0);
@@ -153,7 +153,7 @@ impl Look {
             ambient = a;
             counts.occlusion += spent;
         }
-        let albedo = self.albedo(&at.traps, at.palette_quantity);
+        let albedo = self.albedo(&at.traps, at.palette_colour);
         let mut c = albedo * self.ambient * ambient;
         for (to_light, brightness, lambert) in self.facing(at) {
             let mut light = 1.0f32;

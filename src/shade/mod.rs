@@ -12,7 +12,7 @@
 //! occlusion compares the estimate with the distance stepped along the normal.
 
 use crate::fractal::OrbitTraps;
-use crate::math::{DVec3, Real};
+use crate::math::{DVec3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
 mod bundle;
@@ -30,7 +30,7 @@ pub use lighting::{Light, Specular, MAX_LIGHTS};
 pub use look::Look;
 #[cfg(test)]
 pub use palette::{mix_oklab, smooth_iterations};
-pub use palette::{OrbitQuantity, Palette, Stop, Wrap, MAX_STOPS};
+pub use palette::{OrbitQuantity, Palette, Stop, Table as PaletteTable, Wrap, MAX_STOPS};
 #[cfg(test)]
 pub use path::trace_path;
 pub use path::{cone_direction, cosine_direction, trace_paths, PathScratch, PathTracing};
@@ -116,9 +116,9 @@ pub struct SurfacePoint {
     pub t: Real,
     pub footprint: Real,
     pub traps: OrbitTraps,
-    /// The orbit quantity the look's palette is driven by, where it has
-    /// one that shows (`coloured`); `None` costs nothing.
-    pub palette_quantity: Option<f32>,
+    /// The look's palette's colour here, where it has one that shows
+    /// (`coloured`); `None` costs nothing.
+    pub palette_colour: Option<Vec3>,
 }
 
 impl SurfacePoint {
@@ -131,24 +131,31 @@ impl SurfacePoint {
             t: hit.t,
             footprint: ray.footprint(hit.t),
             traps: hit.estimate.traps,
-            palette_quantity: None,
+            palette_colour: None,
         }
     }
 
-    /// This point with the orbit quantity `look`'s palette needs, where it
-    /// has a palette with some mix, from `estimate`, the one taken at the
+    /// This point with its colour from `palette` (the look's, where it
+    /// shows: `palette_table`), placed by `estimate`, the one taken at the
     /// point (the hit's).
     pub fn coloured(
         mut self,
-        look: &Look,
+        palette: Option<&PaletteTable>,
         fractal: &crate::fractal::Fractal,
         estimate: &crate::fractal::Estimate,
     ) -> Self {
-        if let Some(palette) = look.palette.as_ref().filter(|p| p.mix > 0.0) {
-            self.palette_quantity = Some(palette.quantity(fractal, self.point, estimate));
+        if let Some(table) = palette {
+            self.palette_colour = Some(table.colour(table.quantity(fractal, self.point, estimate)));
         }
         self
     }
+}
+
+/// The table of `look`'s palette for `fractal`'s hits, where it has one
+/// with some mix: made once for all the hits that share them.
+pub fn palette_table(look: &Look, fractal: &crate::fractal::Fractal) -> Option<PaletteTable> {
+    let palette = look.palette.as_ref().filter(|p| p.mix > 0.0)?;
+    Some(palette.table(fractal))
 }
 
 #[cfg(test)]

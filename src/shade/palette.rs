@@ -3,11 +3,11 @@
 //! or its final point's angle) picks the surface colour, mixed over the
 //! trap colours.
 //!
-//! The stops are converted to OKLab once, at a palette's first hit
-//! (`Prepared`), and the smooth count and angle come from the hit's own
-//! estimate, whose orbit already ended where they are read: in f64 with
-//! any estimator but the Jacobian one, a hit iterates no more orbit and
-//! converts no stop.
+//! A frame's hits use the palette through its `Table`, made once per
+//! frame: the stops in OKLab and the logarithms the smooth count divides
+//! by. The smooth count and angle come from the hit's own estimate, whose
+//! orbit already ended where they are read: in f64 with any estimator but
+//! the Jacobian one, a hit iterates no more orbit and converts no stop.
 //!
 //! OKLab: Ottosson, "A perceptual color space for image processing" (2020),
 //! by the `oklab` crate. The smooth escape count: Vepstas, "Renormalizing
@@ -17,7 +17,6 @@ use crate::fractal::{Estimate, Formula, Fractal};
 use crate::math::{DVec3, Real, Vec3};
 use oklab::{linear_srgb_to_oklab, oklab_to_linear_srgb, Oklab, Rgb};
 use serde::{Deserialize, Serialize};
-use std::sync::OnceLock;
 
 /// The most stops a palette may have: each stop's position and colour is a
 /// parameter a track can animate, and the table lists every one.
@@ -41,57 +40,6 @@ pub struct Palette {
     pub mix: f32,
     /// What the gradient does past its ends.
     pub wrap: Wrap,
-    /// What every hit would work out alike, made at the first; not part
-    /// of the timeline.
-    #[serde(skip)]
-    pub(crate) prepared: Prepared,
-}
-
-/// What a palette's hits share, worked out at the first hit that needs it:
-/// each stop's colour in OKLab (its cube roots are most of a conversion's
-/// cost), and the logarithms of the escape radius and power the smooth
-/// count divides by. Each is kept
-/// with the bits it was made from; a stop or fractal that has changed
-/// since (a scene edited after shading) is worked out where it is used.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct Prepared {
-    lab: OnceLock<Vec<([u32; 3], Oklab)>>,
-    logs: OnceLock<([u64; 2], [Real; 2])>,
-}
-
-impl PartialEq for Prepared {
-    /// Always equal: a cache, each entry checked against what it was made
-    /// from at every use.
-    fn eq(&self, _: &Prepared) -> bool {
-        true
-    }
-}
-
-impl Prepared {
-    /// Stop `i` of `stops` (the palette's) in OKLab.
-    fn lab(&self, stops: &[Stop], i: usize) -> Oklab {
-        let colour = stops[i].colour;
-        let table = self.lab.get_or_init(|| {
-            stops
-                .iter()
-                .map(|s| (s.colour.to_array().map(f32::to_bits), to_lab(s.colour)))
-                .collect()
-        });
-        match table.get(i) {
-            Some(&(bits, lab)) if bits == colour.to_array().map(f32::to_bits) => lab,
-            _ => to_lab(colour),
-        }
-    }
-
-    /// ln E and ln n, for escape radius `escape` and power `power`.
-    fn logs(&self, escape: Real, power: Real) -> [Real; 2] {
-        let key = [escape.to_bits(), power.to_bits()];
-        let logs = || [escape.ln(), power.ln()];
-        match self.logs.get_or_init(|| (key, logs())) {
-            &(made_from, made) if made_from == key => made,
-            _ => logs(),
-        }
-    }
 }
 
 /// One stop of a gradient: a linear-RGB colour at a position in [0, 1].
@@ -147,23 +95,45 @@ impl Default for Palette {
             offset: 0.0,
             mix: 1.0,
             wrap: Wrap::Repeat,
-            prepared: Prepared::default(),
         }
     }
 }
 
+/// What a frame's hits share of a palette (`Palette::table`): each stop's
+/// colour in OKLab (its cube roots are most of a conversion's cost), and
+/// the logarithms of the escape radius and power the smooth count divides
+/// by.
+#[derive(Clone, Debug)]
+pub struct Table {
+    palette: Palette,
+    lab: Vec<Oklab>,
+    logs: [Real; 2],
+}
+
 impl Palette {
+    /// This palette as `fractal`'s hits use it.
+    pub fn table(&self, fractal: &Fractal) -> Table {
+        Table {
+            palette: self.clone(),
+            lab: self.stops.iter().map(|s| to_lab(s.colour)).collect(),
+            logs: [fractal.escape_radius::<Real>().ln(), fractal.power.ln()],
+        }
+    }
+}
+
+impl Table {
     /// The colour of a hit whose orbit quantity is `x`.
     pub fn colour(&self, x: f32) -> Vec3 {
-        let t = x * self.scale + self.offset;
+        let p = &self.palette;
+        let t = x * p.scale + p.offset;
         // A quantity that is not finite (an orbit gone NaN) takes the start.
         let t = if t.is_finite() { t } else { 0.0 };
-        self.at(self.wrap.fold(t))
+        self.at(p.wrap.fold(t))
     }
 
     /// The gradient's colour at `t` in [0, 1].
     pub fn at(&self, t: f32) -> Vec3 {
-        let stops = &self.stops;
+        let stops = &self.palette.stops;
         let (Some(first), Some(last)) = (stops.first(), stops.last()) else {
             return Vec3::ZERO;
         };
@@ -171,7 +141,7 @@ impl Palette {
         let next = stops.partition_point(|s| s.position <= t);
         // The stops either side of `t` (by index) and their positions, the
         // neighbour across a repeating gradient's seam moved a gradient along.
-        let (a, at_a, b, at_b) = match (next, self.wrap) {
+        let (a, at_a, b, at_b) = match (next, self.palette.wrap) {
             (0, Wrap::Repeat) => (last_index, last.position - 1.0, 0, first.position),
             (0, _) => return first.colour,
             (k, Wrap::Repeat) if k == n => (last_index, last.position, 0, first.position + 1.0),
@@ -180,15 +150,14 @@ impl Palette {
         };
         let span = at_b - at_a;
         let f = if span > 0.0 { (t - at_a) / span } else { 1.0 };
-        let lab = |i| self.prepared.lab(stops, i);
-        mix_lab(lab(a), lab(b), f.clamp(0.0, 1.0))
+        mix_lab(self.lab[a], self.lab[b], f.clamp(0.0, 1.0))
     }
 
     /// The orbit quantity `by` names for the frame's point `point`, given
     /// the estimate taken there (a hit's): the trap's and, in f64, the
     /// others from where its orbit ended; in f32 from one more orbit.
     pub fn quantity(&self, fractal: &Fractal, point: DVec3, estimate: &Estimate) -> f32 {
-        let (iterations, end, r) = match self.by {
+        let (iterations, end, r) = match self.palette.by {
             OrbitQuantity::Trap => return estimate.traps.origin.sqrt() as f32,
             _ if fractal.ends_f64_orbits() => {
                 (estimate.iterations, estimate.end, estimate.end_radius())
@@ -200,14 +169,9 @@ impl Palette {
                 (orbit.iterations, orbit.z, orbit.r)
             }
         };
-        match self.by {
+        match self.palette.by {
             OrbitQuantity::Angle => azimuth_turns(fractal.formula, end),
-            _ => {
-                let logs = self
-                    .prepared
-                    .logs(fractal.escape_radius::<Real>(), fractal.power);
-                smooth_count(iterations, r, logs)
-            }
+            _ => smooth_count(iterations, r, self.logs),
         }
     }
 }

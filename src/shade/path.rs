@@ -194,7 +194,7 @@ impl Tracing<'_> {
         for (i, path) in paths.iter_mut().enumerate() {
             let Some(path) = path else { continue };
             let here = &path.here;
-            let albedo = self.look.albedo(&here.traps, here.palette_quantity);
+            let albedo = self.look.albedo(&here.traps, here.palette_colour);
             for (l, (to_light, brightness)) in self.look.lights().enumerate() {
                 let k = 3 + 2 * l as u32;
                 let dir = if self.sun_half_angle > 0.0 {
@@ -311,6 +311,9 @@ pub fn trace_paths(
     random: &dyn Fn(usize, u32) -> Real,
     scratch: &mut PathScratch,
 ) {
+    // A handful of stops converted per call, for all its paths' hits.
+    let palette = &super::palette_table(look, fractal);
+    let palette = palette.as_ref();
     let tracing = Tracing {
         look,
         pt,
@@ -372,7 +375,7 @@ pub fn trace_paths(
             let path = paths[i].as_mut().expect("a path that goes on");
             path.here = SurfacePoint {
                 t: path.here.t + hit.t,
-                ..SurfacePoint::from_hit(ray, hit, nrm).coloured(look, fractal, &hit.estimate)
+                ..SurfacePoint::from_hit(ray, hit, nrm).coloured(palette, fractal, &hit.estimate)
             };
         });
     }

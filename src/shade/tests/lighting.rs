@@ -27,7 +27,7 @@ fn every_light_adds_its_light_and_casts_its_shadow() {
             origin: 1.0,
             planes: DVec3::splat(1.0),
         },
-        palette_quantity: None,
+        palette_colour: None,
     };
     let effects = Effects {
         shadows: Some(Shadows::default()),
@@ -75,7 +75,7 @@ fn lambert_is_ambient_only_facing_away_and_brightest_facing_light() {
             t: 1.0,
             footprint: 1e-3,
             traps: traps_far(),
-            palette_quantity: None,
+            palette_colour: None,
         };
         let mut counts = StageCounts::default();
         let c = look.shade(

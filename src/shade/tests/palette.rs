@@ -4,6 +4,26 @@
 
 use super::*;
 
+/// A palette looked at through a table of its own, made for the default
+/// fractal (or `fractal`) at each call: the tests' shorthand.
+trait Looked {
+    fn at(&self, t: f32) -> Vec3;
+    fn colour(&self, x: f32) -> Vec3;
+    fn quantity(&self, fractal: &Fractal, point: DVec3, e: &crate::fractal::Estimate) -> f32;
+}
+
+impl Looked for Palette {
+    fn at(&self, t: f32) -> Vec3 {
+        self.table(&Fractal::default()).at(t)
+    }
+    fn colour(&self, x: f32) -> Vec3 {
+        self.table(&Fractal::default()).colour(x)
+    }
+    fn quantity(&self, fractal: &Fractal, point: DVec3, e: &crate::fractal::Estimate) -> f32 {
+        self.table(fractal).quantity(fractal, point, e)
+    }
+}
+
 /// Linear sRGB to OKLab by the published matrices (Ottosson 2020), in f64:
 /// the reference the crate's f32 conversion is checked against.
 fn oklab_of(c: [f64; 3]) -> [f64; 3] {
@@ -193,9 +213,10 @@ fn a_palette_with_no_mix_leaves_the_trap_colours() {
         ..Palette::default()
     });
     let a = plain.albedo(&traps, None);
-    assert_eq!(a.to_array(), with.albedo(&traps, Some(0.4)).to_array());
+    let colour = Some(Palette::default().colour(0.4));
+    assert_eq!(a.to_array(), with.albedo(&traps, colour).to_array());
     with.palette.as_mut().unwrap().mix = 1.0;
-    assert_ne!(a, with.albedo(&traps, Some(0.4)));
+    assert_ne!(a, with.albedo(&traps, colour));
 }
 
 #[test]
@@ -259,8 +280,9 @@ fn places() -> impl Iterator<Item = f32> {
 fn a_palette_converts_each_stop_once_not_at_every_hit() {
     let p = Palette::default();
     let before = crate::shade::palette::CONVERSIONS.with(|n| n.get());
+    let table = p.table(&Fractal::default());
     for t in places() {
-        p.colour(t);
+        table.colour(t);
     }
     let converted = crate::shade::palette::CONVERSIONS.with(|n| n.get()) - before;
     assert_eq!(converted, p.stops.len() as u64);
