@@ -157,23 +157,30 @@ impl Table {
     /// the estimate taken there (a hit's): the trap's and, in f64, the
     /// others from where its orbit ended; in f32 from one more orbit.
     pub fn quantity(&self, fractal: &Fractal, point: DVec3, estimate: &Estimate) -> f32 {
-        let (iterations, end, r) = match self.palette.by {
-            OrbitQuantity::Trap => return estimate.traps.origin.sqrt() as f32,
-            _ if fractal.ends_f64_orbits() => {
-                (estimate.iterations, estimate.end, estimate.end_radius())
-            }
-            OrbitQuantity::SmoothIterations | OrbitQuantity::Angle => {
-                // In a deep frame `point` is an offset from the anchor, and
-                // `orbit_at` iterates it by perturbation.
-                let orbit = fractal.orbit_at([point.x, point.y, point.z], fractal.iterations, true);
-                (orbit.iterations, orbit.z, orbit.r)
-            }
-        };
         match self.palette.by {
-            OrbitQuantity::Angle => azimuth_turns(fractal.formula, end),
-            _ => smooth_count(iterations, r, self.logs),
+            OrbitQuantity::Trap => estimate.traps.origin.sqrt() as f32,
+            OrbitQuantity::Angle => {
+                azimuth_turns(fractal.formula, orbit_end(fractal, point, estimate).1)
+            }
+            OrbitQuantity::SmoothIterations => {
+                let (iterations, _, r) = orbit_end(fractal, point, estimate);
+                smooth_count(iterations, r, self.logs)
+            }
         }
     }
+}
+
+/// Where the orbit of the frame's point `point` ended (iterations, last
+/// point, its radius): read from `estimate`, the one taken there, where
+/// its orbit is the f64 one, else iterated once more.
+fn orbit_end(fractal: &Fractal, point: DVec3, estimate: &Estimate) -> (u32, [Real; 3], Real) {
+    if fractal.ends_f64_orbits() {
+        return (estimate.iterations, estimate.end, estimate.end_radius());
+    }
+    // In a deep frame `point` is an offset from the anchor, and `orbit_at`
+    // iterates it by perturbation.
+    let orbit = fractal.orbit_at([point.x, point.y, point.z], fractal.iterations, true);
+    (orbit.iterations, orbit.z, orbit.r)
 }
 
 impl Wrap {
