@@ -196,21 +196,12 @@ impl Fractal {
                     let e = self.estimate_in::<T>(self.local(z1), scale, false);
                     (if e.escaped { e.distance } else { 0.0 }, 1 + e.orbits)
                 };
-            let stretch = |delta: Real| n * (length + delta).powf(n - 1.0) * delta;
             // δⁿ ≤ the stretch, and so is δ·n·|p|ⁿ⁻¹: both roots lie above.
             let mut hi = (target / n).powf(1.0 / n);
             if slope > 0.0 {
                 hi = hi.min(target / slope);
             }
-            let mut lo = 0.0;
-            for _ in 0..60 {
-                let mid = 0.5 * (lo + hi);
-                if stretch(mid) > target {
-                    hi = mid;
-                } else {
-                    lo = mid;
-                }
-            }
+            let lo = stretch_root(n, length, target, hi);
             return (as_distance(lo), orbits);
         }
         (distance, 0)
@@ -525,6 +516,34 @@ pub(super) fn as_distance(d: Real) -> Real {
     } else {
         0.0
     }
+}
+
+/// The δ at which the stretch n·(ρ + δ)ⁿ⁻¹·δ reaches `target`, found by
+/// Newton's method from `hi`, a δ at or past it: the stretch is convex and
+/// rising, so each step lands between the root and the last, and the
+/// answer never passes the root by more than rounding.
+pub(super) fn stretch_root(n: Real, rho: Real, target: Real, hi: Real) -> Real {
+    let whole = super::power::whole_power(n);
+    // (ρ + δ)ⁿ⁻² by multiplications where the power is whole.
+    let power = |x: Real| match whole {
+        Some(n) => x.powi(n as i32 - 2),
+        None => x.powf(n - 2.0),
+    };
+    let mut delta = hi;
+    for _ in 0..64 {
+        let x = rho + delta;
+        let below = power(x);
+        let excess = n * below * x * delta - target;
+        let slope = n * below * (rho + n * delta);
+        let next = delta - excess / slope;
+        // Done once the step stalls, is lost to rounding, or is not a number.
+        let moving = next > 0.0 && next < delta;
+        if !moving || delta - next <= delta * 1e-13 {
+            return if moving { next } else { delta };
+        }
+        delta = next;
+    }
+    delta
 }
 
 /// Whether none of `Fractal::bounded`'s bounds applies at `p`: its orbit

@@ -469,3 +469,35 @@ fn julia_lanes_off_the_critical_point_skip_the_bound_as_bounded_would() {
         }
     }
 }
+
+#[test]
+fn the_critical_point_bound_finds_the_stretch_root_from_above() {
+    use crate::fractal::estimate::stretch_root;
+    let stretch = |n: Real, rho: Real, d: Real| n * (rho + d).powf(n - 1.0) * d;
+    for n in [2.0, 3.0, 7.5, 8.0, 16.0] {
+        for rho in [0.0, 1e-3, 0.5, 1.5] {
+            for target in [1e-12, 1e-3, 1.0, 1e6] {
+                // An independent root: plain bisection, far past f64's resolution.
+                let (mut lo, mut hi) = (0.0, (target / n).powf(1.0 / n));
+                let start = hi;
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if stretch(n, rho, mid) > target {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                let root = stretch_root(n, rho, target, start);
+                let case = format!("n {n}, ρ {rho}, target {target}");
+                assert!(
+                    (root - lo).abs() <= 1e-12 * lo,
+                    "{case}: {root} against {lo}"
+                );
+                assert!(root <= start, "{case}: past where it started");
+            }
+        }
+    }
+    // No root to find: the stretch is already 0 at δ = 0.
+    assert_eq!(stretch_root(8.0, 0.0, 0.0, 0.0), 0.0);
+}
