@@ -254,9 +254,10 @@ pub struct PickArgs {
     #[arg(long, value_name = "X,Y", required_unless_present = "refine")]
     pub pixel: Option<String>,
     /// Re-centre the target on the surface under the centre of the view,
-    /// zooming in steps of a thousand from a thousandth of the target's
-    /// size down to this frame's camera distance; prints the new
-    /// `target:` line with all the digits that depth needs.
+    /// zooming in steps (up to a thousand times closer each) from a
+    /// thousandth of the target's size down to this frame's camera
+    /// distance; prints the new `target:` line with all the digits that
+    /// depth needs, and checks that its orbit resolves the frame's pixels.
     #[arg(long, conflicts_with = "pixel")]
     pub refine: bool,
     /// Image size the pixel refers to [default: the timeline's].

@@ -92,9 +92,8 @@ fn as_ron(d: &[String; 3]) -> String {
     format!("(\"{}\", \"{}\", \"{}\")", d[0], d[1], d[2])
 }
 
-/// Rounds of `--refine` at most: each walks in from a thousandth of the
-/// target's size, so a target moved by one round may meet, on the next
-/// round's way in, a surface the camera would fly through.
+/// Rounds of `--refine` at most: a target moved by one round may meet, on
+/// the next round's way in, a surface the camera would fly through.
 const MAX_ROUNDS: usize = 8;
 
 /// A round that moves the target by less than this share of one of frame
@@ -116,11 +115,13 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
             refined: &'a crate::render::pick::Refined,
             round: usize,
             move_pixels: Option<f64>,
+            surface_check: Option<String>,
         }
         let report = Report {
             refined: &refined,
             round,
             move_pixels: moved,
+            surface_check: surface_check(args, size, &refined)?,
         };
         out!("{}", serde_json::to_string(&report)?);
         return Ok(());
@@ -136,10 +137,41 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         args.frame,
         as_ron(&refined.target)
     );
+    if let Some(check) = surface_check(args, size, &refined)? {
+        out!("{check}");
+    }
     if args.aim {
         aim(&args.timeline, &as_ron(&refined.target))?;
     }
     Ok(())
+}
+
+/// Whether the refined target is on the surface at frame F, by the test
+/// `info` applies: its orbit's derivative passes one over a pixel before it
+/// escapes, and it does escape. None where a track sets the target.
+fn surface_check(
+    args: &PickArgs,
+    size: [u32; 2],
+    refined: &crate::render::pick::Refined,
+) -> anyhow::Result<Option<String>> {
+    let text = crate::timeline::read_text(&args.timeline)?;
+    let Ok(moved) = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)) else {
+        return Ok(None);
+    };
+    let scene = Timeline::parse(&moved, &args.timeline)?.scene_at(args.frame);
+    use crate::deep::Derivative;
+    let frame = args.frame;
+    Ok(Some(match crate::timeline::auto::target_derivative(&scene, size) {
+        Derivative::Passes(n) => format!(
+            "check: on the surface: the target's orbit resolves frame {frame}'s pixels after {n} iterations"
+        ),
+        Derivative::Escapes(n) => format!(
+            "warning: the target's orbit escapes after {n} iterations, before it resolves a pixel of frame {frame}: it is off the surface"
+        ),
+        Derivative::Stays => format!(
+            "warning: the target is inside the set at frame {frame} (its orbit stays bounded)"
+        ),
+    }))
 }
 
 /// One round of `--refine`: its target, its number, and how far it moved
@@ -161,7 +193,7 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {
-        let refined = match crate::render::pick::refine(&scene, size) {
+        let refined = match crate::render::pick::refine(&scene, size, round == 1, &auto_count) {
             Ok(refined) => refined,
             // A later round's failure leaves the best round's target,
             // which is never worse than one round's; say why it stopped.
@@ -209,6 +241,15 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
         (previous, scene) = (shift, next);
     }
     best.ok_or_else(|| anyhow::anyhow!("--refine ran no round"))
+}
+
+/// The iterations `scene` takes at `size`: Auto's count for its target
+/// and camera, or the fixed count.
+fn auto_count(scene: &crate::scene::Scene, size: [u32; 2]) -> u32 {
+    match scene.fractal.auto {
+        Some(auto) => crate::timeline::auto::resolve(scene, auto, size).count,
+        None => scene.fractal.iterations,
+    }
 }
 
 /// Where round `round` of `--refine` failed with `problem`: the best

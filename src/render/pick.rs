@@ -103,22 +103,44 @@ pub struct Refined {
     pub steps: Vec<RefineStep>,
 }
 
-/// How much closer each step of `refine` goes: the last hit is within
-/// half a pixel of the surface, so a thousandth keeps it well in view.
+/// How much closer each step of `refine` goes at most.
 const REFINE_STEP: f64 = 1e-3;
 
+/// The fewest of the last step's pixel footprints between the next camera
+/// and the target: the target is placed only to within a footprint or so,
+/// and a camera nearer than that may stand inside the set, or far from it.
+const REFINE_CLEARANCE: f64 = 16.0;
+
+/// The most steps `refine` takes: enough for 1e-300 at a thousand a step.
+const REFINE_MAX_STEPS: usize = 400;
+
+/// The most footprints `onto_the_set` looks past a hit.
+const ONTO_THE_SET: f64 = 4.0;
+
 /// Re-centres `scene`'s target on the surface: from a thousandth of the
-/// target's size away, then a thousandth closer each step down to the
-/// scene's own camera distance, the camera looks along its own direction at
-/// the target and the target moves to where the centre ray meets the
-/// surface. Each hit is within a pixel of the surface at that depth, so the
-/// last places the target as finely as the scene's pixels. `Err` says at
-/// which distance the centre ray missed, or the camera was inside the set.
-pub fn refine(scene: &Scene, image_size: [u32; 2]) -> Result<Refined, String> {
+/// target's size away (`from_afar`), or else one step above the scene's own
+/// camera distance, then closer each step down to that distance, the
+/// camera looks along its own direction at the target and the target moves
+/// to where the centre ray meets the surface. Each hit is within a pixel of
+/// the surface at that depth, so the last places the target as finely as
+/// the scene's pixels. Each step's scene takes the iterations `recount`
+/// gives it (`iterations: Auto` follows the target and the camera, as the
+/// frame's own count will). `Err` says at which distance the centre ray
+/// missed, or the camera was inside the set.
+pub fn refine(
+    scene: &Scene,
+    image_size: [u32; 2],
+    from_afar: bool,
+    recount: &dyn Fn(&Scene, [u32; 2]) -> u32,
+) -> Result<Refined, String> {
     let relative = scene.camera.relative_position();
     let (last, away) = (relative.length(), relative.normalize());
     let size = scene.camera.target.abs().max_element();
-    let mut distance = (REFINE_STEP * size).max(last);
+    let afar = (REFINE_STEP * size).max(last);
+    let mut distance = match from_afar {
+        true => afar,
+        false => (last / closer(scene.camera.axis_pixel_angle(image_size))).min(afar),
+    };
     let mut s = scene.clone();
     // The centre ray of one eye at the camera itself: the view's axis, in
     // an image of an eye's size, whose pixels those of the frame are.
@@ -130,6 +152,7 @@ pub fn refine(scene: &Scene, image_size: [u32; 2]) -> Result<Refined, String> {
         c.offset = Some(away * distance);
         c.position = c.target + away * distance;
         c.position_digits = None;
+        s.fractal.iterations = recount(&s, [width, height]);
         let deep = crate::deep::prepare(&s, [width, height]);
         let marched = deep.as_ref().unwrap_or(&s);
         let ray =
@@ -158,10 +181,19 @@ pub fn refine(scene: &Scene, image_size: [u32; 2]) -> Result<Refined, String> {
             camera_distance: distance,
             beyond_target: t - distance,
         });
-        if distance <= last {
+        // Done where the frame's own camera saw the surface at the target,
+        // not where a hit far off moved the target away from it.
+        if distance <= last && (t - distance).abs() <= ONTO_THE_SET * footprint {
             break;
         }
-        distance = (distance * REFINE_STEP).max(last);
+        if steps.len() >= REFINE_MAX_STEPS {
+            return Err(format!(
+                "the surface did not settle under the centre ray with the camera {distance:.3e} from the target"
+            ));
+        }
+        // The target is as good as the footprint where it was hit: the next
+        // camera stays that many footprints clear of it.
+        distance = (t * closer(ray.pixel_angle)).max(last);
     }
     let target = s
         .camera
@@ -172,10 +204,16 @@ pub fn refine(scene: &Scene, image_size: [u32; 2]) -> Result<Refined, String> {
     Ok(Refined { target, steps })
 }
 
-/// How far past `t` along `ray` the set begins, found by membership: the
-/// estimate stops a ray short of the surface, often by many pixels where it
-/// understates the distance, and a target that short would leave the next,
-/// closer camera far from the surface. 0 where no crossing is found.
+/// How much closer `refine`'s next step goes, for pixels of `pixel_angle`.
+fn closer(pixel_angle: f64) -> f64 {
+    REFINE_STEP.max(REFINE_CLEARANCE * pixel_angle).min(0.5)
+}
+
+/// How far past `t` along `ray` the set begins, found by membership within
+/// `ONTO_THE_SET` footprints (0 where it does not): the estimate stops a ray
+/// a little short of the surface, and a target that short would leave the
+/// next, closer camera far from it. No further: a ray that grazes a tip or
+/// a cusp meets the set's inside only far beyond, off the surface it saw.
 fn onto_the_set(ray: &crate::march::Ray, t: f64, scene: &Scene) -> f64 {
     let from = crate::march::Ray {
         origin: ray.at(t),
@@ -188,7 +226,7 @@ fn onto_the_set(ray: &crate::march::Ray, t: f64, scene: &Scene) -> f64 {
         &scene.quality,
         0.25,
         0.0,
-        1 << 14,
+        (ONTO_THE_SET * 4.0) as u32,
     );
     crossing.unwrap_or(0.0)
 }
@@ -208,9 +246,10 @@ mod tests {
         };
         let mut pair = mono.clone();
         pair.camera.stereo = Some(stereo);
-        let one = refine(&mono, [64, 48]);
+        let same = |s: &Scene, _: [u32; 2]| s.fractal.iterations;
+        let one = refine(&mono, [64, 48], true, &same);
         assert!(one.is_ok(), "{:?}", one.err());
-        let two = refine(&pair, [64, 96]);
+        let two = refine(&pair, [64, 96], true, &same);
         let json = |r: Result<Refined, String>| r.map(|r| serde_json::to_string(&r).ok());
         assert_eq!(json(two), json(one));
     }

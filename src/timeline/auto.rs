@@ -80,6 +80,12 @@ fn resolve_with(
     Resolved { count, decided }
 }
 
+/// What the target's orbit does at `scene`'s pixels (`target_passes`):
+/// a target on the surface has a derivative that passes one over a pixel.
+pub fn target_derivative(scene: &Scene, size: [u32; 2]) -> Derivative {
+    target_passes(scene, size, &deep::References::default())
+}
+
 /// Where the target's orbit's derivative passes one over the pixel's
 /// width at the target (the projection's pixel on the view's axis): in
 /// high precision where the frame is deep.

@@ -763,14 +763,9 @@ fn pick_refine_settles_the_target_in_one_command() {
 
 #[test]
 fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
-    // deep_zoom.ron's frame 300: the second round finds the camera inside
-    // the set; the command still gives the first round's target, and says so.
-    let d = Dir::new();
-    let deep = std::fs::read_to_string(concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/timelines/deep_zoom.ron"
-    ));
-    d.write("deep.ron", &deep.unwrap());
+    // deep_zoom.ron's frame 300: whether a later round settles or stops,
+    // the command gives a round's target, and says which.
+    let d = deep_zoom_copy();
     let out = stdout(&d.ok(&["pick", "deep.ron", "--frame", "300", "--refine"]));
     assert!(
         out.contains("Re-centred for frame 300:  target: (\""),
@@ -783,4 +778,41 @@ fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
         .lines()
         .any(|l| l.starts_with("round ") && !l.contains("note"));
     assert!(stopped || settled, "{out}");
+}
+
+#[test]
+fn pick_refine_puts_the_deepest_frame_of_the_dive_on_the_surface() {
+    // deep_zoom.ron's own recipe, at 1e-30: each step's camera stays clear
+    // of where the last step placed the target, a ray grazing the tip is
+    // not carried into the set far beyond it, and `iterations: Auto`
+    // follows the target as the frame's own count will.
+    let d = deep_zoom_copy();
+    let refine = ["pick", "deep.ron", "--frame", "539", "--refine", "--aim"];
+    let out = stdout(&d.ok(&refine));
+    assert!(out.contains("Aimed: deep.ron now has target: (\""), "{out}");
+    assert!(out.contains("check: on the surface"), "{out}");
+    // The ray through the middle of the aimed frame (a pixel's centre at an
+    // odd size) meets the surface at the camera's distance from the target.
+    let centre = ["--pixel", "160,90", "--size", "321x181", "--json"];
+    let pick = stdout(&d.ok(&[&["pick", "deep.ron", "--frame", "539"][..], &centre].concat()));
+    let report: serde_json::Value = serde_json::from_str(&pick).unwrap();
+    let (distance, footprint) = (
+        report["distance"].as_f64().expect("the centre ray hits"),
+        report["pixel_footprint"].as_f64().unwrap(),
+    );
+    assert!(
+        (distance - 1e-30).abs() < 8.0 * footprint,
+        "hit {distance:e} from a camera 1e-30 away (footprint {footprint:e})"
+    );
+}
+
+/// A folder holding a copy of timelines/deep_zoom.ron as deep.ron.
+fn deep_zoom_copy() -> Dir {
+    let d = Dir::new();
+    let deep = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/timelines/deep_zoom.ron"
+    ));
+    d.write("deep.ron", &deep.unwrap());
+    d
 }

@@ -242,7 +242,7 @@ fn info_names_the_deep_frames_and_pick_refine_recentres_the_target() {
     let off = deep_timeline(3).replace(TARGET[0], "0.5030223070");
     dir.write("off.ron", &off);
     let out = stdout(&dir.ok(&["pick", "off.ron", "--frame", "2", "--refine"]));
-    let line = out.lines().last().unwrap();
+    let line = out.lines().find(|l| l.starts_with("Re-centred")).unwrap();
     let target = line.split("target: ").nth(1).expect(line);
     let refined = deep_timeline(3).replace(
         &format!("(\"{}\", \"{}\", \"{}\")", TARGET[0], TARGET[1], TARGET[2]),
@@ -257,11 +257,14 @@ fn info_names_the_deep_frames_and_pick_refine_recentres_the_target() {
         "2",
         "--pixel",
         "24,13",
+        "--size",
+        "49x27",
         "--json",
     ]));
     let report: serde_json::Value = serde_json::from_str(&pick).unwrap();
     assert_eq!(report["deep"], true);
-    // The camera is 1e-24 from the refined target, and the surface is there.
+    // The camera is 1e-24 from the refined target, and the surface is there,
+    // on the ray through the middle of the view (a pixel's centre at 49×27).
     let distance = report["distance"].as_f64().unwrap();
     assert!((distance - 1e-24).abs() < 0.05e-24, "{distance:e}");
 }
