@@ -92,8 +92,8 @@ fn as_ron(d: &[String; 3]) -> String {
     format!("(\"{}\", \"{}\", \"{}\")", d[0], d[1], d[2])
 }
 
-/// Rounds of `--refine` at most: a target moved by one round may meet, on
-/// the next round's way in, a surface the camera would fly through.
+/// Rounds of `--refine` at most: the first walks in from afar; each later
+/// one from a step above frame F, until the target stays put there.
 const MAX_ROUNDS: usize = 8;
 
 /// A round that moves the target by less than this share of one of frame
@@ -121,7 +121,7 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
             refined: &refined,
             round,
             move_pixels: moved,
-            surface_check: surface_check(args, size, &refined)?,
+            surface_check: surface_check(args, size, &refined),
         };
         out!("{}", serde_json::to_string(&report)?);
         return Ok(());
@@ -137,7 +137,7 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         args.frame,
         as_ron(&refined.target)
     );
-    if let Some(check) = surface_check(args, size, &refined)? {
+    if let Some(check) = surface_check(args, size, &refined) {
         out!("{check}");
     }
     if args.aim {
@@ -148,20 +148,21 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
 
 /// Whether the refined target is on the surface at frame F, by the test
 /// `info` applies: its orbit's derivative passes one over a pixel before it
-/// escapes, and it does escape. None where a track sets the target.
+/// escapes, and it does escape. None where a track sets the target, or
+/// the file cannot be read again: the target is printed either way.
 fn surface_check(
     args: &PickArgs,
     size: [u32; 2],
     refined: &crate::render::pick::Refined,
-) -> anyhow::Result<Option<String>> {
-    let text = crate::timeline::read_text(&args.timeline)?;
-    let Ok(moved) = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)) else {
-        return Ok(None);
-    };
-    let scene = Timeline::parse(&moved, &args.timeline)?.scene_at(args.frame);
+) -> Option<String> {
+    let text = crate::timeline::read_text(&args.timeline).ok()?;
+    let moved = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)).ok()?;
+    let scene = Timeline::parse(&moved, &args.timeline)
+        .ok()?
+        .scene_at(args.frame);
     use crate::deep::Derivative;
     let frame = args.frame;
-    Ok(Some(match crate::timeline::auto::target_derivative(&scene, size) {
+    Some(match crate::timeline::auto::target_derivative(&scene, size) {
         Derivative::Passes(n) => format!(
             "check: on the surface: the target's orbit resolves frame {frame}'s pixels after {n} iterations"
         ),
@@ -171,7 +172,7 @@ fn surface_check(
         Derivative::Stays => format!(
             "warning: the target is inside the set at frame {frame} (its orbit stays bounded)"
         ),
-    }))
+    })
 }
 
 /// One round of `--refine`: its target, its number, and how far it moved
@@ -193,7 +194,9 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
     for round in 1..=MAX_ROUNDS {
-        let refined = match crate::render::pick::refine(&scene, size, round == 1, &auto_count) {
+        // The frame counts Auto's iterations at the whole image's size.
+        let recount = |s: &crate::scene::Scene, _eye: [u32; 2]| auto_count(s, size);
+        let refined = match crate::render::pick::refine(&scene, size, round == 1, &recount) {
             Ok(refined) => refined,
             // A later round's failure leaves the best round's target,
             // which is never worse than one round's; say why it stopped.

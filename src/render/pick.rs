@@ -111,8 +111,12 @@ const REFINE_STEP: f64 = 1e-3;
 /// and a camera nearer than that may stand inside the set, or far from it.
 const REFINE_CLEARANCE: f64 = 16.0;
 
-/// The most steps `refine` takes: enough for 1e-300 at a thousand a step.
-const REFINE_MAX_STEPS: usize = 400;
+/// The most steps `refine` takes: enough for 1e-300 when each step only
+/// halves the distance (wide pixels).
+const REFINE_MAX_STEPS: usize = 4096;
+
+/// The most steps `refine` takes at the scene's own camera distance.
+const REFINE_LAST_STEPS: usize = 16;
 
 /// The most footprints `onto_the_set` looks past a hit.
 const ONTO_THE_SET: f64 = 4.0;
@@ -186,7 +190,8 @@ pub fn refine(
         if distance <= last && (t - distance).abs() <= ONTO_THE_SET * footprint {
             break;
         }
-        if steps.len() >= REFINE_MAX_STEPS {
+        let at_last = steps.iter().filter(|s| s.camera_distance <= last).count();
+        if steps.len() >= REFINE_MAX_STEPS || at_last >= REFINE_LAST_STEPS {
             return Err(format!(
                 "the surface did not settle under the centre ray with the camera {distance:.3e} from the target"
             ));

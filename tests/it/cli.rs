@@ -762,7 +762,7 @@ fn pick_refine_settles_the_target_in_one_command() {
 }
 
 #[test]
-fn pick_refine_keeps_the_last_rounds_target_when_a_later_round_fails() {
+fn pick_refine_on_a_deep_frame_gives_a_rounds_target_and_says_which() {
     // deep_zoom.ron's frame 300: whether a later round settles or stops,
     // the command gives a round's target, and says which.
     let d = deep_zoom_copy();
