@@ -107,7 +107,9 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         refined,
         round,
         moved,
+        framed,
     } = refine_rounds(t, args, size)?;
+    let check = framed.map(|scene| surface_check(&scene, size, args.frame));
     if args.json {
         #[derive(serde::Serialize)]
         struct Report<'a> {
@@ -121,7 +123,7 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
             refined: &refined,
             round,
             move_pixels: moved,
-            surface_check: surface_check(args, size, &refined),
+            surface_check: check,
         };
         out!("{}", serde_json::to_string(&report)?);
         return Ok(());
@@ -137,7 +139,7 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
         args.frame,
         as_ron(&refined.target)
     );
-    if let Some(check) = surface_check(args, size, &refined) {
+    if let Some(check) = check {
         out!("{check}");
     }
     if args.aim {
@@ -146,23 +148,12 @@ fn refine(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Whether the refined target is on the surface at frame F, by the test
-/// `info` applies: its orbit's derivative passes one over a pixel before it
-/// escapes, and it does escape. None where a track sets the target, or
-/// the file cannot be read again: the target is printed either way.
-fn surface_check(
-    args: &PickArgs,
-    size: [u32; 2],
-    refined: &crate::render::pick::Refined,
-) -> Option<String> {
-    let text = crate::timeline::read_text(&args.timeline).ok()?;
-    let moved = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)).ok()?;
-    let scene = Timeline::parse(&moved, &args.timeline)
-        .ok()?
-        .scene_at(args.frame);
+/// Whether the refined target is on the surface at `frame` (`scene`, the
+/// frame with that target), by the test `info` applies: its orbit's
+/// derivative passes one over a pixel before it escapes, and it escapes.
+fn surface_check(scene: &crate::scene::Scene, size: [u32; 2], frame: u32) -> String {
     use crate::deep::Derivative;
-    let frame = args.frame;
-    Some(match crate::timeline::auto::target_derivative(&scene, size) {
+    match crate::timeline::auto::target_derivative(scene, size) {
         Derivative::Passes(n) => format!(
             "check: on the surface: the target's orbit resolves frame {frame}'s pixels after {n} iterations"
         ),
@@ -172,15 +163,17 @@ fn surface_check(
         Derivative::Stays => format!(
             "warning: the target is inside the set at frame {frame} (its orbit stays bounded)"
         ),
-    })
+    }
 }
 
-/// One round of `--refine`: its target, its number, and how far it moved
-/// the target, in frame F's pixels (none where a track sets the target).
+/// One round of `--refine`: its target, its number, how far it moved the
+/// target in frame F's pixels, and frame F with that target (both none
+/// where a track sets the target).
 struct Round {
     refined: crate::render::pick::Refined,
     round: usize,
     moved: Option<f64>,
+    framed: Option<crate::scene::Scene>,
 }
 
 /// Refines the target in rounds, each from the target the last one found,
@@ -193,9 +186,9 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
     let pixel = scene.camera.axis_pixel_angle(size) * scene.camera.relative_position().length();
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
+    // The frame counts Auto's iterations at the whole image's size.
+    let recount = |s: &crate::scene::Scene, _eye: [u32; 2]| auto_count(s, size);
     for round in 1..=MAX_ROUNDS {
-        // The frame counts Auto's iterations at the whole image's size.
-        let recount = |s: &crate::scene::Scene, _eye: [u32; 2]| auto_count(s, size);
         let refined = match crate::render::pick::refine(&scene, size, round == 1, &recount) {
             Ok(refined) => refined,
             // A later round's failure leaves the best round's target,
@@ -211,11 +204,12 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
         }
         // A target a track sets cannot be tried again: one round.
         let Ok(moved) = crate::timeline::edit::set_target(&text, &as_ron(&refined.target)) else {
-            let moved = None;
+            let (moved, framed) = (None, None);
             return Ok(Round {
                 refined,
                 round,
                 moved,
+                framed,
             });
         };
         let next = Timeline::parse(&moved, &args.timeline)?.scene_at(args.frame);
@@ -231,11 +225,12 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
             .as_ref()
             .is_none_or(|b| b.moved.is_some_and(|m| shift < m))
         {
-            let moved = Some(shift);
+            let (moved, framed) = (Some(shift), Some(next.clone()));
             best = Some(Round {
                 refined,
                 round,
                 moved,
+                framed,
             });
         }
         if done {

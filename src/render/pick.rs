@@ -121,6 +121,9 @@ const REFINE_LAST_STEPS: usize = 16;
 /// The most footprints `onto_the_set` looks past a hit.
 const ONTO_THE_SET: f64 = 4.0;
 
+/// `onto_the_set`'s membership step, in footprints.
+const ONTO_STEP: f64 = 0.25;
+
 /// Re-centres `scene`'s target on the surface: from a thousandth of the
 /// target's size away (`from_afar`), or else one step above the scene's own
 /// camera distance, then closer each step down to that distance, the
@@ -229,9 +232,9 @@ fn onto_the_set(ray: &crate::march::Ray, t: f64, scene: &Scene) -> f64 {
         &from,
         &scene.fractal,
         &scene.quality,
-        0.25,
+        ONTO_STEP,
         0.0,
-        (ONTO_THE_SET * 4.0) as u32,
+        (ONTO_THE_SET / ONTO_STEP) as u32,
     );
     crossing.unwrap_or(0.0)
 }
