@@ -187,7 +187,7 @@ fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Resul
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
     // The frame counts Auto's iterations at the whole image's size.
-    let recount = |s: &crate::scene::Scene, _eye: [u32; 2]| auto_count(s, size);
+    let recount = |s: &crate::scene::Scene| auto_count(s, size);
     for round in 1..=MAX_ROUNDS {
         let refined = match crate::render::pick::refine(&scene, size, round == 1, &recount) {
             Ok(refined) => refined,

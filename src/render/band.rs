@@ -166,7 +166,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
         band_shadows(scene, surfaces, runs, walks, shadows, bundles);
         let mut outcomes = shadows.iter().copied();
         band_occlusion(scene, surfaces, occluded);
-        let traced = band_paths(frame, scene, camera, y0, s, order, surfaces, paths);
+        let traced = band_paths(frame, k, y0, s, order, surfaces, paths);
         for (i, ((ray, result), at)) in rays
             .iter()
             .zip(marched.iter())
@@ -403,11 +403,9 @@ fn band_shadows(
 
 /// The band's path-traced samples, a bounce at a time side by side (none
 /// when the scene is not path traced).
-#[allow(clippy::too_many_arguments)] // the band's whole context, passed plainly
 fn band_paths<'p>(
     frame: &FrameSetup,
-    scene: &Scene,
-    camera: &crate::camera::CameraFrame,
+    k: usize,
     y0: usize,
     s: u32,
     order: &[usize],
@@ -415,6 +413,7 @@ fn band_paths<'p>(
     paths: &'p mut crate::shade::PathScratch,
 ) -> &'p [(Vec3, StageCounts)] {
     let w = frame.width as usize;
+    let (scene, camera) = (&frame.scenes[k], &frame.cameras[k]);
     match &scene.effects.path_tracing {
         Some(pt) => {
             let random = |i: usize, d: u32| {
@@ -434,6 +433,7 @@ fn band_paths<'p>(
                 surfaces,
                 camera.up,
                 frame.environment.as_deref(),
+                frame.palettes[k].as_ref(),
                 &random,
                 paths,
             );

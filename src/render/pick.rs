@@ -138,7 +138,7 @@ pub fn refine(
     scene: &Scene,
     image_size: [u32; 2],
     from_afar: bool,
-    recount: &dyn Fn(&Scene, [u32; 2]) -> u32,
+    recount: &dyn Fn(&Scene) -> u32,
 ) -> Result<Refined, String> {
     let relative = scene.camera.relative_position();
     let (last, away) = (relative.length(), relative.normalize());
@@ -154,12 +154,14 @@ pub fn refine(
     let [width, height] = s.camera.eye_size(image_size);
     s.camera.stereo = None;
     let mut steps = Vec::new();
+    // Steps taken at the scene's own distance.
+    let mut at_last = 0;
     loop {
         let c = &mut s.camera;
         c.offset = Some(away * distance);
         c.position = c.target + away * distance;
         c.position_digits = None;
-        s.fractal.iterations = recount(&s, [width, height]);
+        s.fractal.iterations = recount(&s);
         let deep = crate::deep::prepare(&s, [width, height]);
         let marched = deep.as_ref().unwrap_or(&s);
         let ray =
@@ -193,7 +195,7 @@ pub fn refine(
         if distance <= last && (t - distance).abs() <= ONTO_THE_SET * footprint {
             break;
         }
-        let at_last = steps.iter().filter(|s| s.camera_distance <= last).count();
+        at_last += usize::from(distance <= last);
         if steps.len() >= REFINE_MAX_STEPS || at_last >= REFINE_LAST_STEPS {
             return Err(format!(
                 "the surface did not settle under the centre ray with the camera {distance:.3e} from the target"
@@ -254,7 +256,7 @@ mod tests {
         };
         let mut pair = mono.clone();
         pair.camera.stereo = Some(stereo);
-        let same = |s: &Scene, _: [u32; 2]| s.fractal.iterations;
+        let same = |s: &Scene| s.fractal.iterations;
         let one = refine(&mono, [64, 48], true, &same);
         assert!(one.is_ok(), "{:?}", one.err());
         let two = refine(&pair, [64, 96], true, &same);

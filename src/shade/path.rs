@@ -94,6 +94,7 @@ pub fn trace_path(
     counts: &mut StageCounts,
 ) -> Vec3 {
     let mut traced = PathScratch::default();
+    let palette = super::palette_table(look, fractal);
     trace_paths(
         look,
         pt,
@@ -102,6 +103,7 @@ pub fn trace_path(
         &[Some(*at)],
         up,
         environment,
+        palette.as_ref(),
         &|_, d| random(d),
         &mut traced,
     );
@@ -298,7 +300,8 @@ impl Tracing<'_> {
 /// paths advance together a bounce at a time, so each bounce's shadow and
 /// bounce rays march side by side (`march_many`); every path takes exactly
 /// the steps, random numbers (`random(path, d)`) and additions it would
-/// alone, so its radiance and counts are the same to the bit.
+/// alone, so its radiance and counts are the same to the bit. `palette` is
+/// the frame's (`palette_table`), made once for all its bands.
 #[allow(clippy::too_many_arguments)] // the samples' whole context, passed plainly
 pub fn trace_paths(
     look: &Look,
@@ -308,12 +311,10 @@ pub fn trace_paths(
     starts: &[Option<SurfacePoint>],
     up: DVec3,
     environment: Option<&crate::environment::EnvironmentMap>,
+    palette: Option<&super::PaletteTable>,
     random: &dyn Fn(usize, u32) -> Real,
     scratch: &mut PathScratch,
 ) {
-    // A handful of stops converted per call, for all its paths' hits.
-    let palette = &super::palette_table(look, fractal);
-    let palette = palette.as_ref();
     let tracing = Tracing {
         look,
         pt,

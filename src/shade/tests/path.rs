@@ -150,6 +150,7 @@ fn paths_traced_together_match_paths_traced_alone() {
             &starts,
             DVec3::Y,
             environment,
+            crate::shade::palette_table(&look, &fractal).as_ref(),
             &random,
             &mut together,
         );
