@@ -5,6 +5,7 @@
 //! reference orbit starts from them exactly (`fractal::deep`).
 
 use crate::math::DVec3;
+use dashu_float::round::mode::HalfEven;
 use dashu_float::{DBig, FBig};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -161,7 +162,9 @@ pub fn difference(a: (DVec3, Option<&Digits>), b: (DVec3, Option<&Digits>)) -> D
     [a.1, b.1].into_iter().flatten().for_each(tally::differ);
     let bits = DIFFERENCE_BITS;
     let (p, q) = (big_point(a.0, a.1, bits), big_point(b.0, b.1, bits));
-    DVec3::from_array([0, 1, 2].map(|i| (&p[i] - &q[i]).to_f64().value()))
+    // To the nearest f64: `Big` rounds towards zero.
+    let nearest = |d: Big| d.with_rounding::<HalfEven>().to_f64().value();
+    DVec3::from_array([0, 1, 2].map(|i| nearest(&p[i] - &q[i])))
 }
 
 /// `b` as decimal digits: `significant` of them, in plain or scientific
@@ -175,8 +178,37 @@ pub fn decimal(b: &Big, significant: usize) -> String {
     d.to_string()
 }
 
+/// `anchor` (digits `parse_digits` accepts) moved by `delta`, exactly, as
+/// digits `parse_digits` accepts: what a track keyed with digits gives
+/// between its keys (`timeline::deep_keys`). Rounded to `MAX_DIGITS`
+/// significant digits where the exact sum has more.
+pub fn moved(anchor: &str, delta: f64) -> String {
+    let start = DBig::from_str(anchor.strip_prefix('+').unwrap_or(anchor))
+        .unwrap_or_else(|_| unreachable!("checked by parse_digits"));
+    // Shortest decimal that reads back as `delta`: the step as f64 means it.
+    let step = DBig::from_str(&format!("{delta:e}"))
+        .unwrap_or_else(|_| unreachable!("a finite f64 prints as digits"));
+    let sum = start.with_precision(MAX_DIGITS).value() + step;
+    // Fewer digits only where neither notation holds the sum within the
+    // limits (digits far below anything f64 offsets reach).
+    let mut precision = MAX_DIGITS;
+    loop {
+        let rounded = sum.clone().with_precision(precision).value();
+        let plain = rounded.to_string();
+        if parse_digits(&plain).is_ok() {
+            return plain;
+        }
+        let (significand, exponent) = rounded.repr().clone().into_parts();
+        let scientific = format!("{significand}e{exponent}");
+        if parse_digits(&scientific).is_ok() || precision <= 17 {
+            return scientific;
+        }
+        precision /= 2;
+    }
+}
+
 /// One component as written: a number or a string of digits.
-enum Component {
+pub(crate) enum Component {
     Number(f64),
     Digits(String, f64),
 }
@@ -237,7 +269,20 @@ impl<'de> Deserialize<'de> for Coordinates {
 }
 
 impl Coordinates {
-    fn from_components(parts: [Component; 3]) -> Coordinates {
+    /// These coordinates with digits: their own, else each number's
+    /// shortest decimal form (as `from_components` writes a number).
+    pub fn with_digits(self) -> Coordinates {
+        let digits = self
+            .digits
+            .unwrap_or_else(|| Arc::new(self.value.to_array().map(|v| format!("{v:?}"))));
+        Coordinates {
+            value: self.value,
+            digits: Some(digits),
+        }
+    }
+
+    /// The components as written: the digits kept where any is a string.
+    pub(crate) fn from_components(parts: [Component; 3]) -> Coordinates {
         let value = |c: &Component| match c {
             Component::Number(v) | Component::Digits(_, v) => *v,
         };
@@ -316,6 +361,28 @@ mod tests {
         assert!(parse_digits("1e999").unwrap_err().contains("exponent"));
         let long = format!("0.{}", "1".repeat(MAX_DIGITS));
         assert!(parse_digits(&long).unwrap_err().contains("at most"));
+    }
+
+    #[test]
+    fn a_moved_point_keeps_every_digit_of_the_anchor_and_the_step() {
+        assert_eq!(
+            moved("0.5", 1.2345e-31),
+            "0.50000000000000000000000000000012345"
+        );
+        let anchor = "0.50304436772512345678901234567891";
+        let back = moved(&moved(anchor, -3.25e-40), 3.25e-40);
+        assert_eq!(back, anchor);
+        assert_eq!(moved("-1.25e-3", 0.0), "-0.00125");
+        for (anchor, step) in [("0", 1e-300), (&*format!("0.{}", "7".repeat(399)), 1e-290)] {
+            let text = moved(anchor, step);
+            let value = parse_digits(&text).unwrap();
+            let exact = big_from_digits(&text, 2000) - big_from_digits(anchor, 2000);
+            let error = (exact.to_f64().value() - step).abs();
+            assert!(
+                error <= 4e-16 * step,
+                "{anchor} + {step:e} = {text} ({value})"
+            );
+        }
     }
 
     #[test]

@@ -242,11 +242,22 @@ pub fn edited(text: &str, shown: &Path, edits: &[Edit]) -> Result<(String, Timel
             edits.len()
         ));
     }
-    let mut text = text.to_string();
+    // What the page's numbers came from: where they are a point's digits
+    // rounded, the digits are written.
+    let before = std::cell::OnceCell::new();
+    let mut made = text.to_string();
     for edit in edits {
-        text = crate::timeline::edit::apply(&text, edit)?;
+        let timeline = match edit.may_round_digits() {
+            true => before.get_or_init(|| Timeline::parse(text, shown).ok()),
+            false => &None,
+        };
+        let kept = match timeline {
+            Some(timeline) => crate::timeline::edit::keeping_digits(timeline, edit.clone()),
+            None => edit.clone(),
+        };
+        made = crate::timeline::edit::apply(&made, &kept)?;
     }
-    checked(text, shown)
+    checked(made, shown)
 }
 
 /// `text` and its timeline, where it is valid and `render` would read it.

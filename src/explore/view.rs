@@ -146,7 +146,9 @@ impl View {
                     values[0]
                 ));
             }
-            (parameter.set)(scene, values);
+            if !crate::timeline::edit::rounds_digits(scene, parameter, values) {
+                (parameter.set)(scene, values);
+            }
         }
         crate::timeline::validate_scene(scene)
             .map_err(|(field, message)| format!("{field}: {message}"))
@@ -157,7 +159,8 @@ impl View {
 /// effect the scene leaves off.
 pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<Vec<f64>>> {
     let scene = timeline.scene_at(frame);
-    let distance = (scene.camera.position - scene.camera.target).length();
+    // Exactly, where digits put the camera closer than f64 tells apart.
+    let distance = scene.camera.relative_position().length();
     let scene = serde_json::to_value(scene).unwrap_or_default();
     crate::timeline::parameters::all()
         .map(|p| {
@@ -300,7 +303,8 @@ mod tests {
         let t = zoom();
         let values = values(&t, 119);
         let scene = t.scene_at(119);
-        let distance = (scene.camera.position - scene.camera.target).length();
+        // The zoom's own distance, not f64's difference of the two points.
+        let distance = scene.camera.offset.unwrap().length();
         assert_eq!(values["camera.distance"], Some(vec![distance]));
         assert_eq!(values["fractal.iterations"], Some(vec![18.0]));
         assert_eq!(values["fractal.julia"], None);

@@ -4,8 +4,9 @@
 //! must, so the author's comments, field order and layout survive a save.
 
 use super::parameters::{self, Parameter, Shape};
-use super::{KeyValue, ZOOM_TRACK};
+use super::{KeyValue, Timeline, ZOOM_TRACK};
 use crate::math::Real;
+use crate::scene::Scene;
 use crate::spans::{self, Block, Step};
 use std::ops::Range;
 
@@ -30,6 +31,20 @@ pub enum Edit {
         index: usize,
         time: Real,
     },
+}
+
+impl Edit {
+    /// Whether the edit sets a point a timeline may write as digits, with
+    /// numbers (`keeping_digits`).
+    pub fn may_round_digits(&self) -> bool {
+        let (name, value) = match self {
+            Edit::SetScene { parameter, value } => (parameter, value),
+            Edit::SetKey { track, value, .. } => (track, value),
+            _ => return false,
+        };
+        let takes = parameters::find(name).is_some_and(|p| p.digits.is_some());
+        takes && matches!(value, KeyValue::Triple(..))
+    }
 }
 
 /// Key times closer than this are the same key's.
@@ -57,6 +72,40 @@ pub fn set_target(text: &str, target: &str) -> Result<String, String> {
         let path = ["scene", "camera", "target"].map(|f| Step::Field(f.into()));
         set_field(value, &path, target)
     })
+}
+
+/// Whether `values` are only the nearest numbers of digits `scene` holds
+/// for `parameter`: a page holds numbers, and sends them back unmoved.
+pub fn rounds_digits(scene: &Scene, parameter: &Parameter, values: &[Real]) -> bool {
+    let held = parameter.digits.and_then(|exact| (exact.get)(scene));
+    held.is_some_and(|point| point.value.to_array()[..] == *values)
+}
+
+/// `edit` with the digits `timeline` holds at its place where its value is
+/// only their nearest numbers (`rounds_digits`), so an edit sent back
+/// unmoved never writes rounded digits over exact ones.
+pub fn keeping_digits(timeline: &Timeline, edit: Edit) -> Edit {
+    let (name, time, value) = match &edit {
+        Edit::SetScene { parameter, value } => (parameter, None, value),
+        Edit::SetKey { track, time, value } => (track, Some(*time), value),
+        _ => return edit,
+    };
+    let Some(parameter) = parameters::find(name).filter(|_| edit.may_round_digits()) else {
+        return edit;
+    };
+    let scene = time.map_or_else(|| timeline.base.clone(), |t| timeline.scene_at_time(t));
+    let Some(point) = parameter.digits.and_then(|exact| (exact.get)(&scene)) else {
+        return edit;
+    };
+    if !rounds_digits(&scene, parameter, &value.components()) {
+        return edit;
+    }
+    let value = KeyValue::Digits(point);
+    match edit {
+        Edit::SetScene { parameter, .. } => Edit::SetScene { parameter, value },
+        Edit::SetKey { track, time, .. } => Edit::SetKey { track, time, value },
+        other => other,
+    }
 }
 
 /// `edit` made to the document's value, after RON's inner attributes
@@ -338,6 +387,13 @@ fn written(value: &KeyValue, parameter: &Parameter) -> Result<String, String> {
             number(*y)?,
             number(*z)?
         )),
+        (KeyValue::Digits(point), Shape::Triple) if parameter.digits.is_some() => {
+            let [x, y, z] = point.value.to_array();
+            Ok(match &point.digits {
+                Some(d) => format!("({:?}, {:?}, {:?})", d[0], d[1], d[2]),
+                None => format!("({}, {}, {})", number(x)?, number(y)?, number(z)?),
+            })
+        }
         (_, shape) => Err(format!(
             "{} takes {} number(s), got {value:?}",
             parameter.name,

@@ -257,6 +257,10 @@ impl Shown for KeyValue {
         match *self {
             KeyValue::Number(v) => v.shown(),
             KeyValue::Triple(x, y, z) => DVec3::new(x, y, z).shown(),
+            KeyValue::Digits(ref c) => match &c.digits {
+                Some(d) => format!("({:?}, {:?}, {:?})", d[0], d[1], d[2]),
+                None => c.value.shown(),
+            },
         }
     }
 }

@@ -9,6 +9,7 @@
 //! keeps a constant apparent speed over many decades of scale.
 
 pub mod auto;
+mod deep_keys;
 pub mod edit;
 mod limits;
 pub use limits::{MAX_SAMPLES, MAX_SIDE};

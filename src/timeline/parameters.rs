@@ -7,6 +7,7 @@ use super::limits::{MAX_ITERATIONS, MAX_MARCH_STEPS};
 use super::messages::Shown;
 use super::validate::{colour, counted, non_negative, positive, rule, Checked};
 use crate::camera::Projection;
+use crate::exact::{Coordinates, Digits};
 use crate::math::{DVec3, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{Stop, MAX_STOPS};
@@ -42,7 +43,22 @@ pub struct Parameter {
     pub check: fn(&Scene) -> Checked,
     /// Writes a track's sampled value, `shape.components()` numbers.
     pub set: fn(&mut Scene, &[Real]),
+    /// Where the parameter may be written as digits (a point a deep frame
+    /// needs more exactly than f64 holds): how a scene holds them.
+    pub digits: Option<Exact>,
 }
+
+/// A parameter's value with its digits, in a scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Exact {
+    /// The value with its digits, where the scene has digits for it.
+    pub get: fn(&Scene) -> Option<Coordinates>,
+    /// Writes a value and its digits.
+    pub set: fn(&mut Scene, Coordinates),
+}
+
+/// The docs' value of a point whose keys may be strings of digits.
+const DIGITS_TRIPLE: &str = "triple, or strings of digits (deep zooms)";
 
 /// The track that sets the camera–target distance, interpolated in log space.
 pub const ZOOM_TRACK: &str = "camera.distance";
@@ -203,7 +219,14 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.position",
         shape: Triple,
-        doc: "triple",
+        digits: Some(Exact {
+            get: |s| exact(s.camera.position, &s.camera.position_digits),
+            set: |s, p| {
+                s.camera.position = p.value;
+                (s.camera.position_digits, s.camera.offset) = (p.digits, None);
+            },
+        }),
+        doc: DIGITS_TRIPLE,
         check: |s| within(s.camera.position, MAX_COORDINATE),
         set: |s, v| {
             s.camera.position = triple(v);
@@ -213,7 +236,14 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.target",
         shape: Triple,
-        doc: "triple",
+        digits: Some(Exact {
+            get: |s| exact(s.camera.target, &s.camera.target_digits),
+            set: |s, p| {
+                s.camera.target = p.value;
+                s.camera.target_digits = p.digits;
+            },
+        }),
+        doc: DIGITS_TRIPLE,
         check: |s| within(s.camera.target, MAX_COORDINATE),
         set: |s, v| {
             s.camera.target = triple(v);
@@ -223,6 +253,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.up",
         shape: Triple,
+        digits: None,
         doc: "triple",
         check: |s| finite(s.camera.up.is_finite(), s.camera.up),
         set: |s, v| s.camera.up = triple(v),
@@ -230,6 +261,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.roll_degrees",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| finite(s.camera.roll_degrees.is_finite(), s.camera.roll_degrees),
         set: |s, v| s.camera.roll_degrees = v[0],
@@ -237,6 +269,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.fov_degrees",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| fov(s.camera.fov_degrees),
         set: |s, v| s.camera.fov_degrees = v[0],
@@ -244,6 +277,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: ZOOM_TRACK,
         shape: Number,
+        digits: None,
         doc: "number > 0: the surface zoom (below)",
         // Not a field of the scene: its keys are checked (`Track::build`),
         // and the position it places the camera at.
@@ -259,6 +293,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.aperture_radius",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let r = s.camera.aperture_radius;
@@ -271,6 +306,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: "camera.focus_distance",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| s.camera.focus_distance.map_or(Ok(()), positive),
         set: |s, v| s.camera.focus_distance = Some(v[0]),
@@ -278,6 +314,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: FISHEYE_DEGREES,
         shape: Number,
+        digits: None,
         doc: "number (the scene's projection must be a `Fisheye`)",
         check: |s| match s.camera.projection {
             Projection::Fisheye { degrees } => fisheye_degrees(degrees),
@@ -292,6 +329,7 @@ pub(super) const CAMERA: &[Parameter] = &[
     Parameter {
         name: EYE_SEPARATION,
         shape: Number,
+        digits: None,
         doc: "number (the scene must have `camera.stereo`)",
         check: |s| {
             s.camera.stereo.map_or(Ok(()), |stereo| {
@@ -375,6 +413,7 @@ pub(super) const FRACTAL: &[Parameter] = &[
     Parameter {
         name: "fractal.power",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let p = s.fractal.power;
@@ -387,6 +426,7 @@ pub(super) const FRACTAL: &[Parameter] = &[
     Parameter {
         name: "fractal.iterations",
         shape: Number,
+        digits: None,
         doc: "number, rounded to a whole count",
         check: |s| counted(s.fractal.iterations, MAX_ITERATIONS),
         set: |s, v| s.fractal.iterations = count(v),
@@ -394,6 +434,7 @@ pub(super) const FRACTAL: &[Parameter] = &[
     Parameter {
         name: "fractal.bailout",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| bailout(s.fractal.bailout, s.fractal.power),
         set: |s, v| s.fractal.bailout = v[0],
@@ -401,7 +442,14 @@ pub(super) const FRACTAL: &[Parameter] = &[
     Parameter {
         name: "fractal.julia",
         shape: Triple,
-        doc: "triple: the Julia-c morph (switches to Julia mode)",
+        digits: Some(Exact {
+            get: |s| exact(s.fractal.julia?, &s.fractal.julia_digits),
+            set: |s, p| {
+                s.fractal.julia = Some(p.value);
+                s.fractal.julia_digits = p.digits;
+            },
+        }),
+        doc: "triple, or strings of digits: the Julia-c morph (switches to Julia mode)",
         check: |s| s.fractal.julia.map_or(Ok(()), |k| within(k, MAX_JULIA)),
         set: |s, v| {
             s.fractal.julia = Some(triple(v));
@@ -409,6 +457,15 @@ pub(super) const FRACTAL: &[Parameter] = &[
         },
     },
 ];
+
+/// `value` with `digits`, where there are digits.
+fn exact(value: DVec3, digits: &Option<Digits>) -> Option<Coordinates> {
+    let digits = digits.clone()?;
+    Some(Coordinates {
+        value,
+        digits: Some(digits),
+    })
+}
 
 /// Above 1, and small enough for the power (checked first) to raise it to.
 fn bailout(bailout: Real, power: Real) -> Checked {
@@ -429,6 +486,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.hit_threshold",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| positive(s.quality.hit_threshold),
         set: |s, v| s.quality.hit_threshold = v[0],
@@ -436,6 +494,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.membership_step",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let step = s.quality.membership_step;
@@ -455,6 +514,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.fudge",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let f = s.quality.fudge;
@@ -467,6 +527,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.max_steps",
         shape: Number,
+        digits: None,
         doc: "number, rounded",
         check: |s| counted(s.quality.max_steps, MAX_MARCH_STEPS),
         set: |s, v| s.quality.max_steps = count(v),
@@ -474,6 +535,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.normal_step",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| positive(s.quality.normal_step),
         set: |s, v| s.quality.normal_step = v[0],
@@ -481,6 +543,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.bounding_radius",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let r = s.quality.bounding_radius;
@@ -494,6 +557,7 @@ pub(super) const QUALITY: &[Parameter] = &[
     Parameter {
         name: "quality.over_relaxation",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| {
             let w = s.quality.over_relaxation;
@@ -511,6 +575,7 @@ macro_rules! look_colour {
         Parameter {
             name: $name,
             shape: Triple,
+            digits: None,
             doc: "triple",
             check: |s| colour(s.look.$field),
             set: |s, v| s.look.$field = colour_of(v),
@@ -522,6 +587,7 @@ pub(super) const LOOK: &[Parameter] = &[
     Parameter {
         name: "look.light_direction",
         shape: Triple,
+        digits: None,
         doc: "triple",
         check: |s| direction(s.look.light_direction),
         set: |s, v| s.look.light_direction = triple(v),
@@ -535,6 +601,7 @@ pub(super) const LOOK: &[Parameter] = &[
     Parameter {
         name: "look.trap_occlusion",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| fraction(s.look.trap_occlusion),
         set: |s, v| s.look.trap_occlusion = v[0] as f32,
@@ -542,6 +609,7 @@ pub(super) const LOOK: &[Parameter] = &[
     Parameter {
         name: "look.exposure",
         shape: Number,
+        digits: None,
         doc: "number",
         check: |s| non_negative(s.look.exposure),
         set: |s, v| s.look.exposure = v[0] as f32,
@@ -563,6 +631,7 @@ macro_rules! palette_field {
         Parameter {
             name: $name,
             shape: Number,
+            digits: None,
             doc: PALETTE_NUMBER,
             check: |s| s.look.palette.as_ref().map_or(Ok(()), |p| $check(p.$field)),
             set: |s, v| {
@@ -584,6 +653,7 @@ macro_rules! palette_stop {
             Parameter {
                 name: concat!("look.palette.stops[", $i, "].position"),
                 shape: Number,
+                digits: None,
                 doc: STOP_POSITION,
                 check: |s| stop_check(s, $i, |before, stop| stop_position(before, stop.position)),
                 set: |s, v| stop_set(s, $i, |stop| stop.position = v[0] as f32),
@@ -591,6 +661,7 @@ macro_rules! palette_stop {
             Parameter {
                 name: concat!("look.palette.stops[", $i, "].colour"),
                 shape: Triple,
+                digits: None,
                 doc: STOP_COLOUR,
                 check: |s| stop_check(s, $i, |_, stop| colour(stop.colour)),
                 set: |s, v| stop_set(s, $i, |stop| stop.colour = colour_of(v)),
@@ -668,6 +739,7 @@ const EFFECT_NUMBER: &str = "number (the effect must be enabled in `scene.effect
 pub(super) const SHADOWS: &[Parameter] = &[Parameter {
     name: "effects.shadows.softness",
     shape: Number,
+    digits: None,
     doc: EFFECT_NUMBER,
     check: |s| {
         s.effects.shadows.as_ref().map_or(Ok(()), |sh| {
@@ -686,6 +758,7 @@ macro_rules! effect_field {
         Parameter {
             name: $name,
             shape: $shape,
+            digits: None,
             doc: match $shape {
                 Number => EFFECT_NUMBER,
                 Triple => "triple",

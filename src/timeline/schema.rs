@@ -1,6 +1,7 @@
 //! The timeline file as written: its fields, tracks and keys, read by serde
 //! from RON before anything is validated.
 
+use crate::exact::{Component, Coordinates};
 use crate::math::Real;
 use crate::scene::Scene;
 use serde::{Deserialize, Serialize};
@@ -25,6 +26,9 @@ pub enum Interpolation {
 pub enum KeyValue {
     Number(Real),
     Triple(Real, Real, Real),
+    /// A triple with a component written as a string of digits, for a
+    /// point a deep frame needs more exactly than f64 holds.
+    Digits(Coordinates),
 }
 
 /// A number, or a triple written `(x, y, z)` (or `[x, y, z]`, or inside
@@ -58,16 +62,32 @@ impl<'de> Deserialize<'de> for KeyValue {
                 self,
                 mut seq: A,
             ) -> std::result::Result<KeyValue, A::Error> {
-                let mut values = Vec::new();
-                while let Some(v) = seq.next_element::<Real>()? {
-                    values.push(v);
+                let mut parts = Vec::new();
+                while let Some(part) = seq.next_element::<Component>()? {
+                    parts.push(part);
                 }
-                match values[..] {
-                    [x, y, z] => Ok(KeyValue::Triple(x, y, z)),
-                    [v] => Ok(KeyValue::Number(v)),
-                    _ => Err(serde::de::Error::custom(format!(
-                        "expected a number or a triple (x, y, z), got {} numbers",
-                        values.len()
+                let digits = parts.iter().any(|p| matches!(p, Component::Digits(..)));
+                let number = |p: &Component| match p {
+                    Component::Number(v) | Component::Digits(_, v) => *v,
+                };
+                match (parts.len(), digits) {
+                    (3, false) => Ok(KeyValue::Triple(
+                        number(&parts[0]),
+                        number(&parts[1]),
+                        number(&parts[2]),
+                    )),
+                    (3, true) => {
+                        let triple: [Component; 3] = parts
+                            .try_into()
+                            .unwrap_or_else(|_| unreachable!("three parts"));
+                        Ok(KeyValue::Digits(Coordinates::from_components(triple)))
+                    }
+                    (1, false) => Ok(KeyValue::Number(number(&parts[0]))),
+                    (1, true) => Err(serde::de::Error::custom(
+                        "strings of digits are for the components of a triple (x, y, z); a number is written as a number",
+                    )),
+                    (n, _) => Err(serde::de::Error::custom(format!(
+                        "expected a number or a triple (x, y, z), got {n} numbers"
                     ))),
                 }
             }
@@ -81,6 +101,7 @@ impl KeyValue {
         match *self {
             KeyValue::Number(v) => vec![v],
             KeyValue::Triple(x, y, z) => vec![x, y, z],
+            KeyValue::Digits(ref c) => c.value.to_array().to_vec(),
         }
     }
 }

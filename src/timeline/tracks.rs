@@ -2,9 +2,12 @@
 //! component on the `splines` crate, sampled at any time. In a looping film
 //! the keys repeat every period.
 
+use super::deep_keys::DeepKeys;
 use super::messages::Shown;
-use super::parameters::{Parameter, ZOOM_TRACK};
-use super::schema::{Interpolation, KeySpec, TrackSpec};
+use super::parameters::{Exact, Parameter, ZOOM_TRACK};
+use super::schema::{Interpolation, KeySpec, KeyValue, TrackSpec};
+use crate::exact::Coordinates;
+use crate::math::DVec3;
 use crate::math::Real;
 use crate::scene::Scene;
 use splines::{Key, Spline};
@@ -26,6 +29,9 @@ pub struct Track {
     period: Option<Real>,
     /// Writes a sampled value into a scene (`Parameter::set`).
     set: fn(&mut Scene, &[Real]),
+    /// Where a key is written as digits: the keys as digits, sampled in
+    /// high precision, and what writes such a value (`Parameter::digits`).
+    deep: Option<(DeepKeys, Exact)>,
 }
 
 impl Track {
@@ -38,6 +44,9 @@ impl Track {
     /// `sample` without allocating (every scene of every frame is checked):
     /// the value's components first, at most three.
     pub(super) fn sample_components(&self, time_seconds: Real) -> [Real; 3] {
+        if let Some((deep, _)) = &self.deep {
+            return deep.sample(time_seconds).value.to_array();
+        }
         let first = self.key_times[0];
         let last = self.key_times[self.key_times.len() - 1];
         let mut raw = [0.0; 3];
@@ -80,18 +89,39 @@ impl Track {
         fps: Real,
     ) -> std::result::Result<Track, TrackError> {
         let log_space = parameter.name == ZOOM_TRACK;
-        let (times, columns) = key_columns(parameter, &spec.keys, log_space)?;
+        let (times, mut columns) = key_columns(parameter, &spec.keys, log_space)?;
+        let digits = spec
+            .keys
+            .iter()
+            .any(|k| matches!(k.value, KeyValue::Digits(_)));
         let interpolation = spec.interpolation.unwrap_or(Interpolation::CatmullRom);
         let ends = (
             columns.iter().map(|c| c[0]).collect(),
             columns.iter().map(|c| c[c.len() - 1]).collect(),
         );
+        // Which key each laid-out key is: a loop moves and drops keys.
+        columns.push((0..times.len()).map(|k| k as Real).collect());
         // The keys the splines go through: in a looping film, those of
         // one period, in [0, period).
         let (loop_times, loop_columns) = match period {
             Some(period) => one_period(&times, columns, &spec.keys, period, fps)
                 .map_err(|(k, what, message)| (format!(".keys[{k}].{what}"), message))?,
             None => (times.clone(), columns),
+        };
+        let mut loop_columns = loop_columns;
+        let laid_out = loop_columns.pop().unwrap_or_default();
+        let deep = match parameter.digits {
+            Some(exact) if digits => {
+                let points = laid_out
+                    .iter()
+                    .map(|&k| key_point(&spec.keys[k as usize].value))
+                    .collect();
+                Some((
+                    DeepKeys::new(loop_times.clone(), points, interpolation, period),
+                    exact,
+                ))
+            }
+            _ => None,
         };
         let splines = loop_columns
             .iter()
@@ -106,6 +136,7 @@ impl Track {
             log_space,
             period,
             set: parameter.set,
+            deep,
         })
     }
 
@@ -116,6 +147,9 @@ impl Track {
 
     /// Writes the value at `time_seconds` into `scene`.
     pub(super) fn apply(&self, scene: &mut Scene, time_seconds: Real) {
+        if let Some((deep, exact)) = &self.deep {
+            return (exact.set)(scene, deep.sample(time_seconds));
+        }
         let values = self.sample_components(time_seconds);
         (self.set)(scene, &values[..self.components()]);
     }
@@ -159,6 +193,18 @@ fn key_columns(
             let (name, shape, given) = (parameter.name, shape(arity), shape(values.len()));
             return Err((value(), format!("{name} takes {shape}, got {given}")));
         }
+        if let (KeyValue::Digits(_), None) = (&key.value, parameter.digits) {
+            let takes: Vec<&str> = super::parameters::all()
+                .filter(|p| p.digits.is_some())
+                .map(|p| p.name)
+                .collect();
+            let message = format!(
+                "{} takes numbers: strings of digits are for {}",
+                parameter.name,
+                takes.join(", ")
+            );
+            return Err((value(), message));
+        }
         if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
             let message = format!("values must be finite, got {}", bad.shown());
             return Err((value(), message));
@@ -173,6 +219,18 @@ fn key_columns(
         }
     }
     Ok((times, columns))
+}
+
+/// A key's value as a point with digits (`DeepKeys`).
+fn key_point(value: &KeyValue) -> Coordinates {
+    let point = match value {
+        KeyValue::Digits(c) => c.clone(),
+        other => {
+            let v = other.components();
+            Coordinates::from(DVec3::new(v[0], v[1], v[2]))
+        }
+    };
+    point.with_digits()
 }
 
 /// A key's problem: its index, the field (`time` or `value`), the message.
@@ -246,7 +304,7 @@ fn one_period(
 /// [0, period)), the keys are laid out over the period before, this one and
 /// the next instead, so every segment in [0, period) has its true
 /// neighbours: the last key leads into the first as any key into the next.
-fn build_spline(
+pub(super) fn build_spline(
     times: &[Real],
     values: &[Real],
     mode: Interpolation,

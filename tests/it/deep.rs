@@ -377,3 +377,57 @@ fn a_fisheye_deep_frame_renders_without_nan() {
         .count();
     assert!(hits > 50, "{hits} pixels see the surface");
 }
+
+/// A camera 1e-30 from the tip whose target drifts `shift` along x, keyed
+/// as digits, over 1 s of 5 frames; or held at `still` with no track.
+fn drift_timeline(track: bool, still: &str) -> String {
+    let (tip, from) = (&TIP[..62], "(1.5, -2.4, 1.2)");
+    let target = format!("(\"{still}\", \"{tip}\", \"0\")");
+    let drift = format!(
+        "\"camera.target\": (interpolation: Linear, keys: [(time: 0, value: (\"0\", \"{tip}\", \"0\")), (time: 1, value: (\"0.000000000000000000000000000002\", \"{tip}\", \"0\"))]),"
+    );
+    format!(
+        "(fps: 4, frames: 5, size: (32, 18), scene: (camera: (position: {from}, target: {target}, fov_degrees: 40), fractal: (iterations: 40)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-30)]), {} }})",
+        if track { drift.as_str() } else { "" }
+    )
+}
+
+#[test]
+fn a_target_keyed_with_digits_pans_thirty_decades_down() {
+    let d = Dir::new();
+    d.write("drift.ron", &drift_timeline(true, "0"));
+    // Frame 2 is halfway: the still whose target is written there.
+    d.write(
+        "still.ron",
+        &drift_timeline(false, "0.000000000000000000000000000001"),
+    );
+    d.ok(&["render", "drift.ron", "--out", "drift", "--quiet"]);
+    d.ok(&[
+        "render",
+        "still.ron",
+        "--out",
+        "still",
+        "--frames",
+        "2",
+        "--quiet",
+    ]);
+    let pixels = |path: &str| {
+        image::open(d.path().join(path))
+            .unwrap()
+            .to_rgb8()
+            .into_raw()
+    };
+    let frames: Vec<Vec<u8>> = (0..5)
+        .map(|f| pixels(&format!("drift/frame_{f:05}.png")))
+        .collect();
+    assert_eq!(frames[2], pixels("still/frame_00002.png"));
+    // The view moves at every frame: 2e-30 is about three views across.
+    for pair in frames.windows(2) {
+        assert_ne!(pair[0], pair[1]);
+    }
+    let info = stdout(&d.ok(&["info", "drift.ron"]));
+    assert!(
+        info.contains("5 frame(s) (0..=4) are finer than f64"),
+        "{info}"
+    );
+}

@@ -762,3 +762,40 @@ fn the_fisheyes_angle_and_the_eyes_separation_are_listed_and_set() {
         "{message}"
     );
 }
+
+/// The page holds numbers: a deep target's nearest numbers sent back
+/// unmoved, to view or to key the camera, keep the digits they round.
+#[test]
+fn a_deep_targets_digits_survive_viewing_and_keying() {
+    let d = Dir::new();
+    let tip = "-1.10408951367381233764950538762334472132";
+    let at = |x: &str| format!("(\"{x}\", \"{tip}\", \"0\")");
+    let text = format!(
+        "(fps: 4, frames: 5, size: (32, 18), scene: (camera: (position: (1.5, -2.4, 1.2), target: {}, fov_degrees: 40), fractal: (iterations: 40)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-30)]), \"camera.target\": (interpolation: Linear, keys: [(time: 0, value: {}), (time: 1, value: {})]) }})",
+        at("0"),
+        at("0"),
+        at("0.000000000000000000000000000002")
+    );
+    d.write("deep.ron", &text);
+    let s = explore(&d, "deep.ron");
+    let values = s.get("/api/values?frame=2").expect(200).json();
+    let distance = values["camera.distance"][0].as_f64().unwrap();
+    assert!((distance / 1e-30 - 1.0).abs() < 1e-12, "{values}");
+    let target = values["camera.target"].clone();
+    let view = |overrides: Value| {
+        let view = json!({"frame": 2, "overrides": overrides});
+        let shown = s.post("/api/render", json!({"view": view, "stage": "final"}));
+        pixels(&shown.expect(200).body)
+    };
+    assert!(view(json!({})) == view(json!({ "camera.target": target })));
+    let key = |value: &Value| json!({"edits": [{"kind": "set_key", "track": "camera.target", "time": 0.5, "value": value}]});
+    s.post("/api/edit", key(&target)).expect(200);
+    let edited = s.state()["text"].as_str().unwrap().to_string();
+    let midway = at("0.000000000000000000000000000001");
+    assert!(edited.contains(&format!("value: {midway}")), "{edited}");
+    // A value the page moved is written as it is.
+    s.post("/api/edit", key(&json!([0.25, -1.1, 0.0])))
+        .expect(200);
+    let edited = s.state()["text"].as_str().unwrap().to_string();
+    assert!(edited.contains("value: (0.25, -1.1, 0)"), "{edited}");
+}

@@ -184,6 +184,7 @@ fn value_components(value: &KeyValue) -> Vec<Real> {
     match *value {
         KeyValue::Number(v) => vec![v],
         KeyValue::Triple(x, y, z) => vec![x, y, z],
+        KeyValue::Digits(ref point) => point.value.to_array().to_vec(),
     }
 }
 
