@@ -429,6 +429,12 @@ pub fn measure(
     let all: Vec<Variant> = variants(scene)
         .into_iter()
         .filter(|v| deep || v.knob != "perturbation")
+        .map(|mut v| {
+            if crate::deep::f32_too_coarse(&v.scene, [width, height]) {
+                v.setting += " (renders in f64: f32 cannot resolve these pixels)";
+            }
+            v
+        })
         .collect();
     let reference = &all[0].scene;
     progress(0, all.len(), &all[0]);

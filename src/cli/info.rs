@@ -204,10 +204,32 @@ fn deep_frames(t: &Timeline) -> Vec<(u32, f64)> {
         .collect()
 }
 
+/// Which frames ask for f32 but render in f64, since f32 cannot resolve
+/// their pixels (`deep::f32_too_coarse`); nothing where none does.
+fn print_f32_in_f64(t: &Timeline) -> anyhow::Result<()> {
+    use rayon::prelude::*;
+    let size = [t.width, t.height];
+    let coarse: Vec<u32> = (0..t.frame_count)
+        .into_par_iter()
+        .filter(|&f| crate::deep::f32_too_coarse(&t.scene_at(f), size))
+        .collect();
+    let (Some(first), Some(last)) = (coarse.first(), coarse.last()) else {
+        return Ok(());
+    };
+    out!(
+        "f32:      {} frame(s) ({first}..={last}) have pixels finer than f32 resolves at {}x{} (2^-16 of the target's coordinates): they render in f64",
+        coarse.len(),
+        t.width,
+        t.height
+    );
+    Ok(())
+}
+
 /// Which frames are deep (`crate::deep`) at the timeline's size, the
 /// precision their reference orbits take, and the iterations that resolve
 /// the deepest; nothing where every frame is within f64's reach.
 fn print_deep(t: &Timeline) -> anyhow::Result<()> {
+    print_f32_in_f64(t)?;
     let deep = deep_frames(t);
     let (Some(&(first, _)), Some(&(last, _))) = (deep.first(), deep.last()) else {
         return Ok(());

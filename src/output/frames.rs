@@ -59,6 +59,9 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         /// Only in a deep frame's, so that other frames keep their hashes.
         #[serde(skip_serializing_if = "Option::is_none")]
         deep: Option<u32>,
+        /// Only where f32 was asked for and f64 renders (`deep::f32_too_coarse`).
+        #[serde(skip_serializing_if = "std::ops::Not::not")]
+        f32_in_f64: bool,
     }
     let deep = scenes
         .iter()
@@ -71,6 +74,9 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         height,
         scenes,
         deep: deep.then_some(crate::deep::DEEP_REVISION),
+        f32_in_f64: scenes
+            .iter()
+            .any(|s| crate::deep::f32_too_coarse(s, [width, height])),
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);

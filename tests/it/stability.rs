@@ -548,3 +548,40 @@ fn escape_length_in_f32_steps_from_just_outside_the_surface() {
         }
     }
 }
+
+/// A zoom onto the surface in f32 and in f64, one frame a decade from 1e-3
+/// to 1e-7 from the target: pixels of 8e-6 down to 8e-10.
+fn zoom_in(precision: &str) -> String {
+    format!(
+        "(fps: 1, frames: 5, size: (48, 27), scene: (camera: (position: (2.4548, 3.5662, 1.9590), target: (0.503044367725, 0.443308880733, 0.397566446799), fov_degrees: 40), fractal: (iterations: 20, precision: {precision})), tracks: {{ \"camera.distance\": (interpolation: Linear, keys: [(time: 0, value: 1e-3), (time: 4, value: 1e-7)]) }})"
+    )
+}
+
+#[test]
+fn frames_finer_than_f32_resolves_render_in_f64() {
+    let d = Dir::new();
+    d.write("f32.ron", &zoom_in("F32"));
+    d.write("f64.ron", &zoom_in("F64"));
+    for (name, out) in [("f32.ron", "a"), ("f64.ron", "b")] {
+        d.ok(&["render", name, "--out", out, "--quiet"]);
+    }
+    let pixels = |rel: &str| {
+        image::open(d.path().join(rel))
+            .unwrap()
+            .to_rgb8()
+            .into_raw()
+    };
+    // Frame 0's pixels (1.6e-5 of the target) are f32's own; below 2^-16
+    // of the target f32 speckled, and each frame is now f64's.
+    let frame = |out: &str, f: u32| pixels(&format!("{out}/frame_{f:05}.png"));
+    assert_ne!(frame("a", 0), frame("b", 0), "frame 0 is rendered in f32");
+    for f in 1..5 {
+        assert_eq!(frame("a", f), frame("b", f), "frame {f}");
+    }
+    let info = stdout(&d.ok(&["info", "f32.ron"]));
+    assert!(
+        info.contains("f32:      4 frame(s) (1..=4) have pixels finer than f32 resolves"),
+        "{info}"
+    );
+    assert!(!stdout(&d.ok(&["info", "f64.ron"])).contains("f32:"));
+}
