@@ -225,21 +225,38 @@ pub struct ExploreArgs {
     /// under a name you give in the page.
     pub timeline: Option<PathBuf>,
     /// The address to listen on. Anything but loopback lets other machines
-    /// reach the page (they still need its token).
+    /// reach the page (they still need its token), and needs --network.
     #[arg(long, default_value = "127.0.0.1", value_name = "ADDRESS")]
     pub bind: std::net::IpAddr,
+    /// Serve other machines, with a --bind address other than loopback. The
+    /// page, its token and your edits travel as plain HTTP, which anyone on
+    /// the way can read: use it on a network you trust.
+    #[arg(long)]
+    pub network: bool,
     /// The port to listen on; 0 takes any free one.
     #[arg(long, default_value = "0", value_name = "PORT")]
     pub port: u16,
 }
 
-impl From<ExploreArgs> for crate::explore::Options {
-    fn from(args: ExploreArgs) -> Self {
-        crate::explore::Options {
+impl TryFrom<ExploreArgs> for crate::explore::Options {
+    type Error = crate::error::Error;
+
+    /// Refuses an address beyond loopback without --network.
+    fn try_from(args: ExploreArgs) -> Result<Self, Self::Error> {
+        if !args.bind.is_loopback() && !args.network {
+            return Err(crate::error::Error::usage(
+                "--bind",
+                format!(
+                    "{} lets other machines reach the page, over plain HTTP: add --network to mean it",
+                    args.bind
+                ),
+            ));
+        }
+        Ok(crate::explore::Options {
             timeline: args.timeline,
             bind: args.bind,
             port: args.port,
-        }
+        })
     }
 }
 

@@ -131,7 +131,7 @@ pub fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Render(args) => render::render(args),
         Command::Info { timeline } => info::info(&timeline),
         Command::Pick(args) => pick::pick(args),
-        Command::Explore(args) => crate::explore::serve(args.into()),
+        Command::Explore(args) => crate::explore::serve(args.try_into()?),
         Command::Sheet(args) => sheet::sheet(args),
         Command::Status(args) => status::status(args),
         Command::Accuracy(args) => accuracy::accuracy(args),

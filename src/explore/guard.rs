@@ -13,6 +13,12 @@ use std::sync::Arc;
 /// first load carry it in the query instead).
 pub const TOKEN_HEADER: &str = "x-mandelreel-token";
 
+/// The paths that take the token in the query: what a browser loads by
+/// address (the page, its script and style) and the event stream, which
+/// cannot send a header. Every other route takes it in `TOKEN_HEADER`
+/// alone, so a link or a logged address can do no more than open the page.
+const QUERY_TOKEN_PATHS: [&str; 4] = ["/", "/explore.js", "/explore.css", "/api/events"];
+
 /// 128 random bits, as hex.
 pub fn new_token() -> anyhow::Result<String> {
     let mut bytes = [0u8; 16];
@@ -26,13 +32,18 @@ pub async fn check(
     request: Request,
     next: Next,
 ) -> Response {
-    match refusal(&state, request.headers(), request.uri().query()) {
+    let uri = request.uri();
+    let query = uri
+        .query()
+        .filter(|_| QUERY_TOKEN_PATHS.contains(&uri.path()));
+    match refusal(&state, request.headers(), query) {
         Some(reason) => (StatusCode::FORBIDDEN, reason).into_response(),
         None => next.run(request).await,
     }
 }
 
-/// Why a request is refused, if it is.
+/// Why a request is refused, if it is: `query` is the request's where it
+/// may carry the token.
 fn refusal(state: &State, headers: &HeaderMap, query: Option<&str>) -> Option<String> {
     let port = state.address.port();
     let host = headers.get(header::HOST).and_then(|h| h.to_str().ok());

@@ -82,6 +82,26 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
     })
 }
 
+/// The addresses other machines reach a server bound to `bind` at: its
+/// own, or where it is unspecified (0.0.0.0, ::) every interface's of its
+/// family but loopback.
+fn answering(bind: IpAddr) -> Vec<IpAddr> {
+    if !bind.is_unspecified() {
+        return vec![bind];
+    }
+    let interfaces = if_addrs::get_if_addrs().unwrap_or_default();
+    let mut ips: Vec<IpAddr> = interfaces
+        .iter()
+        .map(|i| i.ip())
+        .filter(|ip| !ip.is_loopback() && ip.is_ipv4() == bind.is_ipv4())
+        // A link-local IPv6 address needs its interface named in a URL.
+        .filter(|ip| !matches!(ip, IpAddr::V6(v6) if v6.segments()[0] & 0xffc0 == 0xfe80))
+        .collect();
+    ips.sort();
+    ips.dedup();
+    ips
+}
+
 /// The address to open, on standard output (a script reads it from there).
 fn announce(state: &State) -> anyhow::Result<()> {
     use std::io::Write as _;
@@ -98,9 +118,30 @@ fn announce(state: &State) -> anyhow::Result<()> {
     );
     // One write: a reader that takes the first line and goes cannot make
     // the second fail, which would end the server.
-    let said = format!(
+    let mut said = format!(
         "Exploring {name}: open {url}\n(Ctrl-C stops the server; edits not saved are lost.)\n"
     );
+    if !state.address.ip().is_loopback() {
+        let port = state.address.port();
+        let urls: Vec<String> = answering(state.address.ip())
+            .into_iter()
+            .map(|ip| {
+                format!(
+                    "http://{}/?token={}",
+                    SocketAddr::new(ip, port),
+                    state.token
+                )
+            })
+            .collect();
+        let urls = match urls.is_empty() {
+            true => vec!["(no network interface found)".to_string()],
+            false => urls,
+        };
+        said += &format!(
+            "Other machines reach it at {}\nwarning: plain HTTP: anyone on the network between can read the page, its token and your edits\n",
+            urls.join(" ")
+        );
+    }
     let mut out = std::io::stdout().lock();
     out.write_all(said.as_bytes())?;
     out.flush()?;

@@ -3,7 +3,7 @@
 //! the file watch, refused views and picks. Requests are written by hand
 //! over a TcpStream so that Host and Origin are exactly what a test says.
 
-use crate::util::{stdout, tiny_timeline, with_scene, Dir};
+use crate::util::{stderr, stdout, tiny_timeline, with_scene, Dir};
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read, Write};
 use std::net::TcpStream;
@@ -262,6 +262,26 @@ fn only_our_page_with_its_token_is_answered() {
         b"",
     )
     .expect(403);
+    // Its script, style and events take it there too; no other route does.
+    for path in ["/explore.js", "/explore.css"] {
+        let asset = format!("GET {path}?token={token} HTTP/1.1\r\nHost: {host}\r\n");
+        s.raw(&asset, b"").expect(200);
+    }
+    for (method, path) in [
+        ("GET", "/api/state"),
+        ("POST", "/api/save"),
+        ("POST", "/api/edit"),
+    ] {
+        let head = format!(
+            "{method} {path}?token={token} HTTP/1.1\r\nHost: {host}\r\nContent-Type: application/json\r\n"
+        );
+        let refused = s.raw(&head, b"{}").expect(403);
+        assert!(
+            refused.text().contains("token"),
+            "{path}: {}",
+            refused.text()
+        );
+    }
 
     // Listening on loopback only: the machine's own outward address is refused.
     match outward_address() {
@@ -798,4 +818,55 @@ fn a_deep_targets_digits_survive_viewing_and_keying() {
         .expect(200);
     let edited = s.state()["text"].as_str().unwrap().to_string();
     assert!(edited.contains("value: (0.25, -1.1, 0)"), "{edited}");
+}
+
+/// Beyond loopback only when asked for, saying where and that it is plain
+/// HTTP.
+#[test]
+fn serving_the_network_needs_a_flag_and_names_its_addresses() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let refused = d.run(&["explore", "t.ron", "--bind", "0.0.0.0", "--port", "0"]);
+    assert_eq!(refused.status.code(), Some(2));
+    assert!(
+        stderr(&refused).contains("add --network"),
+        "{}",
+        stderr(&refused)
+    );
+    let mut child = d
+        .command(&[
+            "explore",
+            "t.ron",
+            "--bind",
+            "0.0.0.0",
+            "--network",
+            "--port",
+            "0",
+        ])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("start explore");
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let lines: Vec<String> = (0..4)
+        .map(|_| {
+            let mut line = String::new();
+            out.read_line(&mut line).unwrap();
+            line
+        })
+        .collect();
+    child.kill().unwrap();
+    child.wait().unwrap();
+    assert!(lines[0].contains(": open http://127.0.0.1:"), "{lines:?}");
+    assert!(
+        lines[2].starts_with("Other machines reach it at "),
+        "{lines:?}"
+    );
+    if let Some(ip) = outward_address() {
+        assert!(
+            lines[2].contains(&format!("http://{ip}:")),
+            "{ip}: {lines:?}"
+        );
+    }
+    assert!(lines[3].contains("plain HTTP"), "{lines:?}");
 }
