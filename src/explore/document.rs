@@ -139,20 +139,17 @@ impl Document {
         let (path, target) = match new_name {
             Some(name) => {
                 let path = self.create(name)?;
-                (path.clone(), (path, None))
+                (self.path, self.target) = (Some(path.clone()), Some((path.clone(), None)));
+                (self.saved, self.edited) = (Some(self.text.clone()), false);
+                self.disk_changed = false;
+                return Ok(path);
             }
             None => match (&self.path, &self.target) {
                 (Some(path), Some(target)) => (path.clone(), target.clone()),
                 _ => return Err("a new timeline needs a file name to be saved under".into()),
             },
         };
-        if let Err(e) = write(&target.0, &self.text) {
-            if new_name.is_some() {
-                // The empty file made to claim the name goes with the save.
-                let _ = std::fs::remove_file(&target.0);
-            }
-            return Err(e);
-        }
+        write(&target.0, &self.text)?;
         if let Some(mode) = &target.1 {
             let _ = std::fs::set_permissions(&target.0, mode.clone());
         }
@@ -162,32 +159,26 @@ impl Document {
         Ok(path)
     }
 
-    /// A new file `name` in the document's folder, created empty so that no
-    /// other file is ever written over.
+    /// A new file `name` in the document's folder holding the text, written
+    /// whole or not at all and never over another file.
     fn create(&self, name: &str) -> Result<PathBuf, String> {
-        let plain = !name.is_empty()
-            && name.len() <= 200
-            && !name.starts_with('.')
-            && !name.contains(['/', '\\'])
-            && !name.chars().any(char::is_control);
-        if !plain || !name.ends_with(".ron") {
+        if !plain_name(name) {
             return Err(format!(
-                "{name:?}: a new file's name must be a plain file name ending in .ron, in {}",
+                "{name:?}: a new file's name must be a plain file name ending in .ron (no spaces at either end, no invisible or direction-changing characters), in {}",
                 self.folder.display()
             ));
         }
         let path = self.folder.join(name);
-        std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(&path)
-            .map_err(|e| match e.kind() {
-                std::io::ErrorKind::AlreadyExists => format!(
+        crate::output::atomic::write_new_text(&path, &self.text).map_err(|e| {
+            let exists = matches!(&e, crate::error::Error::Io { cause, .. } if cause.kind() == std::io::ErrorKind::AlreadyExists);
+            match exists {
+                true => format!(
                     "{} already exists: explore writes only its own timeline and new files",
                     path.display()
                 ),
-                _ => format!("cannot create {}: {e}", path.display()),
-            })?;
+                false => format!("cannot create {}: {e}", path.display()),
+            }
+        })?;
         Ok(path)
     }
 
@@ -276,4 +267,25 @@ fn checked(text: String, shown: &Path) -> Result<(String, Timeline), String> {
 /// `text` written over `path` whole, through a temporary file.
 fn write(path: &Path, text: &str) -> Result<(), String> {
     crate::output::atomic::write_text(path, text).map_err(|e| format!("{e:#}"))
+}
+
+/// A name a user can read as it is: a `.ron` file in the folder itself, its
+/// stem with no space at either end, no control character and none of the
+/// invisible or direction-changing ones (`\u{202E}gnp.ron` shows as
+/// `ron.png`).
+fn plain_name(name: &str) -> bool {
+    let invisible = |c: char| {
+        c.is_control()
+            || matches!(c, '\u{00AD}' | '\u{061C}' | '\u{180E}' | '\u{FEFF}')
+            || ('\u{200B}'..='\u{200F}').contains(&c)
+            || ('\u{2028}'..='\u{202E}').contains(&c)
+            || ('\u{2060}'..='\u{206F}').contains(&c)
+    };
+    let stem = name.strip_suffix(".ron").unwrap_or_default();
+    !stem.is_empty()
+        && name.len() <= 200
+        && !name.starts_with('.')
+        && stem.trim() == stem
+        && !name.contains(['/', '\\'])
+        && !name.chars().any(invisible)
 }

@@ -22,6 +22,27 @@ pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&File>, &Path) -> Result<()>,
 ) -> Result<()> {
+    through_temporary(path, true, write)
+}
+
+/// `write_atomic` for a file that must not exist yet: an existing `path` is
+/// an `AlreadyExists` error and is left as it was; nothing else of the new
+/// file is ever seen but the whole of it.
+pub fn write_new_text(path: &Path, text: &str) -> Result<()> {
+    through_temporary(path, false, |writer, file| {
+        use std::io::Write as _;
+        writer
+            .write_all(text.as_bytes())
+            .map_err(|e| Error::io(file, e))
+    })
+}
+
+/// `write_atomic`, writing over an existing `path` only with `clobber`.
+fn through_temporary(
+    path: &Path,
+    clobber: bool,
+    write: impl FnOnce(&mut BufWriter<&File>, &Path) -> Result<()>,
+) -> Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -60,7 +81,12 @@ pub fn write_atomic(
         .sync_all()
         .map_err(|e| Error::io(path, e))?;
     let held = crate::interrupt::hold();
-    temp.persist(path).map_err(|e| Error::io(path, e.error))?;
+    match clobber {
+        true => temp.persist(path).map_err(|e| Error::io(path, e.error))?,
+        false => temp
+            .persist_noclobber(path)
+            .map_err(|e| Error::io(path, e.error))?,
+    };
     drop(held);
     Ok(())
 }

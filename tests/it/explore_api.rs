@@ -366,6 +366,13 @@ fn save_writes_only_its_file_and_new_plain_names() {
         "x.txt",
         "other.ron",
         "t.ron",
+        // Shows as "ron.png"; a name that is only a space; spaces at an end.
+        "\u{202E}gnp.ron",
+        " .ron",
+        " x.ron",
+        "x .ron",
+        "x\u{200B}.ron",
+        ".ron",
     ];
     for name in bad {
         let refused = s.post("/api/save", json!({ "name": name }));

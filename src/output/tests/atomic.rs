@@ -1,5 +1,5 @@
 use crate::host::writer_tag;
-use crate::output::atomic::{remove_stale_partials, write_atomic};
+use crate::output::atomic::{remove_stale_partials, write_atomic, write_new_text};
 
 /// The names of the files in `dir`.
 fn names_in(dir: &std::path::Path) -> Vec<String> {
@@ -55,4 +55,19 @@ fn temporaries_of_dead_local_writers_go_at_once() {
     assert!(!dir.path().join(&dead).exists());
     assert!(dir.path().join(&alive).exists());
     assert!(dir.path().join(elsewhere).exists());
+}
+
+#[test]
+fn a_new_file_is_written_whole_and_never_over_another() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("new.ron");
+    write_new_text(&path, "(fps: 1)").unwrap();
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "(fps: 1)");
+    let refused = write_new_text(&path, "(fps: 2)").unwrap_err();
+    assert!(
+        matches!(&refused, crate::error::Error::Io { cause, .. } if cause.kind() == std::io::ErrorKind::AlreadyExists),
+        "{refused}"
+    );
+    assert_eq!(std::fs::read_to_string(&path).unwrap(), "(fps: 1)");
+    assert_eq!(names_in(dir.path()), ["new.ron"], "a temporary is left");
 }
