@@ -214,7 +214,10 @@ pub fn iterations(timeline: &Timeline, frame: u32) -> Iterations {
 /// indexes its list (`look.palette.stops[1].colour`).
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
     use crate::spans::Step;
-    let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
+    let number = |v: &serde_json::Value| {
+        let written = v.as_f64().map(as_written);
+        written.or_else(|| v.as_str()?.parse().ok())
+    };
     // A projection is written as its variant: `{"Fisheye": {"degrees": D}}`.
     let path = match name {
         crate::timeline::parameters::FISHEYE_DEGREES => "camera.projection.Fisheye.degrees",
@@ -231,6 +234,17 @@ fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
         Some(v) if !v.is_null() => Some(vec![number(v)?]),
         _ if name == "look.exposure" => Some(vec![1.0]),
         _ => None,
+    }
+}
+
+/// `v` as the timeline wrote it: a field held as f32 (colours, a palette)
+/// reaches JSON as the f32's exact value, 1.0499999523162842 for 1.05, so
+/// a value f32 holds exactly is read as the f32's shortest decimal.
+fn as_written(v: f64) -> f64 {
+    let single = v as f32;
+    match single as f64 == v {
+        true => single.to_string().parse().unwrap_or(v),
+        false => v,
     }
 }
 

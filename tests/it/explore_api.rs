@@ -877,3 +877,24 @@ fn serving_the_network_needs_a_flag_and_names_its_addresses() {
     }
     assert!(lines[3].contains("plain HTTP"), "{lines:?}");
 }
+
+/// Values the page shows are the file's, not their f32 roundings.
+#[test]
+fn values_are_the_numbers_the_file_writes() {
+    let d = Dir::new();
+    let text = with_scene(
+        &tiny_timeline(1, 8.0),
+        "look: (base_colour: (0.55, 0.50, 0.45), light_colour: (1.05, 1.0, 0.9)), effects: (fog: (density: 0.3, colour: (0.09, 0.1, 0.12)))",
+    );
+    d.write("t.ron", &text);
+    let s = explore(&d, "t.ron");
+    let values = s.get("/api/values?frame=0").expect(200).json();
+    assert_eq!(
+        values["look.base_colour"],
+        json!([0.55, 0.5, 0.45]),
+        "{values}"
+    );
+    assert_eq!(values["look.light_colour"], json!([1.05, 1.0, 0.9]));
+    assert_eq!(values["effects.fog.colour"], json!([0.09, 0.1, 0.12]));
+    assert_eq!(values["effects.fog.density"], json!([0.3]));
+}
