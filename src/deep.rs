@@ -105,13 +105,22 @@ pub fn bits(scene: &Scene, size: [u32; 2]) -> usize {
     (64 + below.clamp(0.0, 2048.0).ceil() as usize + 32).max(MIN_BITS)
 }
 
-/// The scene that frame renders as, where it differs: a deep frame measured
-/// from its target with the reference orbit set, or one in f64 where f32
-/// cannot resolve it (`f32_too_coarse`). `None` where the scene renders as
-/// it is; powers that are not whole render deep frames in f64 (`info` says
-/// so), since perturbation does not cover them.
+/// The scene that frame renders as, where it is deep: measured from its
+/// target, with the reference orbit set. `None` for a frame f64 resolves,
+/// and for powers that are not whole, which perturbation does not cover
+/// (they render in f64, and `info` says so).
 pub fn prepare(scene: &Scene, size: [u32; 2]) -> Option<Scene> {
     prepare_with(scene, size, &References::default())
+}
+
+/// The scene a frame of `scene` at `size` renders as where it asks for f32
+/// and f32 cannot resolve it (`f32_too_coarse`): the same in f64.
+pub fn in_f64(scene: &Scene, size: [u32; 2]) -> Option<Scene> {
+    f32_too_coarse(scene, size).then(|| {
+        let mut f64 = scene.clone();
+        f64.fractal.precision = crate::fractal::Precision::F64;
+        f64
+    })
 }
 
 /// `prepare`, taking the reference from `references` where one there has
@@ -119,17 +128,6 @@ pub fn prepare(scene: &Scene, size: [u32; 2]) -> Option<Scene> {
 /// instants, a film's frames at one precision), and adding the one it
 /// builds.
 pub fn prepare_with(scene: &Scene, size: [u32; 2], references: &References) -> Option<Scene> {
-    perturbed(scene, size, references).or_else(|| {
-        f32_too_coarse(scene, size).then(|| {
-            let mut f64 = scene.clone();
-            f64.fractal.precision = crate::fractal::Precision::F64;
-            f64
-        })
-    })
-}
-
-/// The deep frame's scene: measured from its target, with the reference set.
-fn perturbed(scene: &Scene, size: [u32; 2], references: &References) -> Option<Scene> {
     if !needed(scene, size) || !scene.fractal.perturbation {
         return None;
     }
@@ -219,14 +217,15 @@ impl References {
     }
 }
 
-/// `scenes` (a frame's instants) as they render at `size`: `None`
-/// where none is deep, so the caller keeps its own. Instants that share a
-/// target and fractal share one reference orbit.
+/// `scenes` (a frame's instants) as they render at `size`, deep or in
+/// f64 in place of f32 (`in_f64`): `None` where each renders as it is, so
+/// the caller keeps its own. Instants that share a target and fractal
+/// share one reference orbit.
 pub fn prepare_all(scenes: &[Scene], size: [u32; 2]) -> Option<Vec<Scene>> {
     let references = References::default();
     let prepared: Vec<Option<Scene>> = scenes
         .iter()
-        .map(|s| prepare_with(s, size, &references))
+        .map(|s| prepare_with(s, size, &references).or_else(|| in_f64(s, size)))
         .collect();
     if prepared.iter().all(Option::is_none) {
         return None;

@@ -200,8 +200,13 @@ pub fn moved(anchor: &str, delta: f64) -> String {
         }
         let (significand, exponent) = rounded.repr().clone().into_parts();
         let scientific = format!("{significand}e{exponent}");
-        if parse_digits(&scientific).is_ok() || precision <= 17 {
+        if parse_digits(&scientific).is_ok() {
             return scientific;
+        }
+        if precision <= 17 {
+            // Below 1e-380, past anything f64 or a coordinate's exponent
+            // holds: the anchor and the step cancel.
+            return "0".into();
         }
         precision /= 2;
     }

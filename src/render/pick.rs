@@ -43,7 +43,8 @@ pub struct PickFractal {
 /// ray its projection gives it. The pixel must be inside the image.
 pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
     let deep = crate::deep::prepare(scene, [width, height]);
-    let marched = deep.as_ref().unwrap_or(scene);
+    let in_f64 = crate::deep::in_f64(scene, [width, height]).filter(|_| deep.is_none());
+    let marched = deep.as_ref().or(in_f64.as_ref()).unwrap_or(scene);
     let camera = marched.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
     let fractal = &marched.fractal;
@@ -163,7 +164,8 @@ pub fn refine(
         c.position_digits = None;
         s.fractal.iterations = recount(&s);
         let deep = crate::deep::prepare(&s, [width, height]);
-        let marched = deep.as_ref().unwrap_or(&s);
+        let in_f64 = crate::deep::in_f64(&s, [width, height]).filter(|_| deep.is_none());
+        let marched = deep.as_ref().or(in_f64.as_ref()).unwrap_or(&s);
         let ray =
             marched
                 .camera

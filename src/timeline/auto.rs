@@ -111,7 +111,9 @@ fn centre_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -
     probe.fractal.iterations = CENTRE_ITERATIONS;
     probe.quality.max_steps = deep::steps_of(scene, size).saturating_mul(4);
     let prepared = deep::prepare_with(&probe, size, references);
-    let marched = prepared.as_ref().unwrap_or(&probe);
+    // Marched in the arithmetic the frame renders in.
+    let in_f64 = deep::in_f64(&probe, size).filter(|_| prepared.is_none());
+    let marched = prepared.as_ref().or(in_f64.as_ref()).unwrap_or(&probe);
     // One eye's centre: a stereo image's centre is where its eyes meet.
     let [width, height] = scene.camera.eye_size(size);
     let mono = crate::camera::Camera {

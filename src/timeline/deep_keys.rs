@@ -28,8 +28,9 @@ pub(super) struct DeepKeys {
     sampled: Arc<Mutex<HashMap<u64, Coordinates>>>,
 }
 
-/// The most sampled values kept (a few hundred bytes each); past it they
-/// start over, costing a recomputation, never memory.
+/// The most sampled values kept (three strings of up to `MAX_DIGITS`
+/// digits each, 1.3 kB at most: 20 MB a track); past it they start over,
+/// costing a recomputation, never memory.
 const MOST_SAMPLED: usize = 1 << 14;
 
 impl DeepKeys {

@@ -144,3 +144,20 @@ fn digits_are_refused_where_a_parameter_takes_numbers() {
         "{e}"
     );
 }
+
+#[test]
+fn a_loops_end_key_in_digits_must_be_its_start_to_the_last_digit() {
+    let keys = |end: &str| {
+        let text = format!(
+            "(fps: 10, frames: 10, size: (8, 6), loop: true, tracks: {{ \"camera.target\": \
+             (keys: [(time: 0, value: (\"0.5\", \"0\", \"0\")), (time: 0.5, value: (\"0.6\", \"0\", \"0\")), \
+             (time: 1, value: ({end:?}, \"0\", \"0\"))]) }})"
+        );
+        Timeline::parse(&text, Path::new("test.ron")).map(drop)
+    };
+    assert!(keys("0.50").is_ok());
+    let e = keys("0.5000000000000000000000000000001")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must have the same value"), "{e}");
+}

@@ -584,4 +584,11 @@ fn frames_finer_than_f32_resolves_render_in_f64() {
         "{info}"
     );
     assert!(!stdout(&d.ok(&["info", "f64.ron"])).contains("f32:"));
+    // `pick` marches such a frame as it renders, in world coordinates.
+    let point = |name: &str| {
+        let pick = ["pick", name, "--frame", "2", "--pixel", "24,13", "--json"];
+        let json: serde_json::Value = serde_json::from_str(&stdout(&d.ok(&pick))).unwrap();
+        (json["point_digits"].clone(), json["deep"].clone())
+    };
+    assert_eq!(point("f32.ron"), point("f64.ron"));
 }
