@@ -6,6 +6,7 @@
 
 mod document;
 mod guard;
+mod listen;
 mod page;
 mod renderer;
 mod routes;
@@ -77,7 +78,7 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
         });
         announce(&state)?;
         tokio::spawn(watch::watch(state.clone()));
-        axum::serve(listener, routes::router(state)).await?;
+        listen::serve(listener, routes::router(state)).await?;
         Ok(())
     })
 }

@@ -57,8 +57,12 @@ impl Response {
 
 /// Starts `explore <timeline> --port 0` in `dir` and reads the address it prints.
 fn explore(dir: &Dir, timeline: &str) -> Server {
-    let mut child = dir
-        .command(&["explore", timeline, "--port", "0"])
+    serve(dir.command(&["explore", timeline, "--port", "0"]))
+}
+
+/// The server `command` starts, once it has printed its address.
+fn serve(mut command: std::process::Command) -> Server {
+    let mut child = command
         .stdout(Stdio::piped())
         .stderr(Stdio::inherit())
         .spawn()
@@ -897,4 +901,40 @@ fn values_are_the_numbers_the_file_writes() {
     assert_eq!(values["look.light_colour"], json!([1.05, 1.0, 0.9]));
     assert_eq!(values["effects.fog.colour"], json!([0.09, 0.1, 0.12]));
     assert_eq!(values["effects.fog.density"], json!([0.3]));
+}
+
+/// Clients that never finish their headers are dropped in time: with the
+/// server allowed 256 open files, 300 of them held open, and a real
+/// request made after them is still answered.
+#[test]
+fn slow_clients_cannot_starve_the_page() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let mut command = std::process::Command::new("sh");
+    command
+        .args(["-c", "ulimit -n 256 && exec \"$0\" explore t.ron --port 0"])
+        .arg(env!("CARGO_BIN_EXE_mandelreel"))
+        .current_dir(d.path());
+    let s = serve(command);
+    let slow: Vec<TcpStream> = (0..300)
+        .filter_map(|_| {
+            let mut stream = TcpStream::connect(("127.0.0.1", s.port)).ok()?;
+            stream
+                .write_all(b"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n")
+                .ok()?;
+            Some(stream)
+        })
+        .collect();
+    assert!(slow.len() >= 250, "{} slow clients connected", slow.len());
+    let started = std::time::Instant::now();
+    let answered = s.get("/api/state").expect(200).json();
+    assert_eq!(answered["name"], "t.ron");
+    // Three rounds of the 5 s header timeout at most, well inside the
+    // request's own 120 s.
+    assert!(
+        started.elapsed() < Duration::from_secs(60),
+        "{:?}",
+        started.elapsed()
+    );
+    drop(slow);
 }
