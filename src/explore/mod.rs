@@ -38,7 +38,15 @@ pub struct State {
     /// Held by an edit from its snapshot to its result: edits take turns,
     /// while the other routes never wait on one.
     pub editing: tokio::sync::Mutex<()>,
+    /// Playback frames render `PLAYING_AT_ONCE` at a time (a newer view
+    /// does not stop them, as it stops the other stages): the page asks
+    /// for one at a time, and a flood of them waits its turn.
+    pub playing: tokio::sync::Semaphore,
 }
+
+/// Playback frames rendered at once: the page's one, and one left over
+/// from a playback just stopped.
+pub const PLAYING_AT_ONCE: usize = 2;
 
 /// What the page is told without asking (server-sent events).
 #[derive(Clone, Debug, serde::Serialize)]
@@ -75,6 +83,7 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
             renders: renderer::Renders::default(),
             events: tokio::sync::broadcast::channel(64).0,
             editing: tokio::sync::Mutex::new(()),
+            playing: tokio::sync::Semaphore::new(PLAYING_AT_ONCE),
         });
         announce(&state)?;
         tokio::spawn(watch::watch(state.clone()));

@@ -181,6 +181,15 @@ async fn render(state: Shared, Json(request): Json<RenderRequest>) -> Response {
         Some(g) => g,
         None => state.renders.begin(),
     };
+    let _turn = match request.stage {
+        Stage::Play => Some(state.playing.acquire().await),
+        _ => None,
+    };
+    // Playback frames rendering now, this one included (0 for a view).
+    let playing = match request.stage {
+        Stage::Play => super::PLAYING_AT_ONCE - state.playing.available_permits(),
+        _ => 0,
+    };
     let shared = state.clone();
     let picture = tokio::task::spawn_blocking(move || {
         shared.renders.render(&prepared, request.stage, generation)
@@ -205,6 +214,10 @@ async fn render(state: Shared, Json(request): Json<RenderRequest>) -> Response {
                 (
                     header::HeaderName::from_static("x-seconds"),
                     format!("{:.3}", p.seconds),
+                ),
+                (
+                    header::HeaderName::from_static("x-playing"),
+                    playing.to_string(),
                 ),
             ],
             p.png,

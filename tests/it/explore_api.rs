@@ -938,3 +938,26 @@ fn slow_clients_cannot_starve_the_page() {
     );
     drop(slow);
 }
+
+/// Playback frames take turns: however many are asked for at once, at
+/// most two render together, and each is answered.
+#[test]
+fn playback_frames_render_two_at_a_time() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let view = json!({"frame": 1, "size": "480x270"});
+    let playing: Vec<usize> = std::thread::scope(|scope| {
+        let asks: Vec<_> = (0..12)
+            .map(|_| {
+                scope.spawn(|| {
+                    let shown = s.post("/api/render", json!({"view": view, "stage": "play"}));
+                    let shown = shown.expect(200);
+                    shown.header("x-playing").unwrap().parse::<usize>().unwrap()
+                })
+            })
+            .collect();
+        asks.into_iter().map(|a| a.join().unwrap()).collect()
+    });
+    assert!(playing.iter().all(|&n| (1..=2).contains(&n)), "{playing:?}");
+}
