@@ -274,16 +274,38 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
 /// invisible or direction-changing ones (`\u{202E}gnp.ron` shows as
 /// `ron.png`).
 fn plain_name(name: &str) -> bool {
+    let ranges = [
+        ('\u{200B}', '\u{200F}'),
+        ('\u{2028}', '\u{202E}'),
+        ('\u{2060}', '\u{206F}'),
+        ('\u{FFF9}', '\u{FFFB}'),
+        ('\u{FE00}', '\u{FE0F}'),
+        ('\u{180B}', '\u{180E}'),
+        ('\u{0600}', '\u{0605}'),
+        ('\u{1D173}', '\u{1D17A}'),
+        ('\u{E0000}', '\u{E0FFF}'),
+    ];
     let invisible = |c: char| {
         c.is_control()
-            || matches!(c, '\u{00AD}' | '\u{061C}' | '\u{180E}' | '\u{FEFF}')
-            || ('\u{200B}'..='\u{200F}').contains(&c)
-            || ('\u{2028}'..='\u{202E}').contains(&c)
-            || ('\u{2060}'..='\u{206F}').contains(&c)
+            || matches!(
+                c,
+                '\u{00AD}'
+                    | '\u{061C}'
+                    | '\u{06DD}'
+                    | '\u{070F}'
+                    | '\u{FEFF}'
+                    | '\u{115F}'
+                    | '\u{1160}'
+                    | '\u{2800}'
+                    | '\u{3164}'
+                    | '\u{FFA0}'
+            )
+            || ranges.iter().any(|&(a, b)| (a..=b).contains(&c))
     };
     let stem = name.strip_suffix(".ron").unwrap_or_default();
+    // Room in a file name's 255 bytes for the temporary it is written as.
     !stem.is_empty()
-        && name.len() <= 200
+        && name.len() <= 150
         && !name.starts_with('.')
         && stem.trim() == stem
         && !name.contains(['/', '\\'])

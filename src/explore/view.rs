@@ -161,14 +161,22 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
     let scene = timeline.scene_at(frame);
     // Exactly, where digits put the camera closer than f64 tells apart.
     let distance = scene.camera.relative_position().length();
-    let scene = serde_json::to_value(scene).unwrap_or_default();
+    let json = serde_json::to_value(&scene).unwrap_or_default();
     crate::timeline::parameters::all()
         .map(|p| {
             // The zoom's distance is a track's alone, not a field of the scene.
             if p.name == crate::timeline::ZOOM_TRACK {
                 return (p.name, Some(vec![distance]));
             }
-            (p.name, field(&scene, p.name))
+            let value = field(&json, p.name);
+            let single = value.is_some() && held_in_f32(&scene, p);
+            (
+                p.name,
+                value.map(|v| match single {
+                    true => v.into_iter().map(as_written).collect(),
+                    false => v,
+                }),
+            )
         })
         .collect()
 }
@@ -214,10 +222,7 @@ pub fn iterations(timeline: &Timeline, frame: u32) -> Iterations {
 /// indexes its list (`look.palette.stops[1].colour`).
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
     use crate::spans::Step;
-    let number = |v: &serde_json::Value| {
-        let written = v.as_f64().map(as_written);
-        written.or_else(|| v.as_str()?.parse().ok())
-    };
+    let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
     // A projection is written as its variant: `{"Fisheye": {"degrees": D}}`.
     let path = match name {
         crate::timeline::parameters::FISHEYE_DEGREES => "camera.projection.Fisheye.degrees",
@@ -237,9 +242,19 @@ fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
     }
 }
 
-/// `v` as the timeline wrote it: a field held as f32 (colours, a palette)
-/// reaches JSON as the f32's exact value, 1.0499999523162842 for 1.05, so
-/// a value f32 holds exactly is read as the f32's shortest decimal.
+/// Whether `scene` holds `parameter` in f32 (colours, a palette): a tenth
+/// set there reads back as f32's tenth.
+fn held_in_f32(scene: &Scene, parameter: &crate::timeline::parameters::Parameter) -> bool {
+    let mut probe = scene.clone();
+    let tenths = vec![0.1; parameter.shape.components()];
+    (parameter.set)(&mut probe, &tenths);
+    let json = serde_json::to_value(&probe).unwrap_or_default();
+    field(&json, parameter.name) == Some(vec![0.1f32 as f64; tenths.len()])
+}
+
+/// `v`, a value of a field held in f32, as the timeline wrote it: JSON
+/// carries the f32's exact value, 1.0499999523162842 for 1.05, so it is
+/// read as the f32's shortest decimal.
 fn as_written(v: f64) -> f64 {
     let single = v as f32;
     match single as f64 == v {

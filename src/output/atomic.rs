@@ -81,12 +81,22 @@ fn through_temporary(
         .sync_all()
         .map_err(|e| Error::io(path, e))?;
     let held = crate::interrupt::hold();
-    match clobber {
-        true => temp.persist(path).map_err(|e| Error::io(path, e.error))?,
-        false => temp
-            .persist_noclobber(path)
-            .map_err(|e| Error::io(path, e.error))?,
-    };
+    if !clobber {
+        // Claimed, then written over whole: under the interrupt lock, so
+        // no empty claim is left. (tempfile's no-clobber persist needs a
+        // rename flag or hard links, which some mounts refuse.)
+        std::fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(path)
+            .map_err(|e| Error::io(path, e))?;
+    }
+    if let Err(e) = temp.persist(path) {
+        if !clobber {
+            let _ = std::fs::remove_file(path);
+        }
+        return Err(Error::io(path, e.error));
+    }
     drop(held);
     Ok(())
 }

@@ -376,6 +376,7 @@ fn save_writes_only_its_file_and_new_plain_names() {
         " x.ron",
         "x .ron",
         "x\u{200B}.ron",
+        "film\u{E0041}.ron",
         ".ron",
     ];
     for name in bad {
@@ -888,7 +889,7 @@ fn values_are_the_numbers_the_file_writes() {
     let d = Dir::new();
     let text = with_scene(
         &tiny_timeline(1, 8.0),
-        "look: (base_colour: (0.55, 0.50, 0.45), light_colour: (1.05, 1.0, 0.9)), effects: (fog: (density: 0.3, colour: (0.09, 0.1, 0.12)))",
+        "quality: (fudge: 0.30000001192092896), look: (base_colour: (0.55, 0.50, 0.45), light_colour: (1.05, 1.0, 0.9)), effects: (fog: (density: 0.3, colour: (0.09, 0.1, 0.12)))",
     );
     d.write("t.ron", &text);
     let s = explore(&d, "t.ron");
@@ -901,6 +902,8 @@ fn values_are_the_numbers_the_file_writes() {
     assert_eq!(values["look.light_colour"], json!([1.05, 1.0, 0.9]));
     assert_eq!(values["effects.fog.colour"], json!([0.09, 0.1, 0.12]));
     assert_eq!(values["effects.fog.density"], json!([0.3]));
+    // An f64 field keeps every digit, though f32 holds this value exactly.
+    assert_eq!(values["quality.fudge"], json!([0.30000001192092896]));
 }
 
 /// Clients that never finish their headers are dropped in time: with the
