@@ -217,15 +217,21 @@ impl References {
     }
 }
 
-/// `scenes` (a frame's instants) as they render at `size`, deep or in
-/// f64 in place of f32 (`in_f64`): `None` where each renders as it is, so
-/// the caller keeps its own. Instants that share a target and fractal
-/// share one reference orbit.
+/// The scene a frame of `scene` at `size` renders as, where it differs:
+/// deep (`prepare_with`; its fractal then has `deep` set), or in f64 in
+/// place of f32 (`in_f64`).
+pub fn rendered(scene: &Scene, size: [u32; 2], references: &References) -> Option<Scene> {
+    prepare_with(scene, size, references).or_else(|| in_f64(scene, size))
+}
+
+/// `scenes` (a frame's instants) as they render at `size` (`rendered`):
+/// `None` where each renders as it is, so the caller keeps its own.
+/// Instants that share a target and fractal share one reference orbit.
 pub fn prepare_all(scenes: &[Scene], size: [u32; 2]) -> Option<Vec<Scene>> {
     let references = References::default();
     let prepared: Vec<Option<Scene>> = scenes
         .iter()
-        .map(|s| prepare_with(s, size, &references).or_else(|| in_f64(s, size)))
+        .map(|s| rendered(s, size, &references))
         .collect();
     if prepared.iter().all(Option::is_none) {
         return None;

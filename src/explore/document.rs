@@ -136,23 +136,21 @@ impl Document {
     /// Writes the text to its file, or to `new_name`: a new file in the
     /// same folder, which becomes the document's file.
     pub fn save(&mut self, new_name: Option<&str>) -> Result<PathBuf, String> {
-        let (path, target) = match new_name {
-            Some(name) => {
+        let (path, target) = match (new_name, &self.path, &self.target) {
+            // `create` writes the text.
+            (Some(name), _, _) => {
                 let path = self.create(name)?;
-                (self.path, self.target) = (Some(path.clone()), Some((path.clone(), None)));
-                (self.saved, self.edited) = (Some(self.text.clone()), false);
-                self.disk_changed = false;
-                return Ok(path);
+                (path.clone(), (path, None))
             }
-            None => match (&self.path, &self.target) {
-                (Some(path), Some(target)) => (path.clone(), target.clone()),
-                _ => return Err("a new timeline needs a file name to be saved under".into()),
-            },
+            (None, Some(path), Some(target)) => {
+                write(&target.0, &self.text)?;
+                if let Some(mode) = &target.1 {
+                    let _ = std::fs::set_permissions(&target.0, mode.clone());
+                }
+                (path.clone(), target.clone())
+            }
+            _ => return Err("a new timeline needs a file name to be saved under".into()),
         };
-        write(&target.0, &self.text)?;
-        if let Some(mode) = &target.1 {
-            let _ = std::fs::set_permissions(&target.0, mode.clone());
-        }
         (self.path, self.target) = (Some(path.clone()), Some(target));
         (self.saved, self.edited) = (Some(self.text.clone()), false);
         self.disk_changed = false;

@@ -162,14 +162,17 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
     // Exactly, where digits put the camera closer than f64 tells apart.
     let distance = scene.camera.relative_position().length();
     let json = serde_json::to_value(&scene).unwrap_or_default();
+    let tenths = serde_json::to_value(tenths(scene)).unwrap_or_default();
     crate::timeline::parameters::all()
         .map(|p| {
             // The zoom's distance is a track's alone, not a field of the scene.
             if p.name == crate::timeline::ZOOM_TRACK {
                 return (p.name, Some(vec![distance]));
             }
+            // A field held in f32 reads back a tenth as f32's tenth.
+            let single =
+                field(&tenths, p.name).is_some_and(|v| v.iter().all(|&x| x == 0.1f32 as f64));
             let value = field(&json, p.name);
-            let single = value.is_some() && held_in_f32(&scene, p);
             (
                 p.name,
                 value.map(|v| match single {
@@ -179,6 +182,16 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
             )
         })
         .collect()
+}
+
+/// `scene` with every parameter but the zoom set to a tenth.
+fn tenths(mut scene: Scene) -> Scene {
+    for p in crate::timeline::parameters::all() {
+        if p.name != crate::timeline::ZOOM_TRACK {
+            (p.set)(&mut scene, &[0.1; 3][..p.shape.components()]);
+        }
+    }
+    scene
 }
 
 /// A frame's iteration count as the page shows it: with `Auto`, the count
@@ -240,16 +253,6 @@ fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
         _ if name == "look.exposure" => Some(vec![1.0]),
         _ => None,
     }
-}
-
-/// Whether `scene` holds `parameter` in f32 (colours, a palette): a tenth
-/// set there reads back as f32's tenth.
-fn held_in_f32(scene: &Scene, parameter: &crate::timeline::parameters::Parameter) -> bool {
-    let mut probe = scene.clone();
-    let tenths = vec![0.1; parameter.shape.components()];
-    (parameter.set)(&mut probe, &tenths);
-    let json = serde_json::to_value(&probe).unwrap_or_default();
-    field(&json, parameter.name) == Some(vec![0.1f32 as f64; tenths.len()])
 }
 
 /// `v`, a value of a field held in f32, as the timeline wrote it: JSON

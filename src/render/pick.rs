@@ -42,9 +42,9 @@ pub struct PickFractal {
 /// `width`×`height` image of `scene`, frame `frame` of its film, along the
 /// ray its projection gives it. The pixel must be inside the image.
 pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 2]) -> Pick {
-    let deep = crate::deep::prepare(scene, [width, height]);
-    let in_f64 = crate::deep::in_f64(scene, [width, height]).filter(|_| deep.is_none());
-    let marched = deep.as_ref().or(in_f64.as_ref()).unwrap_or(scene);
+    let rendered = crate::deep::rendered(scene, [width, height], &Default::default());
+    let marched = rendered.as_ref().unwrap_or(scene);
+    let deep = marched.fractal.deep.is_some();
     let camera = marched.camera.frame();
     let ray = camera.ray(x as f64 + 0.5, y as f64 + 0.5, width, height);
     let fractal = &marched.fractal;
@@ -64,7 +64,7 @@ pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 
     let digits = hit.zip(footprint).map(|((h, _), f)| {
         let size = fractal.world(h.point).abs().max_element();
         let significant = crate::deep::digits_for(size, f);
-        crate::deep::world_digits(scene, deep.is_some(), h.point, significant)
+        crate::deep::world_digits(scene, deep, h.point, significant)
     });
     Pick {
         frame,
@@ -75,7 +75,7 @@ pub fn pick(scene: &Scene, frame: u32, [x, y]: [u32; 2], [width, height]: [u32; 
         hit: hit.is_some(),
         point: hit.map(|(h, _)| arr(fractal.world(h.point))),
         point_digits: digits,
-        deep: deep.is_some(),
+        deep,
         distance: hit.map(|(h, _)| h.t),
         normal: hit.map(|(_, n)| arr(n)),
         pixel_footprint: footprint,
@@ -163,9 +163,9 @@ pub fn refine(
         c.position = c.target + away * distance;
         c.position_digits = None;
         s.fractal.iterations = recount(&s);
-        let deep = crate::deep::prepare(&s, [width, height]);
-        let in_f64 = crate::deep::in_f64(&s, [width, height]).filter(|_| deep.is_none());
-        let marched = deep.as_ref().or(in_f64.as_ref()).unwrap_or(&s);
+        let rendered = crate::deep::rendered(&s, [width, height], &Default::default());
+        let marched = rendered.as_ref().unwrap_or(&s);
+        let deep = marched.fractal.deep.is_some();
         let ray =
             marched
                 .camera
@@ -185,7 +185,7 @@ pub fn refine(
         let t = hit.t + onto_the_set(&ray, hit.t, marched);
         let point = ray.at(t);
         let significant = crate::deep::digits_for(size, footprint);
-        let digits = crate::deep::world_digits(&s, deep.is_some(), point, significant);
+        let digits = crate::deep::world_digits(&s, deep, point, significant);
         s.camera.target = marched.fractal.world(point);
         s.camera.target_digits = Some(std::sync::Arc::new(digits));
         steps.push(RefineStep {

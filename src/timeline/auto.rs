@@ -110,10 +110,9 @@ fn centre_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -
     let mut probe = scene.clone();
     probe.fractal.iterations = CENTRE_ITERATIONS;
     probe.quality.max_steps = deep::steps_of(scene, size).saturating_mul(4);
-    let prepared = deep::prepare_with(&probe, size, references);
-    // Marched in the arithmetic the frame renders in.
-    let in_f64 = deep::in_f64(&probe, size).filter(|_| prepared.is_none());
-    let marched = prepared.as_ref().or(in_f64.as_ref()).unwrap_or(&probe);
+    // Marched as the frame renders: deep, or in f64 in place of f32.
+    let rendered = deep::rendered(&probe, size, references);
+    let marched = rendered.as_ref().unwrap_or(&probe);
     // One eye's centre: a stereo image's centre is where its eyes meet.
     let [width, height] = scene.camera.eye_size(size);
     let mono = crate::camera::Camera {
@@ -123,7 +122,7 @@ fn centre_passes(scene: &Scene, size: [u32; 2], references: &deep::References) -
     let (w, h) = (width as Real, height as Real);
     let ray = mono.frame().ray(w * 0.5, h * 0.5, width, height);
     let hit = crate::march::march(&ray, &marched.fractal, &marched.quality).hit?;
-    if prepared.is_some() {
+    if marched.fractal.deep.is_some() {
         return Some(hit.estimate.iterations);
     }
     let value = 1.0 / ray.footprint(hit.t);

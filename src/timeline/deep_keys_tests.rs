@@ -5,9 +5,18 @@ use std::path::Path;
 
 const Y: &str = "-1.10408951367381233764950538762334472132532660078012416551453";
 
-/// A 1 s film of 11 frames whose target track has `keys` (`(time, x)`,
+/// A 1 s film of 10 frames whose target track has `keys` (`(time, x)`,
 /// x as digits) and `interpolation`, y the tip's, z 0.
 fn film(keys: &[(Real, &str)], interpolation: &str, looping: bool) -> Timeline {
+    parsed(keys, interpolation, looping).unwrap()
+}
+
+/// `film`, or what refuses it.
+fn parsed(
+    keys: &[(Real, &str)],
+    interpolation: &str,
+    looping: bool,
+) -> crate::error::Result<Timeline> {
     let keys: Vec<String> = keys
         .iter()
         .map(|(t, x)| format!("(time: {t}, value: ({x:?}, {Y:?}, \"0\"))"))
@@ -17,7 +26,7 @@ fn film(keys: &[(Real, &str)], interpolation: &str, looping: bool) -> Timeline {
          (interpolation: {interpolation}, keys: [{}]) }})",
         keys.join(", ")
     );
-    Timeline::parse(&text, Path::new("test.ron")).unwrap()
+    Timeline::parse(&text, Path::new("test.ron"))
 }
 
 /// The target's x at `time` less `from`, exactly, as f64.
@@ -147,13 +156,12 @@ fn digits_are_refused_where_a_parameter_takes_numbers() {
 
 #[test]
 fn a_loops_end_key_in_digits_must_be_its_start_to_the_last_digit() {
-    let keys = |end: &str| {
-        let text = format!(
-            "(fps: 10, frames: 10, size: (8, 6), loop: true, tracks: {{ \"camera.target\": \
-             (keys: [(time: 0, value: (\"0.5\", \"0\", \"0\")), (time: 0.5, value: (\"0.6\", \"0\", \"0\")), \
-             (time: 1, value: ({end:?}, \"0\", \"0\"))]) }})"
-        );
-        Timeline::parse(&text, Path::new("test.ron")).map(drop)
+    let keys = |end| {
+        parsed(
+            &[(0.0, "0.5"), (0.5, "0.6"), (1.0, end)],
+            "CatmullRom",
+            true,
+        )
     };
     assert!(keys("0.50").is_ok());
     let e = keys("0.5000000000000000000000000000001")

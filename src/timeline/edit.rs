@@ -94,12 +94,10 @@ pub fn keeping_digits(timeline: &Timeline, edit: Edit) -> Edit {
         return edit;
     };
     let scene = time.map_or_else(|| timeline.base.clone(), |t| timeline.scene_at_time(t));
-    let Some(point) = parameter.digits.and_then(|exact| (exact.get)(&scene)) else {
+    let held = parameter.digits.and_then(|exact| (exact.get)(&scene));
+    let Some(point) = held.filter(|_| rounds_digits(&scene, parameter, &value.components())) else {
         return edit;
     };
-    if !rounds_digits(&scene, parameter, &value.components()) {
-        return edit;
-    }
     let value = KeyValue::Digits(point);
     match edit {
         Edit::SetScene { parameter, .. } => Edit::SetScene { parameter, value },
@@ -388,11 +386,8 @@ fn written(value: &KeyValue, parameter: &Parameter) -> Result<String, String> {
             number(*z)?
         )),
         (KeyValue::Digits(point), Shape::Triple) if parameter.digits.is_some() => {
-            let [x, y, z] = point.value.to_array();
-            Ok(match &point.digits {
-                Some(d) => format!("({:?}, {:?}, {:?})", d[0], d[1], d[2]),
-                None => format!("({}, {}, {})", number(x)?, number(y)?, number(z)?),
-            })
+            let d = point.clone().with_digits().digits.unwrap_or_default();
+            Ok(format!("({:?}, {:?}, {:?})", d[0], d[1], d[2]))
         }
         (_, shape) => Err(format!(
             "{} takes {} number(s), got {value:?}",
