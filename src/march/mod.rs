@@ -17,6 +17,7 @@ use crate::math::{sphere_interval, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
 mod cone;
+pub mod judge;
 mod membership;
 mod normal;
 mod walk;
@@ -252,6 +253,7 @@ impl Marcher {
     /// over-relaxing.
     fn take_back(&mut self) {
         self.t += self.previous_distance - self.previous_step;
+        self.previous_step = self.previous_distance;
         self.omega = 1.0;
     }
 
@@ -304,6 +306,13 @@ impl Walk for Marcher {
             // The spheres of free space around this point and the last one do
             // not overlap: the long step may have jumped over surface. Go from
             // the last point by the plain step instead, without relaxation.
+            self.take_back();
+            return None;
+        }
+        if !estimate.escaped && self.previous_step > self.previous_distance {
+            // An over-relaxed step landed inside: only its plain part is
+            // known free, and the rest may hold several crossings, of which
+            // bisecting would find any, not the first. Take the plain step.
             self.take_back();
             return None;
         }

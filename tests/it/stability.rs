@@ -299,6 +299,7 @@ fn rays_running_out_of_steps_are_counted_and_warned_of() {
 
 use mandelreel::camera::Camera;
 use mandelreel::fractal::{DeMethod, Fractal, Precision};
+use mandelreel::march::judge::past_the_set;
 use mandelreel::march::{march, march_by_membership, MarchSettings, Ray};
 use mandelreel::math::DVec3;
 
@@ -420,6 +421,59 @@ fn large_bailouts_and_spheres_keep_the_bulb() {
             ..Fractal::default()
         };
         sees_the_bulb(&f, radius);
+    }
+}
+
+/// The deepest point of the set, in footprints of the hit, that a ray of a
+/// 24×14 grid of the far camera's passes before its hit (`past_the_set` at a
+/// 64th of a footprint), and the number of hits.
+fn deepest_pass_through(fractal: &Fractal, radius: f64) -> (f64, usize) {
+    let settings = MarchSettings {
+        bounding_radius: radius,
+        ..MarchSettings::default()
+    };
+    let frame = far_camera().frame();
+    let (w, h) = (24, 14);
+    let (mut deepest, mut hits) = (0.0f64, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let ray = frame.ray(x as f64 + 0.5, y as f64 + 0.5, w, h);
+            if let Some(hit) = march(&ray, fractal, &settings).hit {
+                hits += 1;
+                let past = past_the_set(fractal, &settings, &ray, hit.t, 1.0 / 64.0);
+                deepest = deepest.max(past);
+            }
+        }
+    }
+    (deepest, hits)
+}
+
+#[test]
+fn no_ray_passes_through_the_set_in_a_wide_sphere_or_at_a_large_bailout() {
+    // An over-relaxed step from the sphere's edge landed inside the bulb,
+    // and bisecting the whole step found a crossing past the first: 222 of
+    // 750 hits lay up to 7.9 footprints inside at bailout 4 in a sphere
+    // of 6, and 94 up to 6.0 at bailout 100 in a sphere of 10.
+    for (bailout, radius, de, precision) in [
+        (4.0, 6.0, DeMethod::Analytic, Precision::F64),
+        (2.0, 3.0, DeMethod::Analytic, Precision::F64),
+        (100.0, 10.0, DeMethod::Analytic, Precision::F64),
+        (4.0, 6.0, DeMethod::Analytic, Precision::F32),
+        (1e30, 1e6, DeMethod::Potential, Precision::F64),
+        (4.0, 6.0, DeMethod::SinhPotential, Precision::F32),
+    ] {
+        let f = Fractal {
+            bailout,
+            de,
+            precision,
+            ..Fractal::default()
+        };
+        let (deepest, hits) = deepest_pass_through(&f, radius);
+        assert!(hits > 50, "{f:?} inside {radius}: {hits} hits");
+        assert!(
+            deepest == 0.0,
+            "{f:?} inside {radius}: a hit {deepest:.2} footprints past the set"
+        );
     }
 }
 

@@ -1,18 +1,13 @@
-//! Where hits land against the membership crossing, and how that crossing
-//! moves with the resolution it is looked for at: the measurement behind
-//! docs/surface.md. Not run by default (half a minute in release):
-//! `cargo test --release --test it -- --ignored surface_against_membership --nocapture`.
+//! Where the estimate's hits land, judged by membership alone
+//! (`march::judge`): near the set in 3D and never past it along the ray.
+//! The full measurement on every example is `examples/surface.rs`.
 
-use mandelreel::march::{march, Ray};
-use mandelreel::math::{DVec3, Real};
+use mandelreel::march::judge::{distance_to_set, past_the_set};
+use mandelreel::march::{march, march_by_membership};
+use mandelreel::math::Real;
 use mandelreel::scene::Scene;
 use mandelreel::timeline::Timeline;
 use std::path::Path;
-
-/// Steps of the membership references, in footprints.
-const REFERENCES: [Real; 3] = [1.0 / 16.0, 1.0 / 64.0, 1.0 / 256.0];
-/// Walk steps measured (0 trusts the estimate).
-const WALKS: [Real; 4] = [0.0, 0.125, 0.5, 2.0];
 
 fn scene(path: &str, frame: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
@@ -20,131 +15,77 @@ fn scene(path: &str, frame: u32) -> Scene {
     Timeline::parse(&text, &path).unwrap().scene_at(frame)
 }
 
-/// The first point of the set along `ray` in steps of `step` footprints,
-/// from `from` (before which the estimate, a lower bound, saw nothing).
-fn crossing(scene: &Scene, ray: &Ray, from: Real, step: Real) -> Option<Real> {
-    let mut t = from;
-    for _ in 0..4_000_000 {
-        let next = t + step * ray.footprint(t);
-        if scene.fractal.contains(ray.at(next)) {
-            return Some(next);
-        }
-        if next > 100.0 {
-            return None;
-        }
-        t = next;
-    }
-    None
-}
-
-/// Whether a point of the set lies within `radius` of `p`, by 4000 samples
-/// of the ball (finds what is thicker than about a thousandth of it).
-fn set_within(scene: &Scene, p: DVec3, radius: Real, seed: u64) -> bool {
-    let mut state = seed | 1;
-    let mut next = || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state >> 11) as Real / (1u64 << 53) as Real * 2.0 - 1.0
-    };
-    (0..4000).any(|_| {
-        let q = DVec3::new(next(), next(), next());
-        q.length() <= 1.0 && scene.fractal.contains(p + q * radius)
-    })
-}
-
-#[derive(Default)]
-struct Tally {
-    errors: Vec<Real>,
-    past: usize,
-}
-
-impl Tally {
-    fn add(&mut self, hit: Real, crossing: Real, footprint: Real) {
-        let e = (hit - crossing) / footprint;
-        self.past += (e > 1.0) as usize;
-        self.errors.push(e.abs());
-    }
-
-    fn row(&mut self) -> String {
-        self.errors.sort_by(|a, b| a.total_cmp(b));
-        let n = self.errors.len().max(1);
-        let mean = self.errors.iter().sum::<Real>() / n as Real;
-        let p99 = self.errors.get(n * 99 / 100).copied().unwrap_or(0.0);
-        let past = 100.0 * self.past as Real / n as Real;
-        format!("{mean:.1} / {p99:.0} / {past:.1}%")
-    }
-}
-
-fn measure(name: &str, path: &str, frame: u32) {
-    let scene = scene(path, frame);
+/// For the hits of every 4th centre ray, both ways, of a 160×90 frame: their 3D
+/// distances to the set in footprints, sorted, and how deep past the set
+/// along its ray the deepest lies.
+fn judged(scene: &Scene) -> (Vec<Real>, Real) {
     let camera = scene.camera.frame();
     let (w, h) = (160u32, 90u32);
-    let mut tallies: Vec<Vec<Tally>> = WALKS
-        .iter()
-        .map(|_| REFERENCES.iter().map(|_| Tally::default()).collect())
-        .collect();
-    let mut evaluations = vec![0u64; WALKS.len()];
-    let (mut pixels, mut near) = (0usize, 0usize);
+    let (mut distances, mut deepest) = (Vec::new(), 0.0f64);
     for y in (0..h).step_by(4) {
         for x in (0..w).step_by(4) {
             let ray = camera.ray(x as Real + 0.5, y as Real + 0.5, w, h);
-            let hits: Vec<Option<Real>> = WALKS
-                .iter()
-                .zip(&mut evaluations)
-                .map(|(&step, spent)| {
-                    let mut quality = scene.quality.clone();
-                    quality.membership_step = step;
-                    let m = march(&ray, &scene.fractal, &quality);
-                    *spent += m.evaluations as u64;
-                    m.hit.map(|h| h.t)
-                })
-                .collect();
-            let Some(trusted) = hits[0] else { continue };
-            pixels += 1;
-            let footprint = ray.footprint(trusted);
-            near += set_within(&scene, ray.at(trusted), footprint, pixels as u64) as usize;
-            for (j, &step) in REFERENCES.iter().enumerate() {
-                let Some(c) = crossing(&scene, &ray, 0.5 * trusted, step) else {
-                    continue;
-                };
-                for (i, hit) in hits.iter().enumerate() {
-                    if let Some(t) = hit {
-                        tallies[i][j].add(*t, c, ray.footprint(c));
-                    }
-                }
-            }
+            let Some(hit) = march(&ray, &scene.fractal, &scene.quality).hit else {
+                continue;
+            };
+            let footprint = ray.footprint(hit.t);
+            let seed = u64::from(y * w + x);
+            let d = distance_to_set(&scene.fractal, hit.point, footprint, 4000, seed);
+            distances.push(d.unwrap_or(Real::INFINITY));
+            let past = past_the_set(&scene.fractal, &scene.quality, &ray, hit.t, 1.0 / 64.0);
+            deepest = deepest.max(past);
         }
     }
-    println!(
-        "\n{name}: {pixels} pixels hit; a point of the set within 1 footprint of the trusted hit: {:.1}%",
-        100.0 * near as Real / pixels.max(1) as Real
-    );
-    for (i, step) in WALKS.iter().enumerate() {
-        let cells: Vec<String> = tallies[i].iter_mut().map(Tally::row).collect();
-        println!(
-            "| {name} | {step} | {:.1} | {} |",
-            evaluations[i] as Real / (w / 4 * h.div_ceil(4)) as Real,
-            cells.join(" | ")
-        );
-    }
+    distances.sort_by(|a, b| a.total_cmp(b));
+    (distances, deepest)
 }
 
 #[test]
-#[ignore = "measurement for docs/surface.md"]
-fn surface_against_membership() {
-    for frame in [0, 60, 100, 119] {
-        measure(&format!("zoom {frame}"), "timelines/zoom.ron", frame);
-    }
-    for frame in [0, 40, 80] {
-        measure(
-            &format!("julia_morph {frame}"),
-            "timelines/julia_morph.ron",
-            frame,
-        );
-    }
-    for example in ["effects", "path_traced", "dof_motion_blur"] {
-        measure(example, &format!("timelines/{example}.ron"), 0);
-    }
-    measure("S1", "timelines/bench/s1_plain.ron", 0);
+fn hits_on_the_benchmark_scene_lie_near_the_set_and_never_past_it() {
+    let (distances, deepest) = judged(&scene("timelines/bench/s1_plain.ron", 0));
+    let n = distances.len();
+    assert!(n > 100, "{n} hits");
+    let within_2 = distances.iter().filter(|&&d| d <= 2.0).count();
+    assert!(
+        within_2 * 100 >= 99 * n,
+        "{within_2} of {n} hits within 2 footprints"
+    );
+    assert!(
+        distances[n / 2] <= 1.0,
+        "median {} footprints",
+        distances[n / 2]
+    );
+    assert_eq!(deepest, 0.0, "a hit {deepest:.2} footprints past the set");
+}
+
+#[test]
+fn the_judge_sees_a_hit_placed_past_or_away_from_the_set() {
+    // The judge can fail: a "hit" 3 footprints past the first point of
+    // the set on the centre ray reads 3 past it; the crossing itself reads
+    // near the set, and a point 20 footprints off it reads none within 8.
+    let scene = scene("timelines/bench/s1_plain.ron", 0);
+    let ray = scene.camera.frame().ray(80.5, 45.5, 160, 90);
+    let (crossing, _) = march_by_membership(
+        &ray,
+        &scene.fractal,
+        &scene.quality,
+        1.0 / 64.0,
+        0.0,
+        10_000_000,
+    );
+    let crossing = crossing.expect("the centre ray meets the bulb");
+    let footprint = ray.footprint(crossing);
+    let beyond = crossing + 3.0 * footprint;
+    let past = past_the_set(&scene.fractal, &scene.quality, &ray, beyond, 1.0 / 64.0);
+    assert!((2.9..=3.1).contains(&past), "{past} footprints past");
+    let near = distance_to_set(&scene.fractal, ray.at(crossing), footprint, 4000, 1);
+    assert!(
+        near.is_some_and(|d| d < 0.1),
+        "{near:?} footprints from the crossing"
+    );
+    let off = ray.at(crossing - 20.0 * footprint);
+    assert_eq!(
+        distance_to_set(&scene.fractal, off, footprint, 4000, 1),
+        None
+    );
 }

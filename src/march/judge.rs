@@ -1,0 +1,66 @@
+//! How near a hit lies to the set, judged by membership tests alone: the 3D
+//! distance to the nearest point of the set, and how deep past the first
+//! point of the set along its ray it lies. The measure of docs/surface.md.
+
+use super::{MarchSettings, Ray};
+use crate::fractal::Fractal;
+use crate::math::{sample_1d, DVec3, Real};
+
+/// Ball radii searched for the set around a hit, in footprints.
+pub const BALLS: [Real; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
+
+/// The distance from `p` to the nearest of `samples` uniform samples of
+/// the set in the smallest ball of `BALLS` (times `footprint`) that holds
+/// one, in footprints; None where none does. An upper bound that tightens
+/// with `samples`; `seed` makes it repeat exactly.
+pub fn distance_to_set(
+    fractal: &Fractal,
+    p: DVec3,
+    footprint: Real,
+    samples: usize,
+    seed: u64,
+) -> Option<Real> {
+    let mut drawn = 0u32;
+    let mut next = || {
+        drawn += 1;
+        2.0 * sample_1d(seed, 0, 0, drawn, 0) - 1.0
+    };
+    BALLS.iter().find_map(|&radius| {
+        let mut nearest = Real::INFINITY;
+        let mut taken = 0;
+        while taken < samples {
+            let q = DVec3::new(next(), next(), next());
+            if q.length_squared() > 1.0 {
+                continue;
+            }
+            taken += 1;
+            if q.length() < nearest && fractal.contains(p + q * (radius * footprint)) {
+                nearest = q.length();
+            }
+        }
+        nearest.is_finite().then_some(nearest * radius)
+    })
+}
+
+/// How far the hit at `hit` on `ray` lies past the first point of the set
+/// along it, in footprints of the hit: 0 where a scan in steps of `step`
+/// footprints from where the ray enters the bounding sphere meets none
+/// before it. Near the camera, where a footprint shrinks to nothing, it
+/// steps no finer than at a hundredth of the hit's distance.
+pub fn past_the_set(
+    fractal: &Fractal,
+    settings: &MarchSettings,
+    ray: &Ray,
+    hit: Real,
+    step: Real,
+) -> Real {
+    let enter = settings.interval(ray).map_or(0.0, |(enter, _)| enter);
+    let mut t = enter.max(0.0);
+    while t < hit {
+        if fractal.contains(ray.at(t)) {
+            return (hit - t) / ray.footprint(hit);
+        }
+        t += step * ray.footprint(t.max(0.01 * hit));
+    }
+    0.0
+}
