@@ -390,3 +390,59 @@ fn the_page_shows_auto_iterations_count_read_only() {
         client.close().await.expect("close the browser");
     });
 }
+
+/// A film with no tracks: whatever is keyed first is a new track.
+const STILL: &str = "(fps: 24, frames: 24, size: (64, 36), scene: (
+    camera: (position: (0, 0.4, 2.6), target: (0, 0, 0), fov_degrees: 40),
+    fractal: (iterations: 8),
+))";
+
+#[test]
+fn a_first_key_away_from_the_start_keeps_the_films_start() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    let dir = Dir::new();
+    dir.write("still.ron", STILL);
+    let (_server, url) = explore(&dir, "still.ron");
+    let (_driver, driver_url) = chromedriver();
+    let profile = dir.path().join("chromium-profile");
+    let runtime = tokio::runtime::Runtime::new().expect("runtime");
+    let said = runtime.block_on(async {
+        let client = browser(&driver_url, &profile).await;
+        client.goto(&url).await.expect("load the page");
+        settled(&client).await;
+        js(&client, "showFrame(12);").await;
+        until(&client, "page.frame === 12").await;
+        settled(&client).await;
+        drag(&client, (60.0, 0.0)).await;
+        until(&client, "page.overrides['camera.position']").await;
+        press(&client, "key").await;
+        let track = "page.state.tracks.find((t) => t.name === 'camera.position')";
+        until(&client, &format!("{track} && {track}.keys.length === 2")).await;
+        let said = js(
+            &client,
+            "return document.getElementById('message').textContent;",
+        )
+        .await;
+        press(&client, "save").await;
+        until(&client, "!page.state.dirty").await;
+        client.close().await.expect("close the browser");
+        said.as_str().unwrap_or_default().to_string()
+    });
+    assert!(said.contains("frame 0"), "the page said: {said}");
+    // Frame 0 renders as before the key; frame 12 does not.
+    dir.write("before.ron", STILL);
+    for (timeline, out) in [("before.ron", "b"), ("still.ron", "a")] {
+        dir.ok(&["render", timeline, "--frames", "0..=12", "--out", out]);
+    }
+    let frame = |out: &str, n: u32| dir.bytes(&format!("{out}/frame_{n:05}.png"));
+    assert!(
+        pixels(&frame("a", 0)) == pixels(&frame("b", 0)),
+        "frame 0 moved"
+    );
+    assert!(
+        pixels(&frame("a", 12)) != pixels(&frame("b", 12)),
+        "frame 12 kept"
+    );
+}

@@ -381,7 +381,16 @@ function changeKeys() {
       values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
     }
   }
-  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
+  const keys = Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
+  return keys.concat(startKeys(keys));
+}
+
+// A first key on a parameter without a track would set it for the whole
+// film: the film's start keeps the value it had, keyed at frame 0.
+function startKeys(keys) {
+  return keys
+    .filter((k) => k.time > 0 && !trackNamed(k.track) && page.values[k.track])
+    .map((k) => ({ kind: "set_key", track: k.track, time: 0, value: page.values[k.track] }));
 }
 
 async function edit(edits, done, then = () => {}) {
@@ -400,7 +409,12 @@ async function edit(edits, done, then = () => {}) {
 function keyChanges() {
   if (!changedNames().length) { say("Nothing changed to key."); return; }
   const edits = changeKeys();
-  edit(edits, `Keyed ${edits.map((e) => e.track).join(", ")} at frame ${page.frame}.`);
+  const here = edits.filter((e) => e.time > 0 || page.frame === 0).map((e) => e.track);
+  const started = edits.filter((e) => e.time === 0 && page.frame > 0).map((e) => e.track);
+  const start = started.length
+    ? ` New track${started.length > 1 ? "s" : ""} ${started.join(", ")} also keyed at frame 0 with the value ${started.length > 1 ? "they" : "it"} had, so the film's start stays as it was.`
+    : "";
+  edit(edits, `Keyed ${here.join(", ")} at frame ${page.frame}.${start}`);
 }
 
 // The zoom's distance is a track's alone, and a zoom track places the camera
