@@ -192,7 +192,8 @@ fn auto_kept(text: &str, name: &str) -> Result<(), String> {
 fn set_field(text: &str, path: &[Step], value: &str) -> Result<String, String> {
     if let Some(range) = spans::range_at(text, path) {
         let range = spans::inside_some(text, range.clone()).unwrap_or(range);
-        return Ok(spliced(text, range, value));
+        let value = keeping_components(&text[range.clone()], value);
+        return Ok(spliced(text, range, &value));
     }
     let given = (0..path.len())
         .rev()
@@ -227,6 +228,7 @@ fn set_key(text: &str, track: &str, time: Real, value: &KeyValue) -> Result<Stri
     };
     if let Some(i) = keys.times.iter().position(|t| (t - time).abs() < SAME_TIME) {
         let range = key_part(text, keys.range(i), "value")?;
+        let value = keeping_components(&text[range.clone()], &value);
         return Ok(spliced(text, range, &value));
     }
     let index = keys.times.iter().filter(|&&t| t < time).count();
@@ -408,6 +410,58 @@ fn number(v: Real) -> Result<String, String> {
     } else {
         format!("{v:?}")
     })
+}
+
+/// `new` written over `old` with every component that reads as the same
+/// number (or the same text) kept as `old` writes it: typing one component
+/// of `(0.55, 0.50, 0.45)` leaves `0.50` as it was, not `0.5`.
+fn keeping_components(old: &str, new: &str) -> String {
+    let (Some(old_parts), Some(new_parts)) = (components(old), components(new)) else {
+        return new.to_string();
+    };
+    if old_parts.len() != new_parts.len() {
+        return new.to_string();
+    }
+    let same = |a: &str, b: &str| {
+        let (a, b) = (a.trim(), b.trim());
+        a == b || matches!((a.parse::<Real>(), b.parse::<Real>()), (Ok(x), Ok(y)) if x == y)
+    };
+    let mut kept = old.to_string();
+    for (o, n) in old_parts.iter().zip(&new_parts).rev() {
+        if !same(&old[o.clone()], &new[n.clone()]) {
+            kept = spliced(&kept, o.clone(), new[n.clone()].trim());
+        }
+    }
+    kept
+}
+
+/// The ranges of a value's components: the parts between the commas of a
+/// `( … )` written on its own, or the whole of a plain number. None where
+/// the text nests, quotes a comma or holds a comment, which are written anew.
+fn components(text: &str) -> Option<Vec<Range<usize>>> {
+    if text.contains("//") || text.contains("/*") {
+        return None;
+    }
+    let trimmed = text.trim();
+    let start = text.len() - text.trim_start().len();
+    let Some(inner) = trimmed.strip_prefix('(').and_then(|t| t.strip_suffix(')')) else {
+        let whole = start..start + trimmed.len();
+        return (!text.contains(['(', ')', ','])).then(|| std::iter::once(whole).collect());
+    };
+    if inner.contains(['(', ')']) || inner.matches('"').count() % 2 != 0 {
+        return None;
+    }
+    let mut parts = Vec::new();
+    let mut from = start + 1;
+    for piece in inner.split(',') {
+        if piece.contains('"') && piece.trim().matches('"').count() != 2 {
+            return None;
+        }
+        let lead = piece.len() - piece.trim_start().len();
+        parts.push(from + lead..from + lead + piece.trim().len());
+        from += piece.len() + 1;
+    }
+    Some(parts)
 }
 
 /// `entry` made child `index` of `block`: on a line of its own, indented

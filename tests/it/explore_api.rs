@@ -883,7 +883,8 @@ fn serving_the_network_needs_a_flag_and_names_its_addresses() {
     assert!(lines[3].contains("plain HTTP"), "{lines:?}");
 }
 
-/// Values the page shows are the file's, not their f32 roundings.
+/// Values the page shows are the file's, not their f32 roundings, and a
+/// value typed is written with nothing else rewritten.
 #[test]
 fn values_are_the_numbers_the_file_writes() {
     let d = Dir::new();
@@ -904,6 +905,22 @@ fn values_are_the_numbers_the_file_writes() {
     assert_eq!(values["effects.fog.density"], json!([0.3]));
     // An f64 field keeps every digit, though f32 holds this value exactly.
     assert_eq!(values["quality.fudge"], json!([0.30000001192092896]));
+    // Typing 0.9 into the first component, as the page sends it, and
+    // saving changes those bytes alone.
+    let typed = json!([
+        0.9,
+        values["look.base_colour"][1],
+        values["look.base_colour"][2]
+    ]);
+    let edit =
+        json!({"edits": [{"kind": "set_scene", "parameter": "look.base_colour", "value": typed}]});
+    s.post("/api/edit", edit).expect(200);
+    s.post("/api/save", json!({})).expect(200);
+    let saved = String::from_utf8(d.bytes("t.ron")).unwrap();
+    assert_eq!(
+        saved,
+        text.replace("(0.55, 0.50, 0.45)", "(0.9, 0.50, 0.45)")
+    );
 }
 
 /// Clients that never finish their headers are dropped in time: with the

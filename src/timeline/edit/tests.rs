@@ -208,6 +208,43 @@ fn a_value_replaces_only_its_own_bytes() {
 }
 
 #[test]
+fn untouched_components_keep_their_text() {
+    // Typing one component wrote the other two anew: `0.50` became `0.5`.
+    let text = "(fps: 1, size: (8, 8), scene: (look: (base_colour: ( 0.55, 0.50,0.450 )), camera: (fov_degrees: 40.0)),
+    tracks: { \"camera.position\": (keys: [(time: 0, value: (1.0, 2.00, 3))]) })";
+    let set = Edit::SetScene {
+        parameter: "look.base_colour".into(),
+        value: KeyValue::Triple(0.9, 0.5, 0.45),
+    };
+    assert_eq!(edited(text, set), text.replace("0.55", "0.9"));
+    let key = Edit::SetKey {
+        track: "camera.position".into(),
+        time: 0.0,
+        value: KeyValue::Triple(1.0, 2.0, -3.5),
+    };
+    assert_eq!(edited(text, key), text.replace("2.00, 3)", "2.00, -3.5)"));
+    let same = Edit::SetScene {
+        parameter: "camera.fov_degrees".into(),
+        value: KeyValue::Number(40.0),
+    };
+    assert_eq!(edited(text, same), text);
+    // A deep point's digits that stay are kept; a moved one is written.
+    let digits = "(fps: 1, size: (8, 8), scene: (camera: (target: (\"0.5\", \"0.25\", \"0\"))))";
+    let point = |y: &str| {
+        let digits = ["0.5", y, "0"].map(|d| d.to_string());
+        KeyValue::Digits(crate::exact::Coordinates {
+            value: glam::DVec3::new(0.5, y.parse().unwrap(), 0.0),
+            digits: Some(std::sync::Arc::new(digits)),
+        })
+    };
+    let set = Edit::SetScene {
+        parameter: "camera.target".into(),
+        value: point("0.125"),
+    };
+    assert_eq!(edited(digits, set), digits.replace("0.25", "0.125"));
+}
+
+#[test]
 fn a_field_is_inserted_like_its_siblings() {
     let text = "(\n    fps: 1,\n    size: (8, 8),\n    scene: (\n        look: (exposure: 1), // bright\n    ),\n)\n";
     let set = |p: &str, v| Edit::SetScene {
