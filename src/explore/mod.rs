@@ -76,6 +76,11 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
                 anyhow::anyhow!("cannot listen on {}:{}: {e}", options.bind, options.port)
             })?;
         let address = listener.local_addr()?;
+        // `::` on most systems answers IPv4 as well.
+        let dual_stack = address.is_ipv6()
+            && socket2::SockRef::from(&listener)
+                .only_v6()
+                .is_ok_and(|only| !only);
         let state = Arc::new(State {
             token: guard::new_token()?,
             address,
@@ -85,7 +90,7 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
             editing: tokio::sync::Mutex::new(()),
             playing: tokio::sync::Semaphore::new(PLAYING_AT_ONCE),
         });
-        announce(&state)?;
+        announce(&state, dual_stack)?;
         tokio::spawn(watch::watch(state.clone()));
         listen::serve(listener, routes::router(state)).await?;
         Ok(())
@@ -94,8 +99,8 @@ pub fn serve(options: Options) -> anyhow::Result<()> {
 
 /// The addresses other machines reach a server bound to `bind` at: its
 /// own, or where it is unspecified (0.0.0.0, ::) every interface's of its
-/// family but loopback.
-fn answering(bind: IpAddr) -> Vec<IpAddr> {
+/// family (of both, `dual_stack`) but loopback.
+fn answering(bind: IpAddr, dual_stack: bool) -> Vec<IpAddr> {
     if !bind.is_unspecified() {
         return vec![bind];
     }
@@ -103,7 +108,7 @@ fn answering(bind: IpAddr) -> Vec<IpAddr> {
     let mut ips: Vec<IpAddr> = interfaces
         .iter()
         .map(|i| i.ip())
-        .filter(|ip| !ip.is_loopback() && ip.is_ipv4() == bind.is_ipv4())
+        .filter(|ip| !ip.is_loopback() && (dual_stack || ip.is_ipv4() == bind.is_ipv4()))
         // A link-local IPv6 address needs its interface named in a URL.
         .filter(|ip| !matches!(ip, IpAddr::V6(v6) if v6.segments()[0] & 0xffc0 == 0xfe80))
         .collect();
@@ -113,11 +118,13 @@ fn answering(bind: IpAddr) -> Vec<IpAddr> {
 }
 
 /// The address to open, on standard output (a script reads it from there).
-fn announce(state: &State) -> anyhow::Result<()> {
+fn announce(state: &State, dual_stack: bool) -> anyhow::Result<()> {
     use std::io::Write as _;
     let name = state.document.lock().expect("document").name();
+    // Unspecified, it answers on the loopback of its own family.
     let host = match state.address.ip() {
-        ip if ip.is_unspecified() => "127.0.0.1".to_string(),
+        IpAddr::V4(ip) if ip.is_unspecified() => "127.0.0.1".to_string(),
+        IpAddr::V6(ip) if ip.is_unspecified() => "[::1]".to_string(),
         IpAddr::V6(ip) => format!("[{ip}]"),
         ip => ip.to_string(),
     };
@@ -133,7 +140,7 @@ fn announce(state: &State) -> anyhow::Result<()> {
     );
     if !state.address.ip().is_loopback() {
         let port = state.address.port();
-        let urls: Vec<String> = answering(state.address.ip())
+        let urls: Vec<String> = answering(state.address.ip(), dual_stack)
             .into_iter()
             .map(|ip| {
                 format!(

@@ -845,12 +845,44 @@ fn serving_the_network_needs_a_flag_and_names_its_addresses() {
         "{}",
         stderr(&refused)
     );
+    let lines = announced(&d, "0.0.0.0");
+    assert!(lines[0].contains(": open http://127.0.0.1:"), "{lines:?}");
+    assert!(
+        lines[2].starts_with("Other machines reach it at "),
+        "{lines:?}"
+    );
+    if let Some(ip) = outward_address() {
+        assert!(
+            lines[2].contains(&format!("http://{ip}:")),
+            "{ip}: {lines:?}"
+        );
+    }
+    assert!(lines[3].contains("plain HTTP"), "{lines:?}");
+    // `::` opens at IPv6's loopback, and where it also answers IPv4 (Linux's
+    // default) it names the IPv4 addresses too.
+    if std::net::TcpListener::bind("[::]:0").is_err() {
+        return;
+    }
+    let lines = announced(&d, "::");
+    assert!(lines[0].contains(": open http://[::1]:"), "{lines:?}");
+    let dual =
+        std::fs::read_to_string("/proc/sys/net/ipv6/bindv6only").is_ok_and(|v| v.trim() == "0");
+    if let (true, Some(ip)) = (dual, outward_address()) {
+        assert!(
+            lines[2].contains(&format!("http://{ip}:")),
+            "{ip}: {lines:?}"
+        );
+    }
+}
+
+/// The first four lines `explore` prints, serving `t.ron` in `d` at `bind`.
+fn announced(d: &Dir, bind: &str) -> Vec<String> {
     let mut child = d
         .command(&[
             "explore",
             "t.ron",
             "--bind",
-            "0.0.0.0",
+            bind,
             "--network",
             "--port",
             "0",
@@ -869,18 +901,7 @@ fn serving_the_network_needs_a_flag_and_names_its_addresses() {
         .collect();
     child.kill().unwrap();
     child.wait().unwrap();
-    assert!(lines[0].contains(": open http://127.0.0.1:"), "{lines:?}");
-    assert!(
-        lines[2].starts_with("Other machines reach it at "),
-        "{lines:?}"
-    );
-    if let Some(ip) = outward_address() {
-        assert!(
-            lines[2].contains(&format!("http://{ip}:")),
-            "{ip}: {lines:?}"
-        );
-    }
-    assert!(lines[3].contains("plain HTTP"), "{lines:?}");
+    lines
 }
 
 /// Values the page shows are the file's, not their f32 roundings, and a
