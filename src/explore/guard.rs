@@ -37,7 +37,12 @@ pub async fn check(
         .query()
         .filter(|_| QUERY_TOKEN_PATHS.contains(&uri.path()));
     match refusal(&state, request.headers(), query) {
-        Some(reason) => (StatusCode::FORBIDDEN, reason).into_response(),
+        // Closed after the answer: a client without the token holds no
+        // connection open by sending one complete request after another.
+        Some(reason) => {
+            let close = [(header::CONNECTION, "close")];
+            (StatusCode::FORBIDDEN, close, reason).into_response()
+        }
         None => next.run(request).await,
     }
 }

@@ -980,6 +980,32 @@ fn slow_clients_cannot_starve_the_page() {
     drop(slow);
 }
 
+/// A request without the token is answered and its connection closed, so
+/// no client without it holds a connection by asking again and again.
+#[test]
+fn a_refused_request_ends_its_connection() {
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 9.0));
+    let s = explore(&d, "t.ron");
+    let mut stream = TcpStream::connect(("127.0.0.1", s.port)).unwrap();
+    stream
+        .set_read_timeout(Some(Duration::from_secs(20)))
+        .unwrap();
+    let ask = b"GET /api/state HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n";
+    stream.write_all(ask).unwrap();
+    // Read to the end: the server closes the connection after its answer
+    // (a kept-alive one would time out the read instead).
+    let mut answer = String::new();
+    stream
+        .read_to_string(&mut answer)
+        .expect("the server closes the connection");
+    assert!(answer.starts_with("HTTP/1.1 403"), "{answer}");
+    assert!(
+        answer.to_lowercase().contains("connection: close"),
+        "{answer}"
+    );
+}
+
 /// Playback frames take turns: however many are asked for at once, at
 /// most two render together, and each is answered.
 #[test]
