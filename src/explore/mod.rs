@@ -55,8 +55,12 @@ pub enum Event {
     /// The file changed on disk: taken in (`dirty` false), or kept apart
     /// from edits not yet saved (`dirty` true).
     File { dirty: bool, error: Option<String> },
-    /// Rows done of the render in progress.
-    Progress { done: u32, of: u32 },
+    /// Rows done of the full-size stage in progress (`full` or `final`).
+    Progress {
+        done: u32,
+        of: u32,
+        stage: &'static str,
+    },
 }
 
 /// Opens the timeline, listens, prints the page's address, and serves

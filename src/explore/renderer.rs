@@ -45,6 +45,10 @@ pub struct Renders {
     generation: AtomicU64,
     pub rows_done: AtomicU32,
     pub rows_total: AtomicU32,
+    /// Whose rows those are: 1 the full stage, 2 the final one.
+    pub rows_stage: AtomicU32,
+    /// Full-size stages begun: each is announced, though it repeat the last.
+    pub rows_renders: AtomicU32,
     /// Pixels the next quick stage takes, from the pace of the last ones.
     quick_pixels: AtomicU64,
 }
@@ -55,6 +59,8 @@ impl Default for Renders {
             generation: AtomicU64::new(0),
             rows_done: AtomicU32::new(0),
             rows_total: AtomicU32::new(0),
+            rows_stage: AtomicU32::new(0),
+            rows_renders: AtomicU32::new(0),
             quick_pixels: AtomicU64::new(QUICK_PIXELS.2),
         }
     }
@@ -85,13 +91,18 @@ impl Renders {
             first.samples_per_pixel = 1;
             vec![first]
         };
-        if stage == Stage::Final {
+        // The full-size stages take seconds at large sizes: they show progress.
+        let counted = matches!(stage, Stage::Full | Stage::Final);
+        if counted {
             self.rows_done.store(0, Ordering::Relaxed);
             let waves = crate::render::wave_count(&scenes[0]);
             self.rows_total.store(height * waves, Ordering::Relaxed);
+            let whose = if stage == Stage::Full { 1 } else { 2 };
+            self.rows_stage.store(whose, Ordering::Relaxed);
+            self.rows_renders.fetch_add(1, Ordering::Relaxed);
         }
         let on_row = || {
-            if stage == Stage::Final {
+            if counted {
                 self.rows_done.fetch_add(1, Ordering::Relaxed);
             }
         };

@@ -14,7 +14,7 @@ const PROGRESS_EVERY: Duration = Duration::from_millis(200);
 pub async fn watch(state: Arc<State>) {
     let mut file = tokio::time::interval(EVERY);
     let mut progress = tokio::time::interval(PROGRESS_EVERY);
-    let mut shown = (0, 0);
+    let mut shown = (0, 0, 0, 0);
     loop {
         tokio::select! {
             _ = file.tick() => {
@@ -30,10 +30,13 @@ pub async fn watch(state: Arc<State>) {
                 let now = (
                     state.renders.rows_done.load(Ordering::Relaxed),
                     state.renders.rows_total.load(Ordering::Relaxed),
+                    state.renders.rows_stage.load(Ordering::Relaxed),
+                    state.renders.rows_renders.load(Ordering::Relaxed),
                 );
                 if now != shown {
                     shown = now;
-                    super::routes::announce(&state, Event::Progress { done: now.0, of: now.1 });
+                    let stage = if now.2 == 1 { "full" } else { "final" };
+                    super::routes::announce(&state, Event::Progress { done: now.0, of: now.1, stage });
                 }
             }
         }

@@ -446,3 +446,54 @@ fn a_first_key_away_from_the_start_keeps_the_films_start() {
         "frame 12 kept"
     );
 }
+
+/// Every parameter's name whole, nothing wider than the window, disabled
+/// buttons unlike enabled ones, and what the page says kept to the latest:
+/// at a laptop's and a desktop's size. With `MANDELREEL_EXPLORE_SCREENSHOTS`
+/// set to a folder, the page is saved there at each size.
+#[test]
+fn the_page_reads_whole_at_laptop_and_desktop_sizes() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    let dir = Dir::new();
+    let effects = std::fs::read_to_string("timelines/effects.ron").expect("effects.ron");
+    dir.write("effects.ron", &effects);
+    let (_server, url) = explore(&dir, "effects.ron");
+    let (_driver, driver_url) = chromedriver();
+    let profile = dir.path().join("chromium-profile");
+    let runtime = tokio::runtime::Runtime::new().expect("runtime");
+    runtime.block_on(async {
+        let client = browser(&driver_url, &profile).await;
+        for (width, height) in [(1366u32, 768u32), (1920, 1080)] {
+            client.set_window_size(width, height).await.expect("window size");
+            client.goto(&url).await.expect("load the page");
+            settled(&client).await;
+            let cut = js(&client, "return [...document.querySelectorAll('.param:not([hidden]) label')]
+                .filter((l) => l.scrollWidth > l.clientWidth + 1).map((l) => l.title);").await;
+            assert_eq!(cut, json!([]), "{width}x{height}: names cut");
+            let wide = js(&client, "return document.documentElement.scrollWidth - window.innerWidth;").await;
+            assert!(wide.as_f64() <= Some(0.0), "{width}x{height}: {wide} px too wide");
+            let colours = js(&client, "return ['key', 'save'].map((id) => getComputedStyle(document.getElementById(id)).color);").await;
+            assert_ne!(colours[0], colours[1], "a disabled button looks like an enabled one");
+            // The full-size stages' progress comes back by event.
+            js(&client, "refresh();").await;
+            until(&client, "document.getElementById('progress').title.startsWith('final')").await;
+            settled(&client).await;
+            if let Some(folder) = std::env::var_os("MANDELREEL_EXPLORE_SCREENSHOTS") {
+                let png = client.screenshot().await.expect("screenshot");
+                let path = std::path::Path::new(&folder).join(format!("explore-{width}x{height}.png"));
+                std::fs::write(path, png).expect("write the screenshot");
+            }
+        }
+        // A frame past the end is shown as the last, and said so; an error
+        // then replaces that line rather than standing beside it.
+        js(&client, "showFrame(9999);").await;
+        until(&client, "document.getElementById('message').textContent.includes('frames 0 to')").await;
+        js(&client, "document.getElementById('size').value = '7x'; refresh();").await;
+        until(&client, "!document.getElementById('alert').hidden").await;
+        let message = js(&client, "return document.getElementById('message').textContent;").await;
+        assert_eq!(message, json!(""), "a stale line beside the error");
+        client.close().await.expect("close the browser");
+    });
+}

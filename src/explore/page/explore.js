@@ -50,9 +50,11 @@ function currentView(withOverrides = true) {
 
 function say(text) { $("message").textContent = text; }
 
+// An error replaces the last status line, which no longer holds beside it.
 function alertShown(text) {
   $("alert").textContent = text || "";
   $("alert").hidden = !text;
+  if (text) say("");
 }
 
 // ---- the timeline ---------------------------------------------------------
@@ -76,16 +78,18 @@ async function loadState(state) {
 function trackNamed(name) { return page.state.tracks.find((t) => t.name === name); }
 
 async function showFrame(frame) {
-  frame = Math.max(0, Math.min(page.state.frames - 1, frame | 0));
+  const asked = frame | 0;
+  frame = Math.max(0, Math.min(page.state.frames - 1, asked));
+  if (frame !== asked) say(`The film has frames 0 to ${page.state.frames - 1}: showing frame ${frame}.`);
   page.frame = frame;
   $("frame").value = $("slider").value = frame;
   $("time").textContent = `t = ${(frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
-  const asked = page.valuesAsked = (page.valuesAsked || 0) + 1;
+  const serial = page.valuesAsked = (page.valuesAsked || 0) + 1;
   const [values, iterations] = await Promise.all([
     api(`/api/values?frame=${frame}`).then((r) => r.json()),
     api(`/api/iterations?frame=${frame}`).then((r) => r.json()),
   ]);
-  if (asked !== page.valuesAsked) return;  // asked again meanwhile
+  if (serial !== page.valuesAsked) return;  // asked again meanwhile
   page.values = values;
   page.iterations = iterations;
   drawStrip();
@@ -105,13 +109,24 @@ async function refresh() {
     let shown = await stage(view, "quick", null, serial);
     if (!shown || page.dragging) return;
     if ((view.samples || page.state.samples) > 1) {
+      rendering("full", serial);
       const full = await stage(view, "full", shown.generation, serial);
       if (!full) return;
     }
+    rendering("final", serial);
     await stage(view, "final", shown.generation, serial);
   } catch (error) {
     if (serial === page.serial) alertShown(error.message);
   }
+}
+
+// The full-size stages take seconds at large sizes: the bar starts again
+// and the overlay says what is coming (the server's events fill the bar).
+function rendering(name, serial) {
+  if (serial !== page.serial) return;
+  $("progress").value = 0;
+  const size = currentView().size || `${page.state.width}x${page.state.height}`;
+  $("overlay").textContent += ` · rendering ${name} at ${size}…`;
 }
 
 async function stage(view, name, generation, serial) {
@@ -138,8 +153,19 @@ async function stage(view, name, generation, serial) {
   img.dataset.serial = serial;
   img.dataset.size = size;
   $("overlay").textContent = `frame ${view.frame} · ${name} · ${size} · ${samples} sample(s) · ${seconds} s`;
+  img.onload = () => enlarged(img);
   if (name === "final") { $("progress").value = 1; alertShown(""); }
   return { generation: Number(response.headers.get("x-generation")) };
+}
+
+// A small frame stretched to the page's width looks soft: say so, and
+// where the pixels come from.
+function enlarged(img) {
+  // The picture is fitted inside the element (object-fit: contain).
+  const times = Math.min(img.clientWidth / img.naturalWidth, img.clientHeight / img.naturalHeight);
+  if (times > 1.5 && !$("overlay").textContent.includes("shown ×")) {
+    $("overlay").textContent += ` · shown ×${times.toFixed(1)}: Size (right) sets the pixels`;
+  }
 }
 
 // While a drag or the wheel moves the view, only quick stages are asked for,
@@ -534,7 +560,11 @@ function buildControls() {
     row.className = "param";
     row.dataset.name = name;
     const label = document.createElement("label");
-    label.textContent = name.slice(group.length + 1);
+    // A long name breaks after a dot, where it reads best.
+    name.slice(group.length + 1).split(".").forEach((part, i) => {
+      if (i > 0) label.append(".", document.createElement("wbr"));
+      label.append(part);
+    });
     label.title = name;
     row.append(label);
     for (let i = 0; i < components; i++) {
@@ -561,7 +591,10 @@ function fillControls() {
     // A fisheye's angle and stereo's separation only where the camera has them.
     row.hidden = !numbers && ["camera.projection.degrees", "camera.stereo.eye_separation"].includes(name);
     row.querySelectorAll("input").forEach((input, i) => {
-      input.value = numbers ? Number(numbers[i].toPrecision(10)) : "";
+      // Every digit the file holds (the shortest text that reads back as
+      // the number): a component nobody touched goes back unchanged.
+      input.value = numbers ? String(numbers[i]) : "";
+      input.title = input.value;
       input.placeholder = numbers ? "" : "off";
     });
   }
@@ -669,6 +702,7 @@ function listen() {
     const event = JSON.parse(message.data);
     if (event.kind === "progress") {
       $("progress").value = event.of ? event.done / event.of : 0;
+      $("progress").title = `${event.stage}: ${event.done} of ${event.of} rows`;
     } else if (event.kind === "file") {
       if (event.error) alertShown(`The file on disk has an error; the page keeps the last valid timeline.\n${event.error}`);
       else if (event.dirty) alertShown("The file changed on disk. Save writes over it; Reload takes it and drops the edits here.");
