@@ -82,6 +82,36 @@ fn chromedriver() -> (Killed, String) {
 
 /// Headless Chromium as root in a container needs no sandbox, and must not
 /// reach out to the network it does not have.
+/// The explorer serving one timeline of `dir`, chromedriver, and the
+/// runtime a test drives a browser session with.
+struct Session {
+    _server: Killed,
+    _driver: Killed,
+    url: String,
+    driver_url: String,
+    profile: std::path::PathBuf,
+    runtime: tokio::runtime::Runtime,
+}
+
+impl Session {
+    fn open(dir: &Dir, timeline: &str) -> Session {
+        let (_server, url) = explore(dir, timeline);
+        let (_driver, driver_url) = chromedriver();
+        Session {
+            _server,
+            _driver,
+            url,
+            driver_url,
+            profile: dir.path().join("chromium-profile"),
+            runtime: tokio::runtime::Runtime::new().expect("runtime"),
+        }
+    }
+
+    async fn client(&self) -> Client {
+        browser(&self.driver_url, &self.profile).await
+    }
+}
+
 async fn browser(driver: &str, profile: &std::path::Path) -> Client {
     let args = [
         "--headless=new",
@@ -247,12 +277,10 @@ fn the_page_drags_zooms_keys_and_saves_what_render_renders() {
         .expect("zoom.ron")
         .replace("size: (320, 180)", "size: (128, 72)");
     dir.write("zoom.ron", &original);
-    let (_server, url) = explore(&dir, "zoom.ron");
-    let (_driver, driver_url) = chromedriver();
-    let profile = dir.path().join("chromium-profile");
-    let runtime = tokio::runtime::Runtime::new().expect("runtime");
-    let (seen_0, seen_12) = runtime.block_on(async {
-        let client = browser(&driver_url, &profile).await;
+    let session = Session::open(&dir, "zoom.ron");
+    let url = session.url.clone();
+    let (seen_0, seen_12) = session.runtime.block_on(async {
+        let client = session.client().await;
         let seen = author(&client, &url).await;
         if let Some(path) = std::env::var_os("MANDELREEL_EXPLORE_SCREENSHOT") {
             std::fs::write(path, client.screenshot().await.expect("screenshot")).expect("write");
@@ -366,12 +394,10 @@ fn the_page_shows_auto_iterations_count_read_only() {
     dir.write("zoom.ron", crate::auto::ZOOM);
     let info = crate::util::stdout(&dir.ok(&["info", "zoom.ron"]));
     let count = crate::auto::counts(&info)[2];
-    let (_server, url) = explore(&dir, "zoom.ron");
-    let (_driver, driver_url) = chromedriver();
-    let profile = dir.path().join("chromium-profile");
-    let runtime = tokio::runtime::Runtime::new().expect("runtime");
-    runtime.block_on(async {
-        let client = browser(&driver_url, &profile).await;
+    let session = Session::open(&dir, "zoom.ron");
+    let url = session.url.clone();
+    session.runtime.block_on(async {
+        let client = session.client().await;
         client.goto(&url).await.expect("load the page");
         settled(&client).await;
         js(&client, "showFrame(2);").await;
@@ -404,12 +430,10 @@ fn a_first_key_away_from_the_start_keeps_the_films_start() {
     }
     let dir = Dir::new();
     dir.write("still.ron", STILL);
-    let (_server, url) = explore(&dir, "still.ron");
-    let (_driver, driver_url) = chromedriver();
-    let profile = dir.path().join("chromium-profile");
-    let runtime = tokio::runtime::Runtime::new().expect("runtime");
-    let said = runtime.block_on(async {
-        let client = browser(&driver_url, &profile).await;
+    let session = Session::open(&dir, "still.ron");
+    let url = session.url.clone();
+    let said = session.runtime.block_on(async {
+        let client = session.client().await;
         client.goto(&url).await.expect("load the page");
         settled(&client).await;
         js(&client, "showFrame(12);").await;
@@ -459,12 +483,10 @@ fn the_page_reads_whole_at_laptop_and_desktop_sizes() {
     let dir = Dir::new();
     let effects = std::fs::read_to_string("timelines/effects.ron").expect("effects.ron");
     dir.write("effects.ron", &effects);
-    let (_server, url) = explore(&dir, "effects.ron");
-    let (_driver, driver_url) = chromedriver();
-    let profile = dir.path().join("chromium-profile");
-    let runtime = tokio::runtime::Runtime::new().expect("runtime");
-    runtime.block_on(async {
-        let client = browser(&driver_url, &profile).await;
+    let session = Session::open(&dir, "effects.ron");
+    let url = session.url.clone();
+    session.runtime.block_on(async {
+        let client = session.client().await;
         for (width, height) in [(1366u32, 768u32), (1920, 1080)] {
             client.set_window_size(width, height).await.expect("window size");
             client.goto(&url).await.expect("load the page");
