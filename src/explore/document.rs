@@ -301,11 +301,24 @@ fn plain_name(name: &str) -> bool {
             || ranges.iter().any(|&(a, b)| (a..=b).contains(&c))
     };
     let stem = name.strip_suffix(".ron").unwrap_or_default();
+    let chars: Vec<char> = name.chars().collect();
+    let hidden = (0..chars.len()).any(|i| invisible(chars[i]) && !joiner_in_a_word(&chars, i));
     // Room in a file name's 255 bytes for the temporary it is written as.
     !stem.is_empty()
         && name.len() <= 150
         && !name.starts_with('.')
         && stem.trim() == stem
         && !name.contains(['/', '\\'])
-        && !name.chars().any(invisible)
+        && !hidden
+}
+
+/// Whether `chars[i]` is a zero-width joiner or non-joiner between two
+/// letters, where Persian, Arabic and Indic words need it to be spelt
+/// right (as Unicode allows it in identifiers); anywhere else it hides.
+fn joiner_in_a_word(chars: &[char], i: usize) -> bool {
+    let letter = |j: Option<usize>| {
+        j.and_then(|j| chars.get(j))
+            .is_some_and(|c| c.is_alphabetic())
+    };
+    matches!(chars[i], '\u{200C}' | '\u{200D}') && letter(i.checked_sub(1)) && letter(Some(i + 1))
 }

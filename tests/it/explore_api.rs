@@ -377,6 +377,10 @@ fn save_writes_only_its_file_and_new_plain_names() {
         "x .ron",
         "x\u{200B}.ron",
         "film\u{E0041}.ron",
+        // A joiner outside a word hides.
+        "\u{200C}x.ron",
+        "x\u{200D}.ron",
+        "x\u{200D}\u{200D}y.ron",
         ".ron",
     ];
     for name in bad {
@@ -406,6 +410,10 @@ fn save_writes_only_its_file_and_new_plain_names() {
     assert_eq!(d.bytes("work/copy.ron"), text.as_bytes());
     assert!(copy.json()["path"].as_str().unwrap().ends_with("copy.ron"));
     assert_eq!(d.files("work"), ["a", "copy.ron", "other.ron", "t.ron"]);
+    // Persian spells "the films" (فیلم‌ها) with a non-joiner between letters.
+    let persian = "\u{0641}\u{06CC}\u{0644}\u{0645}\u{200C}\u{0647}\u{0627}.ron";
+    s.post("/api/save", json!({ "name": persian })).expect(200);
+    assert_eq!(d.bytes(&format!("work/{persian}")), text.as_bytes());
 }
 
 #[test]
