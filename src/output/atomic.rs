@@ -7,6 +7,7 @@ use crate::host::{file_age, writer_is_dead_here, writer_tag};
 use std::fs::File;
 use std::io::BufWriter;
 use std::path::{Path, PathBuf};
+use tempfile::NamedTempFile;
 
 /// Replaces `path` whole or not at all: `write` fills a hidden temporary file
 /// beside it (`.<name>.<host>.<pid>.<random>.partial`, unique per writer, so a
@@ -80,25 +81,39 @@ fn through_temporary(
         .map_err(|e| Error::io(path, e.into_error()))?
         .sync_all()
         .map_err(|e| Error::io(path, e))?;
-    let held = crate::interrupt::hold();
-    if !clobber {
-        // Claimed, then written over whole: under the interrupt lock, so
-        // no empty claim is left. (tempfile's no-clobber persist needs a
-        // rename flag or hard links, which some mounts refuse.)
-        std::fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .open(path)
-            .map_err(|e| Error::io(path, e))?;
-    }
-    if let Err(e) = temp.persist(path) {
+    let _held = crate::interrupt::hold();
+    let temp = match clobber {
+        true => Some(temp),
+        false => claimed(temp, path)?,
+    };
+    if let Err(e) = temp.map_or(Ok(()), |temp| temp.persist(path).map(drop)) {
         if !clobber {
             let _ = std::fs::remove_file(path);
         }
         return Err(Error::io(path, e.error));
     }
-    drop(held);
     Ok(())
+}
+
+/// `temp` moved to `path` where nothing is there (renameat2's NOREPLACE, or
+/// a hard link): never an empty file in its place, even after kill -9. Where
+/// the mount refuses both, `path` is claimed empty and `temp` handed back to
+/// be renamed over it, under the caller's interrupt lock.
+fn claimed(temp: NamedTempFile, path: &Path) -> Result<Option<NamedTempFile>> {
+    match temp.persist_noclobber(path) {
+        Ok(_) => Ok(None),
+        Err(e) if e.error.kind() == std::io::ErrorKind::AlreadyExists => {
+            Err(Error::io(path, e.error))
+        }
+        Err(e) => {
+            std::fs::OpenOptions::new()
+                .write(true)
+                .create_new(true)
+                .open(path)
+                .map_err(|e| Error::io(path, e))?;
+            Ok(Some(e.file))
+        }
+    }
 }
 
 /// `text` written over `path` whole, through a temporary file.
