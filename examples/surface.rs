@@ -1,7 +1,8 @@
 //! How close the estimate's hits come to the set on every example, judged
 //! by membership alone (`march::judge`): the 3D distance from each hit to
 //! the set, and a scan of each ray for set it passed through before the hit.
-//! Optional arguments set every scene's `hit_threshold` and `membership_step`.
+//! Optional arguments set every scene's `hit_threshold`, `membership_step`
+//! and `over_relaxation`.
 //! The measurement behind docs/surface.md:
 //! `cargo run --release --example surface` (half a minute on two cores).
 
@@ -38,6 +39,9 @@ fn measure(name: &str, path: &str, frame: u32) {
     }
     if let Some(step) = arg(2) {
         scene.quality.membership_step = step;
+    }
+    if let Some(omega) = arg(3) {
+        scene.quality.over_relaxation = omega;
     }
     let camera = scene.camera.frame();
     let (w, h, every) = (160u32, 90u32, 6u32);
