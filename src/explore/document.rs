@@ -312,13 +312,31 @@ fn plain_name(name: &str) -> bool {
         && !hidden
 }
 
-/// Whether `chars[i]` is a zero-width joiner or non-joiner between two
-/// letters, where Persian, Arabic and Indic words need it to be spelt
-/// right (as Unicode allows it in identifiers); anywhere else it hides.
+/// Whether `chars[i]` is a zero-width joiner or non-joiner where a word
+/// needs it to be spelt right, as Unicode's identifier rules (UAX #31)
+/// allow: after an Indic virama, or a non-joiner between two letters of
+/// the Arabic script (Persian writes one in "the films"). Anywhere else
+/// it hides: `rep\u{200D}ort.ron` looks like `report.ron`.
 fn joiner_in_a_word(chars: &[char], i: usize) -> bool {
-    let letter = |j: Option<usize>| {
-        j.and_then(|j| chars.get(j))
-            .is_some_and(|c| c.is_alphabetic())
+    const VIRAMAS: [char; 13] = [
+        '\u{094D}', '\u{09CD}', '\u{0A4D}', '\u{0ACD}', '\u{0B4D}', '\u{0BCD}', '\u{0C4D}',
+        '\u{0CCD}', '\u{0D4D}', '\u{0DCA}', '\u{1039}', '\u{17D2}', '\u{1B44}',
+    ];
+    let arabic = |c: &char| {
+        let ranges = [
+            ('\u{0620}', '\u{06FF}'),
+            ('\u{0750}', '\u{077F}'),
+            ('\u{08A0}', '\u{08FF}'),
+        ];
+        c.is_alphabetic() && ranges.iter().any(|&(a, b)| (a..=b).contains(c))
     };
-    matches!(chars[i], '\u{200C}' | '\u{200D}') && letter(i.checked_sub(1)) && letter(Some(i + 1))
+    let before = i.checked_sub(1).and_then(|j| chars.get(j));
+    match chars[i] {
+        '\u{200D}' => before.is_some_and(|c| VIRAMAS.contains(c)),
+        '\u{200C}' => {
+            before.is_some_and(|c| VIRAMAS.contains(c))
+                || (before.is_some_and(arabic) && chars.get(i + 1).is_some_and(arabic))
+        }
+        _ => false,
+    }
 }

@@ -6,6 +6,9 @@ use super::{MarchSettings, Ray};
 use crate::fractal::Fractal;
 use crate::math::{sample_1d, DVec3, Real};
 
+/// The most points `past_the_set` tests on one ray.
+const MOST_STEPS: u32 = 1 << 24;
+
 /// Ball radii searched for the set around a hit, in footprints.
 pub const BALLS: [Real; 6] = [0.25, 0.5, 1.0, 2.0, 4.0, 8.0];
 
@@ -46,7 +49,8 @@ pub fn distance_to_set(
 /// along it, in footprints of the hit: 0 where a scan in steps of `step`
 /// footprints from where the ray enters the bounding sphere meets none
 /// before it. Near the camera, where a footprint shrinks to nothing, it
-/// steps no finer than at a hundredth of the hit's distance.
+/// steps no finer than at a hundredth of the hit's distance; it gives up
+/// (0) after `MOST_STEPS` points.
 pub fn past_the_set(
     fractal: &Fractal,
     settings: &MarchSettings,
@@ -56,11 +60,17 @@ pub fn past_the_set(
 ) -> Real {
     let enter = settings.interval(ray).map_or(0.0, |(enter, _)| enter);
     let mut t = enter.max(0.0);
-    while t < hit {
+    // At most `MOST_STEPS`, and never a step lost to rounding (a deep
+    // frame's footprint may be below t's ulp): the scan always ends.
+    for _ in 0..MOST_STEPS {
+        if t >= hit {
+            break;
+        }
         if fractal.contains(ray.at(t)) {
             return (hit - t) / ray.footprint(hit);
         }
-        t += step * ray.footprint(t.max(0.01 * hit));
+        let dt = step * ray.footprint(t.max(0.01 * hit));
+        t += dt.max(4.0 * Real::EPSILON * t.abs());
     }
     0.0
 }

@@ -55,7 +55,8 @@ pub struct MarchSettings {
     /// Over-relaxed sphere tracing (Keinert et al. 2014, "Enhanced Sphere
     /// Tracing"): steps of `over_relaxation × fudge × estimate` while the
     /// unbounding spheres of successive points overlap; where they do not,
-    /// the step is taken back and the ray goes on at the plain step. 1 turns it off.
+    /// or the step lands inside the set, the step is taken back and the ray
+    /// goes on at the plain step. 1 turns it off.
     pub over_relaxation: Real,
     /// Camera rays, a block of neighbouring pixels (`cone_block`: 16 is 4×4),
     /// that first march together along one cone holding them all, until

@@ -453,6 +453,11 @@ fn components(text: &str) -> Option<Vec<Range<usize>>> {
     }
     let mut parts = Vec::new();
     let mut from = start + 1;
+    // A trailing comma, as a value laid out over lines may have.
+    let inner = match inner.trim_end().strip_suffix(',') {
+        Some(listed) => listed,
+        None => inner,
+    };
     for piece in inner.split(',') {
         if piece.contains('"') && piece.trim().matches('"').count() != 2 {
             return None;

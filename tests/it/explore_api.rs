@@ -381,6 +381,8 @@ fn save_writes_only_its_file_and_new_plain_names() {
         "\u{200C}x.ron",
         "x\u{200D}.ron",
         "x\u{200D}\u{200D}y.ron",
+        // Between Latin letters it only hides: it shows as "report.ron".
+        "rep\u{200D}ort.ron",
         ".ron",
     ];
     for name in bad {
@@ -414,6 +416,10 @@ fn save_writes_only_its_file_and_new_plain_names() {
     let persian = "\u{0641}\u{06CC}\u{0644}\u{0645}\u{200C}\u{0647}\u{0627}.ron";
     s.post("/api/save", json!({ "name": persian })).expect(200);
     assert_eq!(d.bytes(&format!("work/{persian}")), text.as_bytes());
+    // Hindi's half-form ksha (क्‍ष) takes a joiner after the virama.
+    let hindi = "\u{0915}\u{094D}\u{200D}\u{0937}.ron";
+    s.post("/api/save", json!({ "name": hindi })).expect(200);
+    assert_eq!(d.bytes(&format!("work/{hindi}")), text.as_bytes());
 }
 
 #[test]

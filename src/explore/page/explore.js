@@ -109,11 +109,11 @@ async function refresh() {
     let shown = await stage(view, "quick", null, serial);
     if (!shown || page.dragging) return;
     if ((view.samples || page.state.samples) > 1) {
-      rendering("full", serial);
+      rendering(view, "full", serial);
       const full = await stage(view, "full", shown.generation, serial);
       if (!full) return;
     }
-    rendering("final", serial);
+    rendering(view, "final", serial);
     await stage(view, "final", shown.generation, serial);
   } catch (error) {
     if (serial === page.serial) alertShown(error.message);
@@ -122,10 +122,10 @@ async function refresh() {
 
 // The full-size stages take seconds at large sizes: the bar starts again
 // and the overlay says what is coming (the server's events fill the bar).
-function rendering(name, serial) {
+function rendering(view, name, serial) {
   if (serial !== page.serial) return;
   $("progress").value = 0;
-  const size = currentView().size || `${page.state.width}x${page.state.height}`;
+  const size = view.size || `${page.state.width}x${page.state.height}`;
   $("overlay").textContent += ` · rendering ${name} at ${size}…`;
 }
 
@@ -153,7 +153,8 @@ async function stage(view, name, generation, serial) {
   img.dataset.serial = serial;
   img.dataset.size = size;
   $("overlay").textContent = `frame ${view.frame} · ${name} · ${size} · ${samples} sample(s) · ${seconds} s`;
-  img.onload = () => enlarged(img);
+  // A quick stage is small on purpose: only a full-size one is remarked on.
+  img.onload = name === "quick" ? null : () => enlarged(img);
   if (name === "final") { $("progress").value = 1; alertShown(""); }
   return { generation: Number(response.headers.get("x-generation")) };
 }
@@ -407,16 +408,18 @@ function changeKeys() {
       values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
     }
   }
-  const keys = Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
-  return keys.concat(startKeys(keys));
+  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
 }
 
 // A first key on a parameter without a track would set it for the whole
-// film: the film's start keeps the value it had, keyed at frame 0.
-function startKeys(keys) {
-  return keys
-    .filter((k) => k.time > 0 && !trackNamed(k.track) && page.values[k.track])
-    .map((k) => ({ kind: "set_key", track: k.track, time: 0, value: page.values[k.track] }));
+// film: frame 0 keeps the value it has, keyed there.
+async function startKeys(keys) {
+  const first = keys.filter((k) => k.time > 0 && !trackNamed(k.track));
+  if (!first.length) return [];
+  const start = await (await api("/api/values?frame=0")).json();
+  return first
+    .filter((k) => start[k.track])
+    .map((k) => ({ kind: "set_key", track: k.track, time: 0, value: start[k.track] }));
 }
 
 async function edit(edits, done, then = () => {}) {
@@ -432,15 +435,16 @@ async function edit(edits, done, then = () => {}) {
   }
 }
 
-function keyChanges() {
+async function keyChanges() {
   if (!changedNames().length) { say("Nothing changed to key."); return; }
-  const edits = changeKeys();
-  const here = edits.filter((e) => e.time > 0 || page.frame === 0).map((e) => e.track);
-  const started = edits.filter((e) => e.time === 0 && page.frame > 0).map((e) => e.track);
+  const keys = changeKeys();
+  let starts;
+  try { starts = await startKeys(keys); } catch (error) { alertShown(error.message); return; }
+  const started = starts.map((e) => e.track);
   const start = started.length
-    ? ` New track${started.length > 1 ? "s" : ""} ${started.join(", ")} also keyed at frame 0 with the value ${started.length > 1 ? "they" : "it"} had, so the film's start stays as it was.`
+    ? ` New track${started.length > 1 ? "s" : ""} ${started.join(", ")} also keyed at frame 0 with the value there, so frame 0 stays as it was and the value moves to the new one by frame ${page.frame}.`
     : "";
-  edit(edits, `Keyed ${here.join(", ")} at frame ${page.frame}.${start}`);
+  edit(keys.concat(starts), `Keyed ${keys.map((e) => e.track).join(", ")} at frame ${page.frame}.${start}`);
 }
 
 // The zoom's distance is a track's alone, and a zoom track places the camera

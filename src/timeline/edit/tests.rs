@@ -228,6 +228,13 @@ fn untouched_components_keep_their_text() {
         value: KeyValue::Number(40.0),
     };
     assert_eq!(edited(text, same), text);
+    // Over lines with a trailing comma, as well.
+    let listed = text.replace("( 0.55, 0.50,0.450 )", "(\n  0.55,\n  0.50,\n  0.450,\n)");
+    let set = Edit::SetScene {
+        parameter: "look.base_colour".into(),
+        value: KeyValue::Triple(0.55, 0.5, 0.9),
+    };
+    assert_eq!(edited(&listed, set), listed.replace("0.450", "0.9"));
     // A deep point's digits that stay are kept; a moved one is written.
     let digits = "(fps: 1, size: (8, 8), scene: (camera: (target: (\"0.5\", \"0.25\", \"0\"))))";
     let point = |y: &str| {
