@@ -21,10 +21,8 @@ const SCAN_STEP: Real = 1.0 / 64.0;
 
 fn scene(path: &str, frame: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
-    let text = std::fs::read_to_string(&path).expect("the example timelines are in the repository");
-    Timeline::parse(&text, &path)
-        .expect("the examples parse")
-        .scene_at(frame)
+    let timeline = Timeline::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    timeline.scene_at(frame)
 }
 
 fn measure(name: &str, path: &str, frame: u32) {

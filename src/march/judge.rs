@@ -37,8 +37,9 @@ pub fn distance_to_set(
                 continue;
             }
             taken += 1;
-            if q.length() < nearest && fractal.contains(p + q * (radius * footprint)) {
-                nearest = q.length();
+            let length = q.length();
+            if length < nearest && fractal.contains(p + q * (radius * footprint)) {
+                nearest = length;
             }
         }
         nearest.is_finite().then_some(nearest * radius)

@@ -252,6 +252,11 @@ impl Marcher {
 
     /// Replaces the last over-relaxed step by the plain one and stops
     /// over-relaxing.
+    /// Whether the last step was longer than its estimate vouched for.
+    fn relaxed(&self) -> bool {
+        self.previous_step > self.previous_distance
+    }
+
     fn take_back(&mut self) {
         self.t += self.previous_distance - self.previous_step;
         self.previous_step = self.previous_distance;
@@ -300,20 +305,16 @@ impl Walk for Marcher {
         }
         self.steps += 1;
         self.closest = self.closest.min(estimate.distance / footprint);
-        if self.omega > 1.0
-            && estimate.escaped
-            && self.previous_distance + settings.fudge * estimate.distance < self.previous_step
-        {
-            // The spheres of free space around this point and the last one do
-            // not overlap: the long step may have jumped over surface. Go from
-            // the last point by the plain step instead, without relaxation.
-            self.take_back();
-            return None;
-        }
-        if !estimate.escaped && self.previous_step > self.previous_distance {
-            // An over-relaxed step landed inside: only its plain part is
-            // known free, and the rest may hold several crossings, of which
-            // bisecting would find any, not the first. Take the plain step.
+        // An over-relaxed step holds only where this point's free space
+        // reaches back to cover its relaxed part: where the spheres do not
+        // overlap it may have jumped over surface, and where it landed
+        // inside, that part may hold several crossings, of which bisecting
+        // would find any, not the first. Go from the last point by the plain
+        // step instead, without relaxation.
+        let covers = |e: &Estimate| {
+            e.escaped && self.previous_distance + settings.fudge * e.distance >= self.previous_step
+        };
+        if self.relaxed() && !covers(estimate) {
             self.take_back();
             return None;
         }
@@ -351,7 +352,7 @@ impl Walk for Marcher {
             step * self.omega
         };
         self.t += self.previous_step;
-        if self.t > self.t_exit && self.previous_step > self.previous_distance {
+        if self.t > self.t_exit && self.relaxed() {
             self.take_back();
         }
         if self.t > self.t_exit {

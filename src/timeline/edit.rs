@@ -192,8 +192,7 @@ fn auto_kept(text: &str, name: &str) -> Result<(), String> {
 fn set_field(text: &str, path: &[Step], value: &str) -> Result<String, String> {
     if let Some(range) = spans::range_at(text, path) {
         let range = spans::inside_some(text, range.clone()).unwrap_or(range);
-        let value = keeping_components(&text[range.clone()], value);
-        return Ok(spliced(text, range, &value));
+        return Ok(rewritten(text, range, value));
     }
     let given = (0..path.len())
         .rev()
@@ -228,8 +227,7 @@ fn set_key(text: &str, track: &str, time: Real, value: &KeyValue) -> Result<Stri
     };
     if let Some(i) = keys.times.iter().position(|t| (t - time).abs() < SAME_TIME) {
         let range = key_part(text, keys.range(i), "value")?;
-        let value = keeping_components(&text[range.clone()], &value);
-        return Ok(spliced(text, range, &value));
+        return Ok(rewritten(text, range, &value));
     }
     let index = keys.times.iter().filter(|&&t| t < time).count();
     // Written like the key before it (or after, for a new first key).
@@ -410,6 +408,12 @@ fn number(v: Real) -> Result<String, String> {
     } else {
         format!("{v:?}")
     })
+}
+
+/// `text` with the value at `range` rewritten as `value` (`keeping_components`).
+fn rewritten(text: &str, range: Range<usize>, value: &str) -> String {
+    let value = keeping_components(&text[range.clone()], value);
+    spliced(text, range, &value)
 }
 
 /// `new` written over `old` with every component that reads as the same

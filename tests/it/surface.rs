@@ -11,8 +11,8 @@ use std::path::Path;
 
 fn scene(path: &str, frame: u32) -> Scene {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(path);
-    let text = std::fs::read_to_string(&path).unwrap();
-    Timeline::parse(&text, &path).unwrap().scene_at(frame)
+    let timeline = Timeline::load(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    timeline.scene_at(frame)
 }
 
 /// For the hits of every 4th centre ray, both ways, of a 160×90 frame: their 3D
