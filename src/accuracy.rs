@@ -364,12 +364,9 @@ fn compare(
     }
 }
 
+/// PSNR of an RMSE in unit values.
 fn psnr(rmse: f64) -> f64 {
-    if rmse == 0.0 {
-        f64::INFINITY
-    } else {
-        -20.0 * rmse.log10()
-    }
+    crate::math::psnr_db(rmse * rmse, 1.0)
 }
 
 /// Timed runs per variant: more while the variant has had under
@@ -399,19 +396,10 @@ fn timed_render(scene: &Scene, frame_index: u32, width: u32, height: u32) -> (Fi
         seconds.push(t0.elapsed().as_secs_f64());
         film = Some(f);
     }
-    (film.expect("rendered at least once"), median(&mut seconds))
-}
-
-/// The median of `values` (the mean of the middle two for an even count;
-/// 0 for none). Reorders `values`.
-fn median(values: &mut [f64]) -> f64 {
-    values.sort_by(|a, b| a.total_cmp(b));
-    let n = values.len();
-    match n {
-        0 => 0.0,
-        _ if n % 2 == 1 => values[n / 2],
-        _ => 0.5 * (values[n / 2 - 1] + values[n / 2]),
-    }
+    (
+        film.expect("rendered at least once"),
+        crate::math::median(&mut seconds),
+    )
 }
 
 /// Runs the whole sweep on frame `frame_index` of `scene` at `width`×`height`.
@@ -931,15 +919,6 @@ mod tests {
         assert_eq!(significant(0.012345, 3), 0.0123);
         assert_eq!(significant(33.094, 3), 33.1);
         assert_eq!(significant(0.0, 3), 0.0);
-    }
-
-    #[test]
-    fn median_of_runs_ignores_outliers() {
-        assert_eq!(median(&mut [5.0, 1.0, 3.0]), 3.0);
-        assert_eq!(median(&mut [4.0, 1.0, 3.0, 2.0]), 2.5);
-        // One slow run (a page fault, another process) and one lucky one.
-        assert_eq!(median(&mut [1.0, 1.0, 9.0, 1.0, 0.5]), 1.0);
-        assert_eq!(median(&mut []), 0.0);
     }
 
     #[test]

@@ -361,25 +361,13 @@ fn timed_in_process(runs: usize, contenders: usize, mut work: impl FnMut(usize))
     .expect("an in-process timing has no error to return")
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        0.0
-    } else if n % 2 == 1 {
-        v[n / 2]
-    } else {
-        0.5 * (v[n / 2 - 1] + v[n / 2])
-    }
-}
-
 const MIB: f64 = 1024.0 * 1024.0;
 
 /// Fills the timing columns of `row` from `runs`, and the rates from `work`.
 fn timing_row(mut row: Row, runs: &[Measurement], work: Option<&Work>, peak: &Peak) -> Row {
     let walls: Vec<f64> = runs.iter().map(|m| m.wall_s).collect();
     row.runs = runs.len();
-    row.median_s = median(walls.clone());
+    row.median_s = crate::math::median(&mut walls.clone());
     row.min_s = walls.iter().copied().fold(f64::INFINITY, f64::min);
     row.max_s = walls.iter().copied().fold(0.0, f64::max);
     row.peak_rss_mib = runs.iter().map(|m| m.peak_rss_kib).max().unwrap_or(0) as f64 / 1024.0;
@@ -1524,13 +1512,6 @@ mod tests {
         {
             assert!((d / t - 1.0).abs() < 1e-4, "{d} vs {t}");
         }
-    }
-
-    #[test]
-    fn median_of_odd_and_even_counts() {
-        assert_eq!(median(vec![3.0, 1.0, 2.0]), 2.0);
-        assert_eq!(median(vec![4.0, 1.0, 3.0, 2.0]), 2.5);
-        assert_eq!(median(vec![]), 0.0);
     }
 
     #[test]

@@ -637,7 +637,7 @@ mod tests {
             hit_mismatch: 0.0,
             overshoot: 0.0,
             image_rmse: rmse,
-            psnr_db: -20.0 * rmse.log10(),
+            psnr_db: crate::math::psnr_db(rmse * rmse, 1.0),
             pareto: false,
         }
     }

@@ -171,13 +171,9 @@ pub fn mse(a: &RgbImage, b: &RgbImage) -> f64 {
     squared as f64 / samples as f64
 }
 
-/// Peak signal-to-noise ratio for a mean squared error in 8-bit units²:
-/// 10·log10(255²/mse) dB; +∞ for identical images (mse 0).
+/// Peak signal-to-noise ratio for a mean squared error in 8-bit units².
 pub fn psnr_db(mse: f64) -> f64 {
-    if mse <= 0.0 {
-        return f64::INFINITY;
-    }
-    10.0 * (255.0_f64 * 255.0 / mse).log10()
+    crate::math::psnr_db(mse, 255.0)
 }
 
 #[cfg(test)]
