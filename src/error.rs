@@ -20,7 +20,7 @@ pub enum Error {
         file: PathBuf,
         /// Where the offending value is written, or the block that would
         /// hold it where a default is at fault.
-        place: Option<crate::spans::Place>,
+        place: Option<Place>,
         /// Field path, e.g. `tracks["camera.position"].keys[3].time`.
         path: String,
         message: String,
@@ -67,6 +67,14 @@ impl Error {
             Error::Syntax { .. } | Error::Invalid { .. } | Error::Usage { .. }
         )
     }
+}
+
+/// A place in a text file: 1-based line and column (columns count characters,
+/// as RON's do).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Place {
+    pub line: usize,
+    pub column: usize,
 }
 
 pub type Result<T, E = Error> = std::result::Result<T, E>;

@@ -29,7 +29,6 @@ pub mod quality;
 pub mod render;
 pub mod scene;
 pub mod shade;
-pub mod spans;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.

@@ -149,7 +149,7 @@ fn png_bytes(film: &Film, hash: &str, scene: &Scene) -> Vec<u8> {
     };
     let key = output::frames::stored_key(Format::Png, hash, &[], encoding.exr_compression);
     let mut bytes = Vec::new();
-    output::png::encode(&mut bytes, film, &key, Format::Png, &encoding)
+    output::png::encode(&mut bytes, film, &key, output::PngKind::Rgb8, &encoding)
         .expect("a PNG encodes into memory");
     bytes
 }

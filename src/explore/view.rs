@@ -234,14 +234,14 @@ pub fn iterations(timeline: &Timeline, frame: u32) -> Iterations {
 /// exposure of 1 is left out of the JSON. A palette stop's parameter
 /// indexes its list (`look.palette.stops[1].colour`).
 fn field(scene: &serde_json::Value, name: &str) -> Option<Vec<f64>> {
-    use crate::spans::Step;
+    use crate::timeline::spans::Step;
     let number = |v: &serde_json::Value| v.as_f64().or_else(|| v.as_str()?.parse().ok());
     // A projection is written as its variant: `{"Fisheye": {"degrees": D}}`.
     let path = match name {
         crate::timeline::parameters::FISHEYE_DEGREES => "camera.projection.Fisheye.degrees",
         _ => name,
     };
-    let found = crate::spans::steps(path)
+    let found = crate::timeline::spans::steps(path)
         .iter()
         .try_fold(scene, |v, step| match step {
             Step::Field(f) | Step::Key(f) => v.get(f),

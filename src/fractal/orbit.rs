@@ -190,8 +190,7 @@ impl Fractal {
     /// Where the running derivative of `p`'s orbit reaches `value`, or why
     /// it does not within `limit` iterations: the f64 twin of
     /// `deep::Reference::derivative_passes`, one iteration at a time.
-    pub fn derivative_passes(&self, p: DVec3, value: Real, limit: u32) -> super::deep::Derivative {
-        use super::deep::Derivative;
+    pub fn derivative_passes(&self, p: DVec3, value: Real, limit: u32) -> Derivative {
         let (formula, n) = (self.formula, self.power);
         let escape = self.escape_radius::<Real>();
         let mut state = OrbitState::start(self, p.to_array());
@@ -238,4 +237,16 @@ impl Fractal {
         ITERATIONS.with(|count| count.set(count.get() + state.i as u64));
         state.finish(escape)
     }
+}
+
+/// Where an orbit's running derivative passes a value
+/// (`Fractal::derivative_passes`, `deep::Reference::derivative_passes`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Derivative {
+    /// Its derivative passes the value after this many iterations.
+    Passes(u32),
+    /// It escapes after this many, before its derivative does.
+    Escapes(u32),
+    /// Neither within the reference's iterations: a point inside the set.
+    Stays,
 }

@@ -294,8 +294,7 @@ impl Plan {
         }
         let (_, hash) = self.frame(frame);
         let key = output::frames::stored_key(format, &hash, &self.aovs, self.exr_compression);
-        output::frames::file_state(&path, format, &key, self.verify)
-            == output::frames::FileState::Current
+        output::frames::file_state(&path, format, &key, self.verify) == output::FileState::Current
     }
 
     /// The ffmpeg command encoding `range` from its `format` files: into
@@ -315,7 +314,7 @@ impl Plan {
 
     /// The state of each format's file of `frame` against these inputs
     /// (read whole with `--verify`).
-    pub fn file_states(&self, frame: u32, hash: &str) -> Vec<output::frames::FileState> {
+    pub fn file_states(&self, frame: u32, hash: &str) -> Vec<output::FileState> {
         self.formats
             .iter()
             .map(|&f| {
@@ -329,9 +328,7 @@ impl Plan {
     /// these inputs.
     pub fn is_complete(&self, frame: u32, hash: &str) -> bool {
         let states = self.file_states(frame, hash);
-        states
-            .iter()
-            .all(|&s| s == output::frames::FileState::Current)
+        states.iter().all(|&s| s == output::FileState::Current)
     }
 }
 

@@ -356,8 +356,7 @@ impl Tally {
     pub fn complete_now(&self) -> usize {
         let written = !self.writing.is_empty()
             && self.writing.iter().all(|(path, format, key)| {
-                output::frames::file_state(path, *format, key, false)
-                    == output::frames::FileState::Current
+                output::frames::file_state(path, *format, key, false) == output::FileState::Current
             });
         self.complete + usize::from(written)
     }

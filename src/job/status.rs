@@ -326,10 +326,7 @@ pub fn frame_state(
     // Each file's header read once, and a file read whole only where
     // its header records these inputs.
     let files = part.file_states(frame, &hash);
-    if files
-        .iter()
-        .all(|&s| s == output::frames::FileState::Current)
-    {
+    if files.iter().all(|&s| s == output::FileState::Current) {
         return (FrameState::Complete, None);
     }
     let claim = crate::job::claim::read_claim(&part.claim_path(frame))
@@ -347,9 +344,9 @@ pub fn frame_state(
         part.layers(),
     ) {
         FrameState::Resumable
-    } else if files.contains(&output::frames::FileState::Damaged) {
+    } else if files.contains(&output::FileState::Damaged) {
         FrameState::Damaged
-    } else if files.contains(&output::frames::FileState::Stale) {
+    } else if files.contains(&output::FileState::Stale) {
         FrameState::Stale
     } else {
         FrameState::Missing

@@ -3,7 +3,7 @@
 //! compressed on rayon's pool; and the check that a file ends where its
 //! last chunk does.
 
-use super::frames::FileState;
+use super::FileState;
 use super::{stats_text, Aov, Encoding, HASH_KEY, STATS_KEY};
 use crate::render::Film;
 use std::fs::File;

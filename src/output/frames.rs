@@ -4,7 +4,7 @@
 
 use super::atomic::write_atomic;
 use super::names::FrameName;
-use super::{Aov, Encoding, Format};
+use super::{Aov, Codec, Encoding, FileState, Format, PngKind};
 use crate::error::{Error, Result};
 use crate::render::Film;
 use crate::scene::Scene;
@@ -83,21 +83,6 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
     digest.iter().map(|b| format!("{b:02x}")).collect()
 }
 
-/// What a frame file holds, against the inputs it should record.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum FileState {
-    /// No file.
-    Missing,
-    /// A file that cannot be read, or that records these inputs but is not
-    /// whole (cut short by a copy or a full disk, a PNG chunk whose CRC
-    /// fails, bytes after its end).
-    Damaged,
-    /// A readable file made from other inputs, or not by mandelreel.
-    Stale,
-    /// Made from these inputs, and whole.
-    Current,
-}
-
 /// The state of the frame file at `path` for inputs `key` (`stored_key`).
 /// The header's hash is read first: a stale file costs no more than its
 /// header. A file that records `key` is then checked for being whole: by
@@ -114,9 +99,9 @@ pub fn file_state(path: &Path, format: Format, key: &str, thorough: bool) -> Fil
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return FileState::Missing,
         Err(_) => return FileState::Damaged,
     };
-    match format {
-        Format::Exr => super::exr::file_state(file, path, key, thorough),
-        _ => super::png::file_state(file, path, key, thorough),
+    match format.codec() {
+        Codec::Exr => super::exr::file_state(file, path, key, thorough),
+        Codec::Png(_) => super::png::file_state(file, path, key, thorough),
     }
 }
 
@@ -132,8 +117,8 @@ pub fn stored_key(
     aovs: &[Aov],
     compression: super::exr::ExrCompression,
 ) -> String {
-    match format {
-        Format::Exr => {
+    match format.codec() {
+        Codec::Exr => {
             // Lossless compressions hold the same samples: any of them is current.
             let mut key = light_hash(hash).to_string();
             if !compression.is_lossless() {
@@ -145,8 +130,8 @@ pub fn stored_key(
             }
             key
         }
-        Format::Png => hash.to_string(),
-        _ => format!("{hash}+{}", format.name()),
+        Codec::Png(PngKind::Rgb8) => hash.to_string(),
+        Codec::Png(PngKind::Rgb16 | PngKind::Rgba16) => format!("{hash}+{}", format.name()),
     }
 }
 
@@ -170,10 +155,10 @@ pub fn write_frame(
         message,
     };
     let key = stored_key(format, hash, aovs, encoding.exr_compression);
-    write_atomic(path, |writer, named| match format {
-        Format::Exr => super::exr::encode(writer, film, &key, aovs, encoding)
+    write_atomic(path, |writer, named| match format.codec() {
+        Codec::Exr => super::exr::encode(writer, film, &key, aovs, encoding)
             .map_err(|m| image_error(named, m)),
-        _ => super::png::encode(writer, film, &key, format, encoding)
+        Codec::Png(kind) => super::png::encode(writer, film, &key, kind, encoding)
             .map_err(|m| image_error(named, m)),
     })
 }

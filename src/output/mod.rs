@@ -66,8 +66,52 @@ impl Format {
     }
 
     pub fn is_png(self) -> bool {
-        self.extension() == "png"
+        matches!(self.codec(), Codec::Png(_))
     }
+
+    /// The encoder that writes this format, and what it writes.
+    pub fn codec(self) -> Codec {
+        match self {
+            Format::Png => Codec::Png(PngKind::Rgb8),
+            Format::Png16 => Codec::Png(PngKind::Rgb16),
+            Format::Png16Alpha => Codec::Png(PngKind::Rgba16),
+            Format::Exr => Codec::Exr,
+        }
+    }
+}
+
+/// The encoder of a frame file (`png.rs` or `exr.rs`): every match on a
+/// format's file goes through this, so a new format must name its encoder.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Codec {
+    Png(PngKind),
+    Exr,
+}
+
+/// The PNG a PNG format writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngKind {
+    /// 8-bit RGB, dithered.
+    Rgb8,
+    /// 16-bit RGB.
+    Rgb16,
+    /// 16-bit RGBA with straight alpha.
+    Rgba16,
+}
+
+/// What a frame file holds, against the inputs it should record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FileState {
+    /// No file.
+    Missing,
+    /// A file that cannot be read, or that records these inputs but is not
+    /// whole (cut short by a copy or a full disk, a PNG chunk whose CRC
+    /// fails, bytes after its end).
+    Damaged,
+    /// A readable file made from other inputs, or not by mandelreel.
+    Stale,
+    /// Made from these inputs, and whole.
+    Current,
 }
 
 /// How a finished film is written: shown through `display` (PNG), with

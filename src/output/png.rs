@@ -3,8 +3,7 @@
 //! frame's hash and statistics in text chunks, and the checks that tell a
 //! whole PNG from one cut short or damaged.
 
-use super::frames::FileState;
-use super::{stats_text, Encoding, Format, HASH_KEY, STATS_KEY};
+use super::{stats_text, Encoding, FileState, PngKind, HASH_KEY, STATS_KEY};
 use crate::render::Film;
 use std::fs::File;
 use std::io::{BufReader, Write};
@@ -14,10 +13,10 @@ pub(crate) fn encode(
     out: &mut impl Write,
     film: &Film,
     hash: &str,
-    format: Format,
+    kind: PngKind,
     encoding: &Encoding,
 ) -> std::result::Result<(), String> {
-    let kind = Kind::of(format, encoding);
+    let kind = Kind::of(kind, encoding);
     let mut encoder = png::Encoder::new(out, film.width, film.height);
     encoder.set_color(kind.colour);
     encoder.set_depth(kind.depth);
@@ -59,11 +58,11 @@ struct Kind {
 }
 
 impl Kind {
-    fn of(format: Format, encoding: &Encoding) -> Kind {
-        let (colour, depth) = match format {
-            Format::Png16 => (png::ColorType::Rgb, png::BitDepth::Sixteen),
-            Format::Png16Alpha => (png::ColorType::Rgba, png::BitDepth::Sixteen),
-            _ => (png::ColorType::Rgb, png::BitDepth::Eight),
+    fn of(kind: PngKind, encoding: &Encoding) -> Kind {
+        let (colour, depth) = match kind {
+            PngKind::Rgb8 => (png::ColorType::Rgb, png::BitDepth::Eight),
+            PngKind::Rgb16 => (png::ColorType::Rgb, png::BitDepth::Sixteen),
+            PngKind::Rgba16 => (png::ColorType::Rgba, png::BitDepth::Sixteen),
         };
         Kind {
             colour,

@@ -10,7 +10,6 @@ use crate::march::{normals_many, MarchResult};
 use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
-use rayon::prelude::*;
 
 /// What every band of one frame's rendering shares, worked out once.
 pub(super) struct FrameSetup<'a> {
@@ -82,17 +81,6 @@ impl<'a> FrameSetup<'a> {
         }
     }
 }
-
-/// The image rows rendered together: the rows a block of cone rays can
-/// span (`march::CONE_BLOCK_ROWS`).
-pub(super) const BAND_ROWS: usize = crate::march::CONE_BLOCK_ROWS;
-
-/// Bands in one rayon task at most: one. Left to itself, rayon cuts an
-/// indexed loop into a few runs of bands and a thread works through its run
-/// in order, so a thread that runs out of work can take nothing from a
-/// run another thread has begun, and a frame whose costly bands bunch
-/// together ends on one thread.
-pub(super) const BAND_TASKS: usize = 1;
 
 /// Adds `frame.samples` of every pixel of the band of image rows from `y0`
 /// (as many as `sums` holds) to `sums`.
@@ -502,22 +490,6 @@ thread_local! {
     pub(super) static ROW_SCRATCH: std::cell::Cell<RowScratch> = std::cell::Cell::default();
     /// One band's sums for `render_frame_into`, kept like `ROW_SCRATCH`.
     pub(super) static ROW_SUMS: std::cell::Cell<Accumulation> = std::cell::Cell::default();
-}
-
-/// Bands of `BAND_ROWS` rows of an optional layer for the parallel zip:
-/// `Some(band)` per band when the layer is collected, `None` for each band
-/// otherwise.
-pub(super) fn optional_bands<T: Send>(
-    layer: &mut [T],
-    width: usize,
-    height: usize,
-) -> impl IndexedParallelIterator<Item = Option<&mut [T]>> {
-    let rows: Vec<Option<&mut [T]>> = if layer.is_empty() {
-        (0..height.div_ceil(BAND_ROWS)).map(|_| None).collect()
-    } else {
-        layer.chunks_mut(BAND_ROWS * width).map(Some).collect()
-    };
-    rows.into_par_iter()
 }
 
 /// The radiance of one camera sample, which met the surface at `at` or

@@ -1,8 +1,7 @@
 //! The film: a rendered frame's pixels and layers, how a frame is
 //! finished from its sums, and what a frame size costs in memory.
 
-use super::accumulation::Accumulation;
-use super::band::{optional_bands, BAND_ROWS, BAND_TASKS};
+use super::rows::{optional_bands, BAND_ROWS, BAND_TASKS};
 use super::sized;
 use super::stats::FrameStats;
 use crate::math::Vec3;
@@ -193,70 +192,4 @@ impl Film {
             )
             .with_max_len(BAND_TASKS)
     }
-}
-
-/// Averages the sums of `sums` (all its pixels) over `n` samples into
-/// `out`, pixel for pixel; returns the most estimates one pixel took.
-pub(super) fn finish_pixels(sums: &Accumulation, n: u32, out: FilmPixels) -> u64 {
-    // Every element of `out` is written (a film is not cleared before:
-    // `Film::prepare`), which the zips below do only with sums as long.
-    let pixels = sums.colour.len();
-    let layer =
-        |out: Option<usize>, sums: usize| out.is_none_or(|len| len == pixels && sums == len);
-    debug_assert!(
-        [
-            out.colour.len(),
-            out.alpha.len(),
-            out.depth.len(),
-            out.evaluations.len()
-        ]
-        .into_iter()
-        .chain([sums.hits.len(), sums.depth.len(), sums.spent.len()])
-        .all(|len| len == pixels)
-            && layer(out.normal.as_ref().map(|v| v.len()), sums.normal.len())
-            && layer(out.albedo.as_ref().map(|v| v.len()), sums.albedo.len())
-            && layer(out.traps.as_ref().map(|v| v.len()), sums.traps.len())
-            && layer(out.coverage.as_ref().map(|v| v.len()), sums.inside.len()),
-        "a band's film and sums differ in size"
-    );
-    // Under adaptive sampling each pixel has the samples it took.
-    let taken = |i: usize| sums.spread.get(i).map_or(n, |p| p.taken).max(1);
-    for (i, (c, s)) in out.colour.iter_mut().zip(&sums.colour).enumerate() {
-        let inv = 1.0 / taken(i) as f64;
-        *c = Vec3::new(
-            (s[0] * inv) as f32,
-            (s[1] * inv) as f32,
-            (s[2] * inv) as f32,
-        );
-    }
-    for (i, (a, &h)) in out.alpha.iter_mut().zip(&sums.hits).enumerate() {
-        *a = h as f32 / taken(i) as f32;
-    }
-    out.depth.copy_from_slice(&sums.depth);
-    for (e, &s) in out.evaluations.iter_mut().zip(&sums.spent) {
-        *e = s.min(u32::MAX as u64) as u32;
-    }
-    // A pixel no sample hit has zero layer sums, which stay zero.
-    let per_hit = |i: usize| 1.0 / sums.hits[i].max(1) as f32;
-    if let Some(normal) = out.normal {
-        for (o, v) in normal.iter_mut().zip(&sums.normal) {
-            *o = v.normalize_or_zero();
-        }
-    }
-    if let Some(albedo) = out.albedo {
-        for (i, (o, &v)) in albedo.iter_mut().zip(&sums.albedo).enumerate() {
-            *o = v * per_hit(i);
-        }
-    }
-    if let Some(coverage) = out.coverage {
-        for (i, (o, &k)) in coverage.iter_mut().zip(&sums.inside).enumerate() {
-            *o = k as f32 / taken(i) as f32;
-        }
-    }
-    if let Some(traps) = out.traps {
-        for (i, (o, v)) in traps.iter_mut().zip(&sums.traps).enumerate() {
-            *o = v.map(|x| x * per_hit(i));
-        }
-    }
-    sums.spent.iter().copied().max().unwrap_or(0)
 }

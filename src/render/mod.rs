@@ -17,13 +17,15 @@ pub mod adaptive;
 mod band;
 mod film;
 pub mod pick;
+mod rows;
 mod stats;
 
+use accumulation::finish_pixels;
 pub use accumulation::Accumulation;
 pub use adaptive::{next_wave, wave_count};
-use band::{render_band, FrameSetup, BAND_ROWS, ROW_SUMS};
-use film::finish_pixels;
+use band::{render_band, FrameSetup, ROW_SUMS};
 pub use film::{frame_bytes, Film, Layers, Sums};
+use rows::BAND_ROWS;
 pub use stats::FrameStats;
 
 /// Depth written for pixels that see only background.

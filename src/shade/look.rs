@@ -1,7 +1,6 @@
 //! A scene's look: colours, lights and the display settings a timeline
 //! sets, with their defaults.
 
-use super::lighting::Light;
 use super::palette::Palette;
 use crate::color::Display;
 use crate::color::ToneMap;
@@ -86,3 +85,43 @@ impl Default for Look {
         }
     }
 }
+
+/// Blinn–Phong highlight of the light.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Specular {
+    pub strength: f32,
+    pub shininess: f32,
+}
+
+impl Default for Specular {
+    fn default() -> Self {
+        Specular {
+            strength: 0.3,
+            shininess: 32.0,
+        }
+    }
+}
+
+/// A directional light: where it comes from and how bright it is.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Light {
+    /// Direction towards the light (need not be unit length).
+    pub direction: DVec3,
+    pub colour: Vec3,
+    pub intensity: f32,
+}
+
+impl Default for Light {
+    fn default() -> Self {
+        Light {
+            direction: DVec3::new(-0.5, 0.3, -0.8),
+            colour: Vec3::new(0.45, 0.5, 0.6),
+            intensity: 1.0,
+        }
+    }
+}
+
+/// Most lights a scene may have (the key light and seven more).
+pub const MAX_LIGHTS: usize = 8;

@@ -26,8 +26,7 @@ mod sky;
 
 pub use bundle::{walk_shadows, BundleScratch};
 pub use fog::{fogged, glow, Fog, Glow};
-pub use lighting::{Light, Specular, MAX_LIGHTS};
-pub use look::Look;
+pub use look::{Light, Look, Specular, MAX_LIGHTS};
 #[cfg(test)]
 pub use palette::{mix_oklab, smooth_iterations};
 pub use palette::{OrbitQuantity, Palette, Stop, Table as PaletteTable, Wrap, MAX_STOPS};

@@ -2,8 +2,8 @@
 //! towards lights of real angular size and the environment map, Russian
 //! roulette; paths advance together a bounce at a time.
 
-use super::lighting::MAX_LIGHTS;
 use super::look::Look;
+use super::look::MAX_LIGHTS;
 use super::shadow::shadow_origin;
 use super::sky::Sky;
 use super::{StageCounts, SurfacePoint};

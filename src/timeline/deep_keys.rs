@@ -5,7 +5,7 @@
 //! and a pan a few footprints wide at 1e-30 keeps every digit.
 
 use super::schema::Interpolation;
-use super::tracks::build_spline;
+use super::spline::build_spline;
 use crate::exact::{self, Coordinates, Digits};
 use crate::math::{DVec3, Real};
 use std::collections::HashMap;

@@ -4,10 +4,10 @@
 //! must, so the author's comments, field order and layout survive a save.
 
 use super::parameters::{self, Parameter, Shape};
+use super::spans::{self, Block, Step};
 use super::{KeyValue, Timeline, ZOOM_TRACK};
 use crate::math::Real;
 use crate::scene::Scene;
-use crate::spans::{self, Block, Step};
 use std::ops::Range;
 
 /// One change a user makes to a timeline.

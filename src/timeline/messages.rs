@@ -4,9 +4,10 @@
 
 use super::limits::count_message;
 use super::schema::KeyValue;
+use super::spans;
 use crate::error::Error;
+use crate::error::Place;
 use crate::math::{DVec3, Real, Vec3};
-use crate::spans::{self, Place};
 use std::path::Path;
 
 /// The number written at `line`:`column` (1-based), where a parse error

@@ -9,6 +9,7 @@
 //! keeps a constant apparent speed over many decades of scale.
 
 pub mod auto;
+mod checks;
 mod deep_keys;
 pub mod edit;
 mod limits;
@@ -19,6 +20,8 @@ mod parse;
 mod relative;
 mod scan;
 mod schema;
+pub(crate) mod spans;
+mod spline;
 mod tracks;
 mod validate;
 

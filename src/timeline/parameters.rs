@@ -3,9 +3,9 @@
 //! names, `Track`'s setter, `validate_scene`'s range checks of these fields
 //! and the docs' table of parameters all come from `GROUPS`.
 
+use super::checks::{colour, counted, non_negative, positive, rule, Checked};
 use super::limits::{MAX_ITERATIONS, MAX_MARCH_STEPS};
 use super::messages::Shown;
-use super::validate::{colour, counted, non_negative, positive, rule, Checked};
 use crate::camera::Projection;
 use crate::exact::{Coordinates, Digits};
 use crate::math::{DVec3, Real, Vec3};

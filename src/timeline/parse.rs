@@ -6,13 +6,14 @@ use super::limits::{check_scene_count, TooMany, FRAMES_HINT, MAX_FRAMES, MAX_KEY
 use super::messages::{invalid_value, syntax_message, Shown};
 use super::parameters::{self, PARAMETERS, ZOOM_TRACK};
 use super::schema::TimelineFile;
+use super::spans;
 use super::tracks::{Track, TrackError};
 use super::validate::validate_scene;
 use super::Timeline;
+use crate::error::Place;
 use crate::error::{Error, Result};
 use crate::math::Real;
 use crate::scene::Scene;
-use crate::spans::{self, Place};
 use std::path::Path;
 
 /// Past a thousand frames a second no player or encoder keeps up (ffmpeg's

@@ -6,7 +6,8 @@
 //! written as `spans` writes them: `Some(…)` and a struct's name add no
 //! step, an unnamed item is an index.
 
-use crate::spans::{self, Place, Step};
+use super::spans::{self, Step};
+use crate::error::Place;
 
 /// What opened a level: `Some(` holds one value and adds no step.
 #[derive(Clone, Copy, Debug, PartialEq)]

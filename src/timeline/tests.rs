@@ -1,6 +1,6 @@
+use super::spans;
 use super::*;
 use crate::math::DVec3;
-use crate::spans;
 
 fn parse(text: &str) -> Result<Timeline> {
     Timeline::parse(text, Path::new("test.ron"))

@@ -3,8 +3,9 @@
 //! and fields that depend on one another consistent (a view direction, path
 //! tracing without the effects it replaces).
 
+use super::checks::{colour, counted, non_negative, rule, Checked};
 use super::limits::{
-    count_outside, MAX_BOUNCES, MAX_CONE_RAYS, MAX_OCCLUSION_SAMPLES, MAX_SAMPLES, MAX_SHADOW_STEPS,
+    MAX_BOUNCES, MAX_CONE_RAYS, MAX_OCCLUSION_SAMPLES, MAX_SAMPLES, MAX_SHADOW_STEPS,
 };
 use super::messages::Shown;
 use super::parameters::Parameter;
@@ -12,48 +13,12 @@ use super::parameters::{
     AMBIENT_OCCLUSION, CAMERA, FOG, FRACTAL, GLOW, LOOK, PALETTE, QUALITY, SHADOWS, SPECULAR,
 };
 use crate::error::Result;
-use crate::math::{Real, Vec3};
+use crate::math::Real;
 use crate::scene::Scene;
 use crate::shade::{Effects, PathTracing, Sky};
 
-/// A value within its range, or what is wrong with it.
-pub type Checked = std::result::Result<(), String>;
-
 /// A field's problem: its path in the scene and the message.
 type Invalid = (String, String);
-
-/// `ok`, else `message`'s problem. The message is built only when the
-/// check fails: every rendered scene is checked, thousands per frame under
-/// motion blur.
-pub(super) fn rule(ok: bool, message: impl FnOnce() -> String) -> Checked {
-    if ok {
-        Ok(())
-    } else {
-        Err(message())
-    }
-}
-
-// The three checks most fields need, each with one wording.
-
-pub(super) fn positive<T: Into<f64> + Copy + Shown>(v: T) -> Checked {
-    let x: f64 = v.into();
-    rule(x.is_finite() && x > 0.0, || {
-        format!("must be positive, got {}", v.shown())
-    })
-}
-
-pub(super) fn non_negative<T: Into<f64> + Copy + Shown>(v: T) -> Checked {
-    let x: f64 = v.into();
-    rule(x.is_finite() && x >= 0.0, || {
-        format!("must be non-negative, got {}", v.shown())
-    })
-}
-
-pub(super) fn colour(c: Vec3) -> Checked {
-    rule(c.is_finite() && c.min_element() >= 0.0, || {
-        format!("colours must be finite and non-negative, got {}", c.shown())
-    })
-}
 
 /// `checked`'s problem, at `field`.
 fn at(field: &str, checked: Checked) -> Result<(), Invalid> {
@@ -129,11 +94,6 @@ fn noise(x: f32) -> Checked {
     rule((1e-4..=1.0).contains(&x), || {
         format!("must be from 0.0001 to 1 (an error in display values), got {x}")
     })
-}
-
-/// A count from 1 to `most`.
-pub(super) fn counted(n: u32, most: u32) -> Checked {
-    rule((1..=most).contains(&n), || count_outside(most, n))
 }
 
 /// The view direction the camera's position, target and up give.

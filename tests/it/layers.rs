@@ -24,7 +24,7 @@ const LAYERS: &[(&str, &[&str])] = &[
     ("light", &["color", "environment"]),
     ("errors", &["error"]),
     ("digits", &["exact"]),
-    ("leaves", &["math", "spans", "input", "interrupt", "host"]),
+    ("leaves", &["math", "input", "interrupt", "host"]),
 ];
 
 fn rank(module: &str) -> Option<usize> {
@@ -137,4 +137,190 @@ fn a_use_of_a_higher_layer_is_found() {
     let text = "use crate::math::Real;\nfn f() { crate::cli::run(); crate::timeline::x(); }";
     assert_eq!(uses_upwards("render", text), ["cli", "timeline"]);
     assert!(uses_upwards("cli", text).is_empty());
+}
+
+/// A source file's module path: `src/a/b.rs` and `src/a/b/mod.rs` are
+/// `["a", "b"]`.
+fn module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).expect("under src");
+    let mut path: Vec<String> = rel
+        .components()
+        .map(|c| {
+            c.as_os_str()
+                .to_string_lossy()
+                .trim_end_matches(".rs")
+                .to_string()
+        })
+        .collect();
+    if path.last().is_some_and(|l| l == "mod" || l == "lib") {
+        path.pop();
+    }
+    path
+}
+
+/// The module paths `text`, the file of module `own`, names: `crate::a::b`
+/// and `super::c` (`super::{c, d}` too), resolved from the crate's root.
+fn named_paths(own: &[String], text: &str) -> Vec<Vec<String>> {
+    let ident = |s: &str| -> String {
+        s.chars()
+            .take_while(|c| c.is_alphanumeric() || *c == '_')
+            .collect()
+    };
+    let mut found = Vec::new();
+    for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+        for (i, _) in line.match_indices("crate::") {
+            if line[..i]
+                .chars()
+                .last()
+                .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '$')
+            {
+                continue;
+            }
+            let rest = &line[i + 7..];
+            found.push(
+                rest.split("::")
+                    .map(ident)
+                    .take_while(|s| !s.is_empty())
+                    .collect(),
+            );
+        }
+        for (i, _) in line.match_indices("super::") {
+            let before = &line[..i];
+            if before.ends_with("super::")
+                || before
+                    .chars()
+                    .last()
+                    .is_some_and(|c| c.is_alphanumeric() || c == '_')
+            {
+                continue; // counted from the first `super` of a chain
+            }
+            let mut base = own.to_vec();
+            let mut rest = &line[i..];
+            while let Some(r) = rest.strip_prefix("super::") {
+                base.pop();
+                rest = r;
+            }
+            let names: Vec<String> = match rest.strip_prefix('{') {
+                Some(group) => group.split([',', '}']).map(|s| ident(s.trim())).collect(),
+                None => vec![ident(rest)],
+            };
+            for name in names.into_iter().filter(|n| !n.is_empty()) {
+                let mut path = base.clone();
+                path.push(name);
+                found.push(path);
+            }
+        }
+    }
+    found
+}
+
+/// The circles among the files of one folder: `(folder, members)` for each
+/// set of sibling files that use one another in a ring. A folder's mod.rs
+/// (its facade) and its tests stand outside.
+fn circles(files: &[(Vec<String>, String)]) -> Vec<(String, Vec<String>)> {
+    use std::collections::BTreeMap;
+    let mut edges: BTreeMap<Vec<String>, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for (own, text) in files {
+        let named = named_paths(own, text);
+        // Every folder this file sits below, with the child it sits in.
+        for depth in 0..own.len() {
+            let (folder, child) = (&own[..depth], &own[depth]);
+            if child == "tests" || own.get(depth + 1).is_some_and(|c| c == "tests") {
+                continue;
+            }
+            let siblings = edges.entry(folder.to_vec()).or_default();
+            let out = siblings.entry(child.clone()).or_default();
+            for path in &named {
+                if path.len() > depth && path[..depth] == *folder && path[depth] != *child {
+                    out.insert(path[depth].clone());
+                }
+            }
+        }
+    }
+    let mut found = Vec::new();
+    for (folder, graph) in &edges {
+        // Keep only uses of files that are in this folder.
+        let reaches = |from: &String| {
+            let mut seen = BTreeSet::new();
+            let mut stack = vec![from.clone()];
+            while let Some(at) = stack.pop() {
+                for next in graph.get(&at).into_iter().flatten() {
+                    if graph.contains_key(next) && seen.insert(next.clone()) {
+                        stack.push(next.clone());
+                    }
+                }
+            }
+            seen
+        };
+        let mut ring: Vec<String> = graph
+            .keys()
+            .filter(|k| reaches(k).contains(*k))
+            .cloned()
+            .collect();
+        ring.retain(|k| k != "tests");
+        if !ring.is_empty() {
+            found.push((folder.join("/"), ring));
+        }
+    }
+    found
+}
+
+#[test]
+fn the_files_of_a_folder_use_one_another_one_way() {
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut paths = Vec::new();
+    sources(&src, &mut paths);
+    let files: Vec<(Vec<String>, String)> = paths
+        .iter()
+        .map(|p| {
+            (
+                module_path(&src, p),
+                std::fs::read_to_string(p).expect("read source"),
+            )
+        })
+        .collect();
+    let found = circles(&files);
+    assert!(
+        found.is_empty(),
+        "files in a circle (folder: files): {found:?}"
+    );
+}
+
+#[test]
+fn a_circle_between_two_files_is_found() {
+    let file = |path: &str, text: &str| {
+        let path = path.split('/').map(String::from).collect::<Vec<_>>();
+        (path, text.to_string())
+    };
+    let ring = [
+        file("render/band", "use super::film::Film;"),
+        file("render/film", "use crate::render::band::BAND_ROWS;"),
+        file("render", "mod band;\nmod film;\nuse band::x;"),
+    ];
+    assert_eq!(
+        circles(&ring),
+        [(
+            "render".to_string(),
+            vec!["band".to_string(), "film".to_string()]
+        )]
+    );
+    let one_way = [
+        file("render/band", "use super::{film::Film, rows};"),
+        file("render/film", "use super::rows::BAND_ROWS;"),
+        file("render/rows", "// use super::band in a comment"),
+        file("fractal/deep/lanes", "use super::super::orbit::Orbit;"),
+        file("fractal/orbit", "use super::power::x;"),
+    ];
+    assert!(circles(&one_way).is_empty());
+    let deep = [
+        file("fractal/deep/lanes", "use super::super::orbit::Orbit;"),
+        file("fractal/orbit", "fn f() -> super::deep::Derivative {}"),
+    ];
+    assert_eq!(
+        circles(&deep),
+        [(
+            "fractal".to_string(),
+            vec!["deep".to_string(), "orbit".to_string()]
+        )]
+    );
 }

@@ -12,6 +12,7 @@
 //! Mandelbrot mode the reference is the orbit of 0 with c = anchor, so it
 //! serves both; in Julia mode the orbit of 0 is a second reference.
 
+pub use super::orbit::Derivative;
 use super::orbit::{Orbit, ITERATIONS};
 use super::power::{length_squared, powi, whole_power, whole_power_step};
 use super::{DeMethod, Estimate, Formula, Fractal, OrbitTraps, Precision, Triplex};
@@ -333,17 +334,6 @@ impl Fractal {
             .resolves_in_f64(p, scale)
             .then(|| self.plain().estimate(reference.anchor + p, scale))
     }
-}
-
-/// What the anchor's orbit does (`Reference::derivative_passes`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Derivative {
-    /// Its derivative passes the value after this many iterations.
-    Passes(u32),
-    /// It escapes after this many, before its derivative does.
-    Escapes(u32),
-    /// Neither within the reference's iterations: a point inside the set.
-    Stays,
 }
 
 /// `anchor`, or where it lies on the pole axis a point 2⁻⁽ᵇⁱᵗˢ⁻³²⁾ of its

@@ -1,6 +1,7 @@
 use super::{film, write_plain};
 use crate::math::Vec3;
-use crate::output::frames::{file_state, write_frame, FileState};
+use crate::output::frames::{file_state, write_frame};
+use crate::output::FileState;
 use crate::output::{Aov, Format, HASH_KEY};
 use crate::render::{Film, FrameStats};
 use std::path::Path;

@@ -2,7 +2,7 @@ use super::{film, write_plain};
 use crate::output::exr::ExrCompression::{Dwaa, Piz, Zip};
 use crate::output::frames::*;
 use crate::output::names::FrameName;
-use crate::output::{Aov, Format};
+use crate::output::{Aov, FileState, Format};
 use crate::scene::Scene;
 use std::path::Path;
 

@@ -1,5 +1,6 @@
 use super::{film, write_plain};
-use crate::output::frames::{file_state, FileState};
+use crate::output::frames::file_state;
+use crate::output::FileState;
 use crate::output::Format;
 
 #[test]

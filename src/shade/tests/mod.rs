@@ -1,7 +1,6 @@
 //! Unit tests of shading, by concern, and the helpers they share.
 
 use super::fog::*;
-use super::lighting::*;
 use super::look::*;
 use super::path::*;
 use super::shadow::*;

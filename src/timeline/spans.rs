@@ -5,6 +5,7 @@
 //! of the document's text, so comments and same-named fields elsewhere
 //! never match.
 
+use crate::error::Place;
 use ron::value::RawValue;
 use serde::de::{Deserialize, Deserializer, MapAccess, SeqAccess, Visitor};
 use std::ops::Range;
@@ -15,14 +16,6 @@ pub enum Step {
     Field(String),
     Index(usize),
     Key(String),
-}
-
-/// A place in the text: 1-based line and column (columns count characters,
-/// as RON's do).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Place {
-    pub line: usize,
-    pub column: usize,
 }
 
 /// The steps of a field path as messages write them:
