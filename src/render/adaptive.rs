@@ -133,38 +133,5 @@ fn stands_out(spread: &[Spread], i: usize, w: usize, h: usize, contrast: f64) ->
     neighbours(i, w, h).any(|j| (spread[j].mean() - mean).abs() > contrast)
 }
 
-/// Sub-pixel offset of sample `s` under adaptive sampling, where a pixel
-/// may stop after any wave: an Owen-scrambled Sobol sequence (Burley,
-/// "Practical Hash-based Owen Scrambling", JCGT 2020), scrambled by a hash
-/// of the pixel. Its first 2^k samples are stratified as a (0, k, 2)-net:
-/// the first 4 one to each quarter of the pixel, all 16 one to each cell
-/// of a 4×4 grid, as a uniform 16 jitters them.
-pub(super) fn progressive_subpixel(scene: &Scene, frame: u32, pixel: u64, s: u32) -> (Real, Real) {
-    let hash = crate::math::sample_1d(scene.seed, frame, pixel, u32::MAX, 0);
-    let seed = (hash * 4_294_967_296.0) as u32;
-    let x = sobol_burley::sample(s, 0, seed);
-    let y = sobol_burley::sample(s, 1, seed);
-    (x as Real, y as Real)
-}
-
-/// The instant (of `instants`, spread over the shutter) that sample `s`
-/// sees under adaptive sampling: a stride through them that is prime to
-/// their count, near the golden section, so that a pixel's first samples
-/// are spread over the shutter rather than bunched at its opening.
-pub(super) fn progressive_instant(s: u32, instants: usize) -> usize {
-    let n = instants.max(1);
-    let golden = (n as f64 * 0.618_033_988_749_895).round() as usize;
-    let stride = (golden.max(1)..=n).find(|&k| gcd(k, n) == 1).unwrap_or(1);
-    (s as usize * stride) % n
-}
-
-fn gcd(a: usize, b: usize) -> usize {
-    if b == 0 {
-        a
-    } else {
-        gcd(b, a % b)
-    }
-}
-
 #[cfg(test)]
 mod tests;

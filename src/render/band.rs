@@ -3,11 +3,10 @@
 //! radiance of each sample.
 
 use super::accumulation::{Accumulation, RowSums};
-use super::adaptive::progressive_subpixel;
+use super::sampler;
 use super::stats::FrameStats;
-use super::subpixel;
 use crate::march::{normals_many, MarchResult};
-use crate::math::{finite_or_zero, sample_1d, Real, Vec3};
+use crate::math::{finite_or_zero, Real, Vec3};
 use crate::scene::Scene;
 use crate::shade::{fogged, glow, StageCounts, SurfacePoint};
 
@@ -103,10 +102,7 @@ pub(super) fn render_band(frame: &FrameSetup, y0: usize, mut sums: RowSums) -> F
     scratch.picked_valid = false; // another band's pixels
     scratch.marched.resize(rows * w, MarchResult::default());
     for s in frame.samples.clone() {
-        let k = match scenes[0].adaptive {
-            Some(_) => super::adaptive::progressive_instant(s, scenes.len()),
-            None => s as usize % scenes.len(),
-        };
+        let k = sampler::instant(&scenes[0], s, scenes.len());
         let (scene, camera, scale) = (&scenes[k], &frame.cameras[k], frame.scales[k]);
         scratch.camera_rays(frame, scene, camera, y0, rows, s);
         let RowScratch {
@@ -311,17 +307,13 @@ impl RowScratch {
         self.rays.extend(self.picked.iter().map(|&p| {
             let (x, y) = (p % w, y0 + p / w);
             let pixel = (y0 * w + p) as u64;
-            let (ox, oy) = match scene.adaptive {
-                Some(_) if n > 1 => progressive_subpixel(scene, frame.frame_index, pixel, s),
-                _ => subpixel(scene, frame.frame_index, pixel, s, n),
-            };
+            let (ox, oy) = sampler::offset(scene, frame.frame_index, pixel, s, n);
             if partial {
                 let (x, y) = (x as Real + ox, y as Real + oy);
                 self.seen.push(camera.sees(x, y, width, height));
             }
             if camera.has_lens() {
-                let u = sample_1d(scene.seed, frame.frame_index, pixel, s, 2);
-                let v = sample_1d(scene.seed, frame.frame_index, pixel, s, 3);
+                let (u, v) = sampler::lens(scene, frame.frame_index, pixel, s);
                 camera.lens_ray(x as Real + ox, y as Real + oy, width, height, u, v)
             } else {
                 camera.ray(x as Real + ox, y as Real + oy, width, height)
@@ -405,13 +397,7 @@ fn band_paths<'p>(
     match &scene.effects.path_tracing {
         Some(pt) => {
             let random = |i: usize, d: u32| {
-                sample_1d(
-                    scene.seed,
-                    frame.frame_index,
-                    (y0 * w + order[i]) as u64,
-                    s,
-                    d,
-                )
+                sampler::path_number(scene, frame.frame_index, (y0 * w + order[i]) as u64, s, d)
             };
             crate::shade::trace_paths(
                 &scene.look,

@@ -8,7 +8,6 @@
 //! `quality.cone_rays`), never on which thread ran it or in which order, so
 //! the image is identical for any thread count.
 
-use crate::math::{sample_1d, Real};
 use crate::scene::Scene;
 use rayon::prelude::*;
 
@@ -18,6 +17,7 @@ mod band;
 mod film;
 pub mod pick;
 mod rows;
+mod sampler;
 mod stats;
 
 use accumulation::finish_pixels;
@@ -30,24 +30,6 @@ pub use stats::FrameStats;
 
 /// Depth written for pixels that see only background.
 pub const BACKGROUND_DEPTH: f32 = 1.0e10;
-
-/// Sub-pixel offset of sample `s` of `n`: the centre for one sample; a
-/// jittered point in cell `s` of a k×k grid when n = k²; otherwise stratified
-/// in n rows with x uniform, which still covers the whole pixel evenly.
-fn subpixel(scene: &Scene, frame: u32, pixel: u64, s: u32, n: u32) -> (Real, Real) {
-    if n == 1 {
-        return (0.5, 0.5);
-    }
-    let jx = sample_1d(scene.seed, frame, pixel, s, 0);
-    let jy = sample_1d(scene.seed, frame, pixel, s, 1);
-    let k = (n as Real).sqrt().round() as u32;
-    if k * k == n {
-        let (cx, cy) = (s % k, s / k);
-        ((cx as Real + jx) / k as Real, (cy as Real + jy) / k as Real)
-    } else {
-        (jx, (s as Real + jy) / n as Real)
-    }
-}
 
 /// Renders `scene` at `width`×`height` as frame `frame_index`. `on_row` is called
 /// once per finished row (from any thread) for progress display.

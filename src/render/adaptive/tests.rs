@@ -42,54 +42,6 @@ fn waves_double_from_the_first_up_to_the_cap() {
     assert_eq!(wave_count(&uniform), 14);
 }
 
-#[test]
-fn every_first_power_of_two_samples_stratify_the_pixel() {
-    // The first 2^k samples of every pixel tried put one sample in each
-    // cell of every grid of 2^k cells (2^a by 2^(k-a)): the first 2 one in
-    // each half, either way; the first 16 one in each cell of a 4×4 grid.
-    let scene = adaptive(2, 64);
-    for pixel in 0..500 {
-        let points: Vec<_> = (0..64)
-            .map(|s| progressive_subpixel(&scene, 7, pixel, s))
-            .collect();
-        assert!(points
-            .iter()
-            .all(|&(x, y)| (0.0..1.0).contains(&x) && (0.0..1.0).contains(&y)));
-        for k in 1..=6u32 {
-            for a in 0..=k {
-                let (cols, rows) = (1usize << a, 1usize << (k - a));
-                let mut cells = vec![0; cols * rows];
-                for &(x, y) in &points[..1 << k] {
-                    let cell = (y * rows as Real) as usize * cols + (x * cols as Real) as usize;
-                    cells[cell] += 1;
-                }
-                assert!(
-                    cells.iter().all(|&c| c == 1),
-                    "pixel {pixel}: {k} {a}: {cells:?}"
-                );
-            }
-        }
-    }
-    // Pixels do not share a pattern.
-    let first = |pixel| progressive_subpixel(&scene, 7, pixel, 0);
-    assert_ne!(first(1), first(2));
-}
-
-#[test]
-fn instants_are_all_seen_and_early_ones_spread_over_the_shutter() {
-    for n in 1..50 {
-        let mut seen: Vec<usize> = (0..n as u32).map(|s| progressive_instant(s, n)).collect();
-        let first_four: Vec<usize> = seen.iter().take(4).copied().collect();
-        seen.sort();
-        assert_eq!(seen, (0..n).collect::<Vec<_>>(), "{n} instants");
-        if n >= 8 {
-            // The first four reach both halves of the shutter.
-            assert!(first_four.iter().any(|&i| i < n / 2));
-            assert!(first_four.iter().any(|&i| i >= n / 2));
-        }
-    }
-}
-
 /// An accumulation of `w`×`h` whose pixels have the spreads `f` makes,
 /// `done` samples in.
 fn judged(w: u32, h: u32, done: u32, f: impl Fn(usize) -> Spread) -> Accumulation {

@@ -1,28 +1,7 @@
 //! Unit tests of rendering: sampling, reuse, waves, effects and cones.
 
 use super::*;
-use crate::math::Vec3;
-
-#[test]
-fn subpixel_offsets_stay_in_the_pixel_and_cover_it() {
-    let scene = Scene::default();
-    assert_eq!(subpixel(&scene, 0, 0, 0, 1), (0.5, 0.5));
-    let pts: Vec<_> = (0..4).map(|s| subpixel(&scene, 0, 9, s, 4)).collect();
-    for &(x, y) in &pts {
-        assert!((0.0..1.0).contains(&x) && (0.0..1.0).contains(&y));
-    }
-    // Three samples: one in each horizontal third, averaging over the whole pixel.
-    let thirds: std::collections::HashSet<_> = (0..3)
-        .map(|s| (subpixel(&scene, 0, 9, s, 3).1 * 3.0) as u8)
-        .collect();
-    assert_eq!(thirds.len(), 3);
-    // Four samples: one in each quadrant of a 2×2 grid.
-    let quadrants: std::collections::HashSet<_> = pts
-        .iter()
-        .map(|&(x, y)| ((x * 2.0) as u8, (y * 2.0) as u8))
-        .collect();
-    assert_eq!(quadrants.len(), 4);
-}
+use crate::math::{Real, Vec3};
 
 #[test]
 fn a_reused_film_renders_each_frame_as_a_new_one_would() {
