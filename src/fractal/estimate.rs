@@ -105,7 +105,7 @@ impl Fractal {
     /// with this, so they agree to the bit.
     ///
     /// - Far from the set (past twice `set_radius`, or past the escape
-    ///   radius): ½·r·ln r/dr holds only near the boundary (seed 001, part V:
+    ///   radius): ½·r·ln r/dr holds only near the boundary ("Distance Estimated 3D Fractals", part V:
     ///   "for points far away we can restrict the maximum DE step"); after
     ///   one iteration it is about ½·|p|·ln|p|, beyond the true distance
     ///   from |p| ≈ 4.5 (power 8), so rays entering a large bounding sphere
@@ -582,7 +582,7 @@ pub(super) fn distance_to_ball(p: DVec3, bailout: Real) -> Real {
 }
 
 /// ½·r·ln r / `slope`: the distance bound of an orbit that escaped to radius
-/// r, given how fast |z| grows with the starting point (seed 001, part V).
+/// r, given how fast |z| grows with the starting point ("Distance Estimated 3D Fractals", part V).
 /// The logarithm is `math::ln`, which the vector kernel repeats to the bit.
 #[inline]
 pub(super) fn half_r_ln_r_over(r: Real, slope: Real) -> Real {

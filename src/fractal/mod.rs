@@ -6,12 +6,13 @@
 //! estimators built on them.
 //!
 //! Sources: the spherical power and the scalar running derivative
-//! `dr ← n·r^(n−1)·dr (+1 in Mandelbrot mode)` with `DE = ½·ln(r)·r/dr`: seeds
-//! 002 (course notes) and 001 (Christensen, "distance estimated 3D fractals",
-//! parts V–VI, which also gives the potential-gradient, sinh and escape-length
-//! estimators and their costs); the y-up convention, the power-8 polynomial
-//! (a benchmark comparison) and the four orbit traps: seed 000 (Quilez, "The
-//! algorithm", "Optimizing", "Coloring").
+//! `dr ← n·r^(n−1)·dr (+1 in Mandelbrot mode)` with `DE = ½·ln(r)·r/dr`: the
+//! university course notes "Mandelbulb" and Christensen's "Distance
+//! Estimated 3D Fractals", parts V–VI, which also give the
+//! potential-gradient, sinh and escape-length estimators and their costs;
+//! the y-up convention, the power-8 polynomial (a benchmark comparison) and
+//! the four orbit traps: Quilez, "Mandelbulb" ("The algorithm",
+//! "Optimizing", "Coloring").
 
 use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};

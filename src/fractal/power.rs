@@ -85,7 +85,7 @@ pub(super) fn complex_powi<T: Arith>(re: T, im: T, n: u32) -> (T, T) {
 /// The polar angle comes from (pole, ρ) as one complex number, the azimuth
 /// from the unit vector of the equatorial pair as another, where ρ is the
 /// distance from the pole axis; multiplying them out gives the three
-/// conventions of seed 000 with the trigonometric form's exact result. For
+/// conventions of Quilez's "Mandelbulb" with the trigonometric form's exact result. For
 /// n = 8 that is three complex squarings each, cheaper than Quilez's
 /// expanded polynomial, which this replaces. Returns `None` within a relative
 /// 1e-6 of the pole axis, where the azimuth is undefined; the caller then
@@ -144,7 +144,7 @@ pub(super) fn triplex_power_int_unchecked<T: Arith>(
     (out, rho2, r2)
 }
 
-/// Quilez's expanded power-8 polynomial (seed 000, "Optimizing"), kept only
+/// Quilez's expanded power-8 polynomial ("Mandelbulb", "Optimizing"), kept only
 /// so the kernel benchmark can compare it with `triplex_power_int`.
 #[inline]
 pub fn power8_polynomial<T: Number>(w: Triplex<T>) -> Option<Triplex<T>> {

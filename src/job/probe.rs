@@ -154,8 +154,8 @@ mod tests {
 
     #[test]
     fn cost_thumbnails_keep_the_aspect_within_64_pixels_a_side() {
-        // A tall, narrow frame made a thumbnail 64 wide and two million
-        // high; now no frame's has more than 64×64 pixels.
+        // A tall, narrow frame's thumbnail is 64 high, not 64 wide and
+        // two million high: no frame's has more than 64×64 pixels.
         assert_eq!(thumbnail_size(320, 180, 64), (64, 36));
         assert_eq!(thumbnail_size(48, 27, 64), (64, 36));
         assert_eq!(thumbnail_size(1, 32_768, 64), (1, 64));

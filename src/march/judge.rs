@@ -75,3 +75,50 @@ pub fn past_the_set(
     }
     0.0
 }
+
+/// How far along the unit `dir` from `origin` the set begins: membership
+/// steps of `step`, then bisection to the last bit of f64. Only for an
+/// `origin` outside the set whose ray meets it.
+pub fn surface_along(fractal: &Fractal, origin: DVec3, dir: DVec3, step: Real) -> Real {
+    let mut lo = 0.0;
+    while !fractal.contains(origin + dir * (lo + step)) {
+        lo += step;
+    }
+    let mut hi = lo + step;
+    for _ in 0..80 {
+        let mid = 0.5 * (lo + hi);
+        if fractal.contains(origin + dir * mid) {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    lo
+}
+
+/// Root-mean-square distance of an `n`×`n` grid's depths (row by row, as
+/// (depth, footprint)) from the plane that fits them best, in footprints:
+/// how far a block of hits departs from the smooth surface it samples.
+pub fn depth_off_plane(hits: &[(Real, Real)], n: u32) -> Real {
+    // Least squares of t = a + b·x + c·y over a full grid: x and y are
+    // centred, so the three coefficients separate.
+    let m = (n as Real - 1.0) / 2.0;
+    let at = |i: usize| ((i as u32 % n) as Real - m, (i as u32 / n) as Real - m);
+    let count = hits.len() as Real;
+    let a = hits.iter().map(|h| h.0).sum::<Real>() / count;
+    let sxx: Real = (0..hits.len()).map(|i| at(i).0.powi(2)).sum();
+    let slope = |axis: fn((Real, Real)) -> Real| {
+        hits.iter()
+            .enumerate()
+            .map(|(i, h)| axis(at(i)) * h.0)
+            .sum::<Real>()
+            / sxx
+    };
+    let (b, c) = (slope(|x| x.0), slope(|x| x.1));
+    let squares: Real = hits
+        .iter()
+        .enumerate()
+        .map(|(i, h)| ((h.0 - a - b * at(i).0 - c * at(i).1) / h.1).powi(2))
+        .sum();
+    (squares / count).sqrt()
+}

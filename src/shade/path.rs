@@ -12,8 +12,8 @@ use crate::march::{march_many, normals_many, MarchResult, MarchSettings, Ray};
 use crate::math::{DVec3, Real, Vec3};
 use serde::{Deserialize, Serialize};
 
-/// Global illumination by path tracing (seed 001, Christensen, "path tracing
-/// 3D fractals"): Lambertian surfaces with the orbit-trap albedo,
+/// Global illumination by path tracing (Christensen, "Path Tracing 3D
+/// Fractals"): Lambertian surfaces with the orbit-trap albedo,
 /// cosine-weighted bounces, next-event estimation towards a sun of real
 /// angular size, a sky dome, and Russian roulette after the third bounce so
 /// the estimate stays unbiased. Replaces the direct-lighting effects (its sun

@@ -33,13 +33,6 @@ const SEED: u64 = 21;
 /// to fail the test quickly.
 const DEADLINE: Duration = Duration::from_secs(5);
 
-/// Classes of input that once hung or exhausted memory: a frame count or
-/// duration that makes validation walk millions of frames, and an
-/// environment map that never ends (`/dev/zero`, `/dev/urandom`, a FIFO).
-/// `true` skips them (see `known_failure`), to look past one while it is
-/// being mended; `the_known_endless_inputs_get_an_answer` checks each of them.
-const SKIP_KNOWN_FAILURES: bool = false;
-
 fn config() -> Config {
     let given = |name: &str| std::env::var_os(name).is_some();
     // The default reads every PROPTEST_ variable.
@@ -94,9 +87,6 @@ impl Fixtures {
 
     /// Loads `bytes` as a timeline under the guard; the problem, if any.
     fn check(&self, bytes: &[u8]) -> Result<(), String> {
-        if SKIP_KNOWN_FAILURES && known_failure(bytes).is_some() {
-            return Ok(());
-        }
         let path = self.dir.path().join("timeline.ron");
         std::fs::write(&path, bytes).expect("write the case");
         let lines = bytes.iter().filter(|&&b| b == b'\n').count() + 1;
@@ -164,49 +154,6 @@ fn error_points_inside(e: &Error, lines: usize) -> Result<(), String> {
             Err(format!("line {l} of a file of {lines} lines: {shown}"))
         }
         _ => Ok(()),
-    }
-}
-
-/// Why `bytes` is one of the known failures (`SKIP_KNOWN_FAILURES`), if it
-/// is: an endless map named anywhere, or more than `WALK` scenes for
-/// validation to build (frames, times motion blur's samples).
-fn known_failure(bytes: &[u8]) -> Option<&'static str> {
-    const WALK: f64 = 100_000.0;
-    let text = String::from_utf8_lossy(bytes);
-    if ["/dev/zero", "/dev/urandom", "fifo"]
-        .iter()
-        .any(|p| text.contains(p))
-    {
-        return Some("an environment map that never ends");
-    }
-    let options =
-        ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME);
-    let value: ron::Value = options.from_str(&text).ok()?;
-    let number = |v: &ron::Value, key: &str| match field(v, key)? {
-        ron::Value::Number(n) => Some(n.into_f64()),
-        _ => None,
-    };
-    let frames = number(&value, "frames")
-        .or_else(|| Some(number(&value, "duration_seconds")? * number(&value, "fps")?))?;
-    let scene = field(&value, "scene");
-    let blurred = scene
-        .and_then(|s| field(s, "effects"))
-        .and_then(|e| field(e, "motion_blur"))
-        .is_some_and(|m| !matches!(m, ron::Value::Option(None)));
-    let samples = scene.and_then(|s| number(s, "samples_per_pixel"));
-    let scenes = frames
-        * if blurred {
-            samples.unwrap_or(1.0) + 1.0
-        } else {
-            1.0
-        };
-    (scenes > WALK).then_some("validation walks every frame")
-}
-
-fn field<'a>(value: &'a ron::Value, key: &str) -> Option<&'a ron::Value> {
-    match value {
-        ron::Value::Map(map) => map.get(&ron::Value::String(key.into())),
-        _ => None,
     }
 }
 
@@ -471,13 +418,12 @@ fn every_kind_of_environment_map_path_gets_an_answer() {
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-/// The known failures (`SKIP_KNOWN_FAILURES`), each spelled out.
+/// Inputs that would make loading walk billions of frames or read
+/// forever, each spelled out: a frame count or duration that makes
+/// validation walk millions of frames, and an environment map that never
+/// ends (`/dev/zero`, `/dev/urandom`, a FIFO).
 #[test]
 fn the_known_endless_inputs_get_an_answer() {
-    if SKIP_KNOWN_FAILURES {
-        eprintln!("skipped: SKIP_KNOWN_FAILURES is set");
-        return;
-    }
     let fixtures = Fixtures::new();
     let still = |fields: &str| format!("(fps: 24, size: (8, 8), {fields})");
     let inputs = [

@@ -1,4 +1,4 @@
-//! Input that once hung mandelreel or filled the memory: FIFOs and devices
+//! Input that could hang a program or fill the memory: FIFOs and devices
 //! where files belong, huge maps, counts no film needs, frames too costly
 //! to measure. Each is answered at once, or refused naming the limit.
 
@@ -86,7 +86,7 @@ fn a_map_file_past_256_mib_is_refused_unread() {
 
 #[test]
 fn four_billion_frames_are_refused_with_the_limit() {
-    // Taken before: every frame's scene was checked, for hours.
+    // Checking every frame's scene would take hours.
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(4_000_000_000, 8.0));
     let out = guarded(&d, &["render", "t.ron"]);

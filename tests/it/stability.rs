@@ -500,8 +500,8 @@ fn single_precision_takes_huge_bailouts() {
 #[test]
 fn a_julia_camera_on_the_critical_point_sees_the_set() {
     // In Julia mode the derivative of z ↦ zⁿ + c is 0 at z = 0: the
-    // estimate there was 0 (every ray hit at once) and, nearby, far too
-    // large. c = (0.8, 0.3, 0.2) leaves 0 outside the set, which is first
+    // naive estimate there is 0 (every ray would hit at once) and, nearby,
+    // far too large. c = (0.8, 0.3, 0.2) leaves 0 outside the set, which is first
     // met 0.59 along the view: each ray must find what it finds when
     // started 0.3 along, past the critical point, where membership finds
     // nothing before.

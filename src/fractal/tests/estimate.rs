@@ -197,7 +197,7 @@ fn jacobian_on_the_pole_axis_is_conservative() {
 #[test]
 fn methods_agree_with_analytic_near_the_surface() {
     // Near the surface every estimator approximates the same distance; the
-    // scalar ones differ by bounded factors (seed 001 compares them). The
+    // scalar ones differ by bounded factors (Christensen's "Distance Estimated 3D Fractals", part V, compares them). The
     // stated tolerance: within a factor of 3 of the analytic estimate for
     // 90% of points 1e-4..1e-2 from the surface.
     let analytic = Fractal::default();

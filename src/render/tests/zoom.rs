@@ -4,26 +4,14 @@ use crate::fractal::Fractal;
 use crate::march::*;
 use crate::math::{DVec3, Real};
 
-/// Hits (t and point) of an n×n block of pixels in the middle of a
-/// 1920×1080 frame, with the camera `distance` from a surface point,
-/// looking straight at it; with each ray's footprint at the hit.
-/// Where the deep-zoom measurements look at the bulb: the surface
-/// point on the ray from `origin` along `dir`.
-const SURFACES: [(DVec3, DVec3); 2] = [
-    (DVec3::new(0.1, 0.35, 2.0), DVec3::new(0.3, -0.2, -1.0)),
-    (DVec3::new(-0.4, 0.2, 2.0), DVec3::new(0.2, -0.1, -1.0)),
-];
+/// Where the deep-zoom test looks at the bulb: the surface point on the
+/// ray from this origin along this direction.
+const SURFACE: (DVec3, DVec3) = (DVec3::new(0.1, 0.35, 2.0), DVec3::new(0.3, -0.2, -1.0));
 
+/// Hits (t, point and the ray's footprint there) of an n×n block of pixels
+/// in the middle of a 1920×1080 frame, with the camera `distance` from the
+/// surface point, looking straight at it.
 fn block_hits_with_depth(
-    precision: crate::fractal::Precision,
-    distance: Real,
-    n: u32,
-) -> Vec<(Real, DVec3, Real)> {
-    block_hits_at(SURFACES[0], precision, distance, n)
-}
-
-fn block_hits_at(
-    (origin, dir): (DVec3, DVec3),
     precision: crate::fractal::Precision,
     distance: Real,
     n: u32,
@@ -33,27 +21,12 @@ fn block_hits_at(
         iterations: 30,
         ..Fractal::default()
     };
-    // The surface point on a fixed ray: membership steps of 1e-4, then
-    // bisection to the last bit of f64.
-    let dir = dir.normalize();
+    let (origin, dir) = (SURFACE.0, SURFACE.1.normalize());
     let exact = Fractal {
         iterations: 30,
         ..Fractal::default()
     };
-    let mut lo = 0.0;
-    while !exact.contains(origin + dir * (lo + 1e-4)) {
-        lo += 1e-4;
-    }
-    let mut hi = lo + 1e-4;
-    for _ in 0..80 {
-        let mid = 0.5 * (lo + hi);
-        if exact.contains(origin + dir * mid) {
-            hi = mid;
-        } else {
-            lo = mid;
-        }
-    }
-    let target = origin + dir * lo;
+    let target = origin + dir * judge::surface_along(&exact, origin, dir, 1e-4);
     let camera = crate::camera::Camera {
         position: target - dir * distance,
         target,
@@ -106,7 +79,8 @@ fn deep_zoom_in_f64_stays_sharp_to_1e_12() {
         // And the depths follow the surface: within half a footprint
         // of a plane (a depth stuck at the camera or in one terrace
         // over a sloping block would not be).
-        let off = depth_off_plane(&with_depth, 6);
+        let depths: Vec<(Real, Real)> = with_depth.iter().map(|h| (h.0, h.2)).collect();
+        let off = judge::depth_off_plane(&depths, 6);
         assert!(
             off < 0.5,
             "depths {off} footprints off a plane at {distance}"
@@ -149,91 +123,5 @@ mod properties {
                 prop_assert!(n.is_finite() && (n.length() - 1.0).abs() < 1e-9);
             }
         }
-    }
-}
-
-/// Root-mean-square distance of hit depths from the plane that fits
-/// them best over the pixel grid (`n`×`n`, row by row), in footprints:
-/// how far a deep zoom's depths depart from the smooth surface they sample.
-fn depth_off_plane(hits: &[(Real, DVec3, Real)], n: u32) -> Real {
-    // Least squares of t = a + b·x + c·y over a full grid: x and y are
-    // centred, so the three coefficients separate.
-    let m = (n as Real - 1.0) / 2.0;
-    let at = |i: usize| ((i as u32 % n) as Real - m, (i as u32 / n) as Real - m);
-    let count = hits.len() as Real;
-    let a = hits.iter().map(|h| h.0).sum::<Real>() / count;
-    let sxx: Real = (0..hits.len()).map(|i| at(i).0.powi(2)).sum();
-    let b = hits
-        .iter()
-        .enumerate()
-        .map(|(i, h)| at(i).0 * h.0)
-        .sum::<Real>()
-        / sxx;
-    let c = hits
-        .iter()
-        .enumerate()
-        .map(|(i, h)| at(i).1 * h.0)
-        .sum::<Real>()
-        / sxx;
-    let squares: Real = hits
-        .iter()
-        .enumerate()
-        .map(|(i, h)| ((h.0 - a - b * at(i).0 - c * at(i).1) / h.2).powi(2))
-        .sum();
-    (squares / count).sqrt()
-}
-
-fn distinct_depths(hits: &[(Real, DVec3, Real)]) -> usize {
-    let mut v: Vec<u64> = hits.iter().map(|h| h.0.to_bits()).collect();
-    v.sort();
-    v.dedup();
-    v.len()
-}
-
-#[test]
-#[ignore = "measurement for docs/stability.md: cargo test --release -- --ignored zoom_depth_limits --nocapture"]
-fn zoom_depth_limits() {
-    use crate::fractal::Precision;
-    let distances = [
-        1e-3, 1e-4, 1e-5, 1e-6, 1e-8, 1e-10, 1e-12, 5e-13, 2e-13, 1e-13, 5e-14, 2e-14, 1e-14,
-        5e-15, 2e-15,
-    ];
-    for d in distances {
-        let wide = block_hits_with_depth(Precision::F64, d, 8);
-        let single = block_hits_with_depth(Precision::F32, d, 8);
-        let median_off = |a: &[(Real, DVec3, Real)], b: &[(Real, DVec3, Real)]| {
-            let mut e: Vec<Real> = a
-                .iter()
-                .zip(b)
-                .map(|(a, b)| (a.0 - b.0).abs() / a.2)
-                .collect();
-            e.sort_by(|a, b| a.total_cmp(b));
-            e.get(e.len() / 2).copied().unwrap_or(Real::NAN)
-        };
-        let other = |p| block_hits_at(SURFACES[1], p, d, 8);
-        eprintln!(
-            "{d:e} second surface: f32 depth off f64 by median {:.2} footprints",
-            median_off(&other(Precision::F64), &other(Precision::F32))
-        );
-        let mut errors: Vec<Real> = wide
-            .iter()
-            .zip(&single)
-            .map(|(a, b)| (a.0 - b.0).abs() / a.2)
-            .collect();
-        errors.sort_by(|a, b| a.total_cmp(b));
-        let points: Vec<DVec3> = wide.iter().map(|h| h.1).collect();
-        let plane = if wide.len() == 64 {
-            format!("{:.2}", depth_off_plane(&wide, 8))
-        } else {
-            "-".into()
-        };
-        eprintln!(
-            "{d:e}: f64 {} hits, {} distinct points, {} distinct depths, {plane} footprints off a plane; f32 depth off f64 by median {:.2} / max {:.2} footprints",
-            wide.len(),
-            distinct(&points),
-            distinct_depths(&wide),
-            errors.get(errors.len() / 2).copied().unwrap_or(Real::NAN),
-            errors.last().copied().unwrap_or(Real::NAN),
-        );
     }
 }
