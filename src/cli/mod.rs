@@ -41,6 +41,7 @@ mod quality;
 mod render;
 mod sheet;
 mod status;
+mod values;
 
 pub use args::{
     AccuracyArgs, BenchArgs, ExploreArgs, PickArgs, QualityArgs, RenderArgs, SequenceArgs,

@@ -39,7 +39,7 @@ impl Formula {
 }
 
 /// How the distance to the surface is estimated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum DeMethod {
     /// ½·ln r·r/dr with the running scalar derivative (one orbit).
     Analytic,
@@ -75,7 +75,7 @@ impl DeMethod {
 }
 
 /// Floating-point precision of the distance-estimator kernel.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Precision {
     F64,
     /// Single precision, as GPU renderers use; marching itself stays f64.

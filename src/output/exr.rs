@@ -348,16 +348,7 @@ fn exr_ends_with_its_last_chunk(
 
 /// The compressions `--exr-compression` offers: every one exrs writes.
 #[derive(
-    Clone,
-    Copy,
-    Debug,
-    Default,
-    PartialEq,
-    Eq,
-    Hash,
-    clap::ValueEnum,
-    serde::Serialize,
-    serde::Deserialize,
+    Clone, Copy, Debug, Default, PartialEq, Eq, Hash, serde::Serialize, serde::Deserialize,
 )]
 #[serde(rename_all = "lowercase")]
 pub enum ExrCompression {
@@ -385,6 +376,19 @@ pub enum ExrCompression {
 }
 
 impl ExrCompression {
+    pub const ALL: [ExrCompression; 10] = [
+        ExrCompression::None,
+        ExrCompression::Rle,
+        ExrCompression::Zips,
+        ExrCompression::Zip,
+        ExrCompression::Piz,
+        ExrCompression::Pxr24,
+        ExrCompression::B44,
+        ExrCompression::B44a,
+        ExrCompression::Dwaa,
+        ExrCompression::Dwab,
+    ];
+
     fn exr(self) -> exr::prelude::Compression {
         use exr::prelude::Compression as C;
         match self {

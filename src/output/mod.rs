@@ -28,14 +28,13 @@ pub const HASH_KEY: &str = "mandelreel-hash";
 pub const STATS_KEY: &str = "mandelreel-stats";
 
 /// An output file format.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, clap::ValueEnum)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Format {
     /// 8-bit sRGB PNG, dithered (no banding in smooth gradients).
     Png,
     /// 16-bit sRGB PNG.
     Png16,
     /// 16-bit sRGB PNG with straight (unpremultiplied) alpha.
-    #[value(name = "png16alpha")]
     Png16Alpha,
     /// OpenEXR: linear half-float premultiplied R, G, B, A and a float
     /// depth.Z (camera distance), plus the layers --aov asks for.
@@ -43,6 +42,8 @@ pub enum Format {
 }
 
 impl Format {
+    pub const ALL: [Format; 4] = [Format::Png, Format::Png16, Format::Png16Alpha, Format::Exr];
+
     pub fn extension(self) -> &'static str {
         match self {
             Format::Png | Format::Png16 | Format::Png16Alpha => "png",
@@ -62,7 +63,9 @@ impl Format {
 
     /// The format `--format` calls `name`.
     pub fn named(name: &str) -> Option<Format> {
-        <Format as clap::ValueEnum>::from_str(name, true).ok()
+        Format::ALL
+            .into_iter()
+            .find(|f| f.name().eq_ignore_ascii_case(name))
     }
 
     pub fn is_png(self) -> bool {
@@ -127,17 +130,7 @@ pub struct Encoding {
 
 /// Extra EXR layers (arbitrary output variables) a render can write.
 #[derive(
-    Clone,
-    Copy,
-    Debug,
-    PartialEq,
-    Eq,
-    Hash,
-    PartialOrd,
-    Ord,
-    clap::ValueEnum,
-    Serialize,
-    serde::Deserialize,
+    Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, serde::Deserialize,
 )]
 #[serde(rename_all = "lowercase")]
 pub enum Aov {
@@ -152,6 +145,8 @@ pub enum Aov {
 }
 
 impl Aov {
+    pub const ALL: [Aov; 4] = [Aov::Normal, Aov::Albedo, Aov::Traps, Aov::Steps];
+
     /// The layer's name, as `--aov` takes it.
     pub fn name(self) -> &'static str {
         match self {
