@@ -4,14 +4,11 @@
 //! (`FRAME_SIZE=WxH` for another size than 1080p).
 
 use mandelreel::output::exr::ExrCompression;
-use mandelreel::output::{frames::write_frame, Encoding, Format};
+use mandelreel::output::{write_frame, Encoding, Format};
 use mandelreel::render::Film;
 use std::sync::OnceLock;
 
-const COMPRESSIONS: [ExrCompression; 10] = {
-    use ExrCompression::*;
-    [None, Rle, Zips, Zip, Piz, Pxr24, B44, B44a, Dwaa, Dwab]
-};
+const COMPRESSIONS: [ExrCompression; 10] = ExrCompression::ALL;
 const PNGS: [Format; 3] = [Format::Png, Format::Png16, Format::Png16Alpha];
 
 fn film() -> &'static Film {

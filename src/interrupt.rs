@@ -61,6 +61,7 @@ impl Actions {
 }
 
 /// `Actions::on_interrupt`, taking the lock for it.
+#[cfg(test)]
 pub fn on_interrupt(cleanup: impl FnOnce() + Send + 'static) -> Registered {
     hold().on_interrupt(cleanup)
 }

@@ -4,31 +4,35 @@
 //! job, the output files, the timeline and the renderer to the fractal and the
 //! arithmetic; each uses only the layers below it. docs/architecture.md lists
 //! them and tests/it/layers.rs holds the code to that list.
+//!
+//! Public are the modules the binary, the tests, the benchmarks and the
+//! examples use, and inside them the parts those use; everything else is
+//! private to the crate.
 
 #![forbid(unsafe_code)]
 
-pub mod accuracy;
-pub mod bench;
+mod accuracy;
+mod bench;
 pub mod camera;
 pub mod cli;
-pub mod color;
+mod color;
 pub mod deep;
-pub mod environment;
+mod environment;
 pub mod error;
-pub mod exact;
-pub mod explore;
+mod exact;
+mod explore;
 pub mod fractal;
-pub mod host;
-pub mod input;
-pub mod interrupt;
+mod host;
+mod input;
+mod interrupt;
 pub mod job;
 pub mod march;
 pub mod math;
 pub mod output;
-pub mod quality;
+mod quality;
 pub mod render;
 pub mod scene;
-pub mod shade;
+mod shade;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.

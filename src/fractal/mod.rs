@@ -233,7 +233,7 @@ impl Estimate {
 /// A point of the kernel's number type.
 pub type Triplex<T> = [T; 3];
 
-pub mod deep;
+pub(crate) mod deep;
 mod estimate;
 mod form;
 mod kernel;

@@ -5,19 +5,19 @@
 //! folder, warnings, and the cost probe `info` shows. Nothing here parses
 //! arguments or prints.
 
-pub mod checkpoint;
-pub mod claim;
-pub mod describe;
-pub mod frames;
-pub mod memory;
-pub mod plan;
-pub mod probe;
-pub mod record;
+pub(crate) mod checkpoint;
+pub(crate) mod claim;
+pub(crate) mod describe;
+pub(crate) mod frames;
+pub(crate) mod memory;
+pub(crate) mod plan;
+pub(crate) mod probe;
+pub(crate) mod record;
 pub mod request;
-pub mod run;
-pub mod status;
-pub mod warnings;
-pub mod waves;
+pub(crate) mod run;
+pub(crate) mod status;
+pub(crate) mod warnings;
+pub(crate) mod waves;
 
 pub use plan::Plan;
 pub use request::{Request, Sequence};

@@ -7,19 +7,20 @@
 //! contact sheets (`sheet`), CSV tables (`csv`) and the font drawn text
 //! uses (`font`).
 
-pub mod atomic;
-pub mod csv;
+pub(crate) mod atomic;
+pub(crate) mod csv;
 pub mod exr;
-pub mod font;
-pub mod frames;
-pub mod names;
-pub mod png;
-pub mod sheet;
+pub(crate) mod font;
+pub(crate) mod frames;
+pub(crate) mod names;
+pub(crate) mod png;
+pub(crate) mod sheet;
 
 #[cfg(test)]
 mod tests;
 
 use crate::render::Film;
+pub use frames::write_frame;
 use serde::Serialize;
 
 /// Metadata key under which every frame stores the hash of what made it.

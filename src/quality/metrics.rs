@@ -91,6 +91,7 @@ impl Luma {
 /// smallest), while those neighbours agree among themselves (max − min of
 /// their values at most 60). An isolated dot that the neighbours do not
 /// explain: unconverged samples, a firefly, a missed surface.
+#[cfg(test)]
 pub fn speckles(img: &RgbImage) -> u64 {
     speckles_in(&Luma::of(img))
 }
@@ -120,6 +121,7 @@ fn is_speckle(value: f64, mut neighbours: [f64; 8]) -> bool {
 ///
 /// # Panics
 /// If the two frames differ in size (`measure` checks that first).
+#[cfg(test)]
 pub fn pops(prev: &RgbImage, next: &RgbImage) -> u64 {
     pops_between(&Luma::of(prev), &Luma::of(next))
 }

@@ -6,10 +6,10 @@
 //! other commands may hand over frames they rendered. `report` prints the
 //! result as a table.
 
-pub mod metrics;
-pub mod report;
+pub(crate) mod metrics;
+pub(crate) mod report;
 
-pub use metrics::{mse, pops, psnr_db, speckles};
+pub use metrics::psnr_db;
 
 use crate::error::{Error, Result};
 use image::RgbImage;
@@ -62,6 +62,7 @@ pub struct SequenceQuality {
 /// Measures `frames`, a sequence in order, all of one size; with
 /// `reference`, each frame against the reference frame of the same number,
 /// which must be there and of the same size. The errors name the frame.
+#[cfg(test)]
 pub fn measure(frames: &[FrameImage], reference: Option<&[FrameImage]>) -> Result<SequenceQuality> {
     let mut meter = Meter::default();
     for frame in frames {
@@ -74,6 +75,7 @@ pub fn measure(frames: &[FrameImage], reference: Option<&[FrameImage]>) -> Resul
     meter.finish()
 }
 
+#[cfg(test)]
 fn reference_frame(all: &[FrameImage], frame: u32) -> Result<&RgbImage> {
     all.iter()
         .find(|r| r.frame == frame)

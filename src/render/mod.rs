@@ -12,10 +12,10 @@ use crate::scene::Scene;
 use rayon::prelude::*;
 
 mod accumulation;
-pub mod adaptive;
+pub(crate) mod adaptive;
 mod band;
 mod film;
-pub mod pick;
+pub(crate) mod pick;
 mod rows;
 mod sampler;
 mod stats;

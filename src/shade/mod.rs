@@ -26,17 +26,13 @@ mod sky;
 
 pub use bundle::{walk_shadows, BundleScratch};
 pub use fog::{fogged, glow, Fog, Glow};
-pub use look::{Light, Look, Specular, MAX_LIGHTS};
+pub use look::{Look, Specular, MAX_LIGHTS};
 #[cfg(test)]
-pub use palette::{mix_oklab, smooth_iterations};
-pub use palette::{OrbitQuantity, Palette, Stop, Table as PaletteTable, Wrap, MAX_STOPS};
-#[cfg(test)]
-pub use path::trace_path;
-pub use path::{cone_direction, cosine_direction, trace_paths, PathScratch, PathTracing};
-#[cfg(test)]
-pub use shadow::occlusion;
-pub use shadow::{occlusions, shadow, AmbientOcclusion, ShadowWalk, Shadows};
-pub use sky::{preetham, Sky};
+pub use palette::{OrbitQuantity, Palette};
+pub use palette::{Stop, Table as PaletteTable, MAX_STOPS};
+pub use path::{trace_paths, PathScratch, PathTracing};
+pub use shadow::{occlusions, AmbientOcclusion, ShadowWalk, Shadows};
+pub use sky::Sky;
 
 /// The effects a scene calls for; each is off unless given.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]

@@ -50,6 +50,8 @@ impl Default for AmbientOcclusion {
 
 /// Light reaching `from` along `to_light`: 1 unoccluded, 0 blocked, in between
 /// in a penumbra (`softness` > 0). Returns the factor and the estimates spent.
+/// One ray alone: what the tests hold the walks side by side to.
+#[cfg(test)]
 pub fn shadow(
     fractal: &Fractal,
     settings: &MarchSettings,

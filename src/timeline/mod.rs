@@ -8,14 +8,14 @@
 //! spline code; `camera.distance` is interpolated in log space so a zoom
 //! keeps a constant apparent speed over many decades of scale.
 
-pub mod auto;
+pub(crate) mod auto;
 mod checks;
 mod deep_keys;
-pub mod edit;
+pub(crate) mod edit;
 mod limits;
 pub use limits::{MAX_SAMPLES, MAX_SIDE};
 mod messages;
-pub mod parameters;
+pub(crate) mod parameters;
 mod parse;
 mod relative;
 mod scan;

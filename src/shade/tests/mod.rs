@@ -2,6 +2,7 @@
 
 use super::fog::*;
 use super::look::*;
+use super::palette::*;
 use super::path::*;
 use super::shadow::*;
 use super::sky::*;

@@ -995,7 +995,7 @@ fn a_camera_too_far_to_see_anything_is_refused_by_name() {
 
 /// timelines/zoom.ron with `iterations: Auto` and its iterations track cut.
 fn zoom_with_auto() -> String {
-    let text = include_str!("../../timelines/zoom.ron");
+    let text = include_str!("../../../timelines/zoom.ron");
     let line = "iterations: 10,     // raised by a track as the zoom deepens";
     assert!(text.contains(line), "zoom.ron's iterations line moved");
     let text = text.replace(line, "iterations: Auto,");
