@@ -213,9 +213,19 @@ pub fn moved(anchor: &str, delta: f64) -> String {
 }
 
 /// One component as written: a number or a string of digits.
+#[derive(Clone, Debug, PartialEq)]
 pub(crate) enum Component {
     Number(f64),
     Digits(String, f64),
+}
+
+impl Component {
+    /// Its value in f64 (a string of digits' nearest).
+    pub(crate) fn value(&self) -> f64 {
+        match self {
+            Component::Number(v) | Component::Digits(_, v) => *v,
+        }
+    }
 }
 
 impl<'de> Deserialize<'de> for Component {

@@ -3,8 +3,9 @@
 //! server-sent events. Every route is behind `guard::check`.
 
 use super::renderer::Stage;
-use super::view::View;
+use super::view::{View, NOT_DIGITS};
 use super::{Event, State};
+use crate::exact::{Component, Coordinates};
 use axum::http::{header, HeaderValue, StatusCode};
 use axum::response::sse::{KeepAlive, Sse};
 use axum::response::{IntoResponse, Response};
@@ -22,6 +23,7 @@ pub fn router(state: Arc<State>) -> Router {
         .route("/explore.css", get(super::page::style))
         .route("/api/state", get(timeline_state))
         .route("/api/values", get(values))
+        .route("/api/digits", get(digits))
         .route("/api/iterations", get(iterations))
         .route("/api/render", post(render))
         .route("/api/pick", post(pick))
@@ -142,6 +144,18 @@ async fn values(state: Shared, query: axum::extract::Query<FrameQuery>) -> Respo
         return refused(StatusCode::UNPROCESSABLE_ENTITY, message);
     }
     Json(super::view::values(&timeline, query.frame)).into_response()
+}
+
+async fn digits(state: Shared, query: axum::extract::Query<FrameQuery>) -> Response {
+    let timeline = state.document.lock().expect("document").timeline.clone();
+    if query.frame >= timeline.frame_count {
+        let last = timeline.frame_count - 1;
+        return refused(
+            StatusCode::UNPROCESSABLE_ENTITY,
+            format!("frame {} is past the last frame ({last})", query.frame),
+        );
+    }
+    Json(super::view::digits(&timeline, query.frame)).into_response()
 }
 
 async fn iterations(state: Shared, query: axum::extract::Query<FrameQuery>) -> Response {
@@ -287,12 +301,12 @@ async fn estimate(state: Shared, Json(view): Json<View>) -> Response {
 enum EditRequest {
     SetScene {
         parameter: String,
-        value: Vec<f64>,
+        value: Vec<Component>,
     },
     SetKey {
         track: String,
         time: f64,
-        value: Vec<f64>,
+        value: Vec<Component>,
     },
     DeleteKey {
         track: String,
@@ -324,11 +338,21 @@ impl EditRequest {
     }
 }
 
-fn key_value(name: &str, value: &[f64]) -> Result<crate::timeline::KeyValue, String> {
+/// A value as the page sends it: one number or three, where a point that
+/// takes digits (`parameters::Exact`) may have strings of digits among them.
+fn key_value(name: &str, value: &[Component]) -> Result<crate::timeline::KeyValue, String> {
     use crate::timeline::KeyValue;
-    match *value {
-        [v] => Ok(KeyValue::Number(v)),
-        [x, y, z] => Ok(KeyValue::Triple(x, y, z)),
+    let digits = value.iter().any(|c| matches!(c, Component::Digits(..)));
+    let takes = crate::timeline::parameters::find(name).is_some_and(|p| p.digits.is_some());
+    match value {
+        [x, y, z] if digits && takes => Ok(KeyValue::Digits(Coordinates::from_components([
+            x.clone(),
+            y.clone(),
+            z.clone(),
+        ]))),
+        _ if digits => Err(format!("{name}: {NOT_DIGITS}")),
+        [v] => Ok(KeyValue::Number(v.value())),
+        [x, y, z] => Ok(KeyValue::Triple(x.value(), y.value(), z.value())),
         _ => Err(format!(
             "{name}: a value is one number or three, got {}",
             value.len()

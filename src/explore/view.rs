@@ -3,6 +3,7 @@
 //! samples as `render --size --samples` take them; checked as the command
 //! line checks them.
 
+use crate::exact::{Component, Coordinates};
 use crate::job::request::MAX_SAMPLES;
 use crate::scene::Scene;
 use crate::timeline::Timeline;
@@ -22,13 +23,42 @@ pub struct View {
     pub frame: u32,
     /// Parameter values that replace the tracks' at this frame.
     #[serde(default)]
-    pub overrides: BTreeMap<String, Vec<f64>>,
+    pub overrides: BTreeMap<String, Override>,
     /// `WIDTHxHEIGHT`, as `--size`; the timeline's size where absent.
     #[serde(default)]
     pub size: Option<String>,
     /// As `--samples`; the timeline's where absent.
     #[serde(default)]
     pub samples: Option<u32>,
+}
+
+/// What a parameter that takes no digits says of a string of them.
+pub const NOT_DIGITS: &str =
+    "takes numbers; strings of digits are for the camera's position and target and the Julia constant";
+
+/// A parameter's value in a view: numbers, and for a point a deep frame
+/// needs more exactly than f64 holds, strings of digits among them.
+#[derive(Clone, Debug, Default, PartialEq, Deserialize)]
+#[serde(transparent)]
+pub struct Override(Vec<Component>);
+
+impl From<Vec<f64>> for Override {
+    fn from(numbers: Vec<f64>) -> Override {
+        Override(numbers.into_iter().map(Component::Number).collect())
+    }
+}
+
+impl Override {
+    fn numbers(&self) -> Vec<f64> {
+        self.0.iter().map(Component::value).collect()
+    }
+
+    /// The point it is, where a component is a string of digits.
+    fn digits(&self) -> Option<Coordinates> {
+        let any = self.0.iter().any(|c| matches!(c, Component::Digits(..)));
+        let parts: [Component; 3] = self.0.clone().try_into().ok()?;
+        any.then(|| Coordinates::from_components(parts))
+    }
 }
 
 /// A view's scenes (one per sample under motion blur), size and hash.
@@ -107,10 +137,15 @@ impl View {
     fn lay_over(&self, scene: &mut Scene) -> Result<(), String> {
         let zoom = crate::timeline::ZOOM_TRACK;
         let (last, first): (Vec<_>, Vec<_>) = self.overrides.iter().partition(|(n, _)| *n == zoom);
-        for (name, values) in first.into_iter().chain(last) {
+        for (name, given) in first.into_iter().chain(last) {
             let parameter = crate::timeline::parameters::find(name)
                 .ok_or_else(|| format!("{name}: no such parameter"))?;
+            let values = &given.numbers();
             let wanted = parameter.shape.components();
+            let digits = given.digits();
+            if digits.is_some() && parameter.digits.is_none() {
+                return Err(format!("{name}: {NOT_DIGITS}"));
+            }
             if values.len() != wanted {
                 return Err(format!(
                     "{name}: takes {wanted} numbers, got {}",
@@ -146,8 +181,10 @@ impl View {
                     values[0]
                 ));
             }
-            if !crate::timeline::edit::rounds_digits(scene, parameter, values) {
-                (parameter.set)(scene, values);
+            match (digits, parameter.digits) {
+                (Some(point), Some(exact)) => (exact.set)(scene, point),
+                _ if crate::timeline::edit::rounds_digits(scene, parameter, values) => {}
+                _ => (parameter.set)(scene, values),
             }
         }
         crate::timeline::validate_scene(scene)
@@ -180,6 +217,19 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
                     false => v,
                 }),
             )
+        })
+        .collect()
+}
+
+/// The strings of digits the scene of `frame` holds a point in, by
+/// parameter: what the page shows and sends back for those points, which
+/// `values` gives only as their nearest numbers.
+pub fn digits(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, [String; 3]> {
+    let scene = timeline.scene_at(frame);
+    crate::timeline::parameters::all()
+        .filter_map(|p| {
+            let point = (p.digits?.get)(&scene)?;
+            Some((p.name, point.digits?.as_ref().clone()))
         })
         .collect()
 }
@@ -306,7 +356,8 @@ mod tests {
             frame: 300,
             ..View::default()
         };
-        view.overrides.insert("camera.distance".into(), vec![1e-25]);
+        view.overrides
+            .insert("camera.distance".into(), vec![1e-25].into());
         let prepared = view.prepare(&t).unwrap();
         let scene = &prepared.scenes[0];
         let auto = scene.fractal.auto.unwrap();
@@ -321,11 +372,12 @@ mod tests {
             frame: 30,
             ..View::default()
         };
-        view.overrides.insert("camera.distance".into(), vec![0.5]);
         view.overrides
-            .insert("camera.position".into(), vec![0.0, 1.0, 3.0]);
+            .insert("camera.distance".into(), vec![0.5].into());
         view.overrides
-            .insert("camera.target".into(), vec![0.0, 1.0, 0.0]);
+            .insert("camera.position".into(), vec![0.0, 1.0, 3.0].into());
+        view.overrides
+            .insert("camera.target".into(), vec![0.0, 1.0, 0.0].into());
         let camera = &view.prepare(&zoom()).unwrap().scenes[0].camera;
         assert!((camera.position - crate::math::DVec3::new(0.0, 1.0, 0.5)).length() < 1e-12);
     }
@@ -358,12 +410,12 @@ mod tests {
         let mut view = View::default();
         let green = vec![0.0, 1.0, 0.0];
         view.overrides
-            .insert("look.palette.stops[1].colour".into(), green);
+            .insert("look.palette.stops[1].colour".into(), green.into());
         let scene = &view.prepare(&t).unwrap().scenes[0];
         let stop = scene.look.palette.as_ref().unwrap().stops[1];
         assert_eq!(stop.colour, crate::math::Vec3::new(0.0, 1.0, 0.0));
         view.overrides
-            .insert("look.palette.stops[2].colour".into(), vec![1.0; 3]);
+            .insert("look.palette.stops[2].colour".into(), vec![1.0; 3].into());
         assert!(view
             .prepare(&t)
             .err()
@@ -381,11 +433,42 @@ mod tests {
     }
 
     #[test]
+    fn a_point_typed_in_digits_is_viewed_and_shown_in_its_digits() {
+        let text = std::fs::read_to_string("timelines/deep_zoom.ron").unwrap();
+        let t = Timeline::parse(&text, Path::new("deep_zoom.ron")).unwrap();
+        let written = "-1.10408951367381233764950538762334472132532660078012416551453";
+        assert_eq!(
+            digits(&t, 539)["camera.target"],
+            ["0".to_string(), written.into(), "0".into()]
+        );
+        assert!(!digits(&zoom(), 0).contains_key("camera.target"));
+        // The same point 1e-40 along x, which no f64 tells from it.
+        let moved = "0.0000000000000000000000000000000000000001";
+        let typed: Override =
+            serde_json::from_str(&format!(r#"["{moved}", "{written}", 0]"#)).unwrap();
+        let view = View {
+            frame: 539,
+            overrides: [("camera.target".to_string(), typed)].into(),
+            ..View::default()
+        };
+        let scene = &view.prepare(&t).unwrap().scenes[0];
+        let held = scene.camera.target_digits.as_deref().unwrap();
+        assert_eq!(held, &[moved.to_string(), written.into(), "0.0".into()]);
+        // Digits only where a point takes them.
+        let up: Override = serde_json::from_str(r#"["0.1", 1, 0]"#).unwrap();
+        let view = View {
+            overrides: [("camera.up".to_string(), up)].into(),
+            ..View::default()
+        };
+        assert!(view.prepare(&t).err().unwrap().contains("takes numbers"));
+    }
+
+    #[test]
     fn bad_views_say_what_is_wrong() {
         let t = zoom();
         let error = |view: View| view.prepare(&t).err().unwrap();
         let at = |name: &str, v: Vec<f64>| View {
-            overrides: [(name.to_string(), v)].into(),
+            overrides: [(name.to_string(), v.into())].into(),
             ..View::default()
         };
         assert!(error(View {

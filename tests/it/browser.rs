@@ -471,6 +471,58 @@ fn a_first_key_away_from_the_start_keeps_the_films_start() {
     );
 }
 
+/// A still whose target is held in digits, as a deep zoom's is.
+const HELD: &str = r#"(fps: 24, frames: 2, size: (64, 36), scene: (
+    camera: (position: (0, 0.4, 2.6), target: ("0.1", "-0.110408951367381233764950538762334472", "0"), fov_degrees: 40),
+    fractal: (iterations: 8),
+))"#;
+
+#[test]
+fn digits_typed_into_a_field_are_saved_as_typed() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    const TYPED: &str = "0.1000000000000000000000000000001";
+    let dir = Dir::new();
+    dir.write("held.ron", HELD);
+    let session = Session::open(&dir, "held.ron");
+    let url = session.url.clone();
+    let shown = session.runtime.block_on(async {
+        let client = session.client().await;
+        client.goto(&url).await.expect("load the page");
+        settled(&client).await;
+        let fields = ".param[data-name=\"camera.target\"] input";
+        let y = format!("return document.querySelectorAll('{fields}')[1].value;");
+        let shown = js(&client, &y).await;
+        let x = client
+            .find(Locator::Css(fields))
+            .await
+            .expect("the x field");
+        x.clear().await.expect("clear x");
+        x.send_keys(TYPED).await.expect("type x");
+        js(&client, "document.activeElement.blur();").await;
+        until(&client, "page.typed['camera.target']").await;
+        press(&client, "set-scene").await;
+        until(
+            &client,
+            "page.state.dirty && !page.overrides['camera.target']",
+        )
+        .await;
+        press(&client, "save").await;
+        until(&client, "!page.state.dirty").await;
+        client.close().await.expect("close the browser");
+        shown
+    });
+    // The field showed the digits the file holds, not their f64.
+    assert_eq!(shown, json!("-0.110408951367381233764950538762334472"));
+    let saved = String::from_utf8(dir.bytes("held.ron")).expect("text");
+    assert!(
+        saved.contains(&format!("\"{TYPED}\""))
+            && saved.contains("\"-0.110408951367381233764950538762334472\""),
+        "{saved}"
+    );
+}
+
 /// Every parameter's name whole, nothing wider than the window, disabled
 /// buttons unlike enabled ones, and what the page says kept to the latest:
 /// at a laptop's and a desktop's size. With `MANDELREEL_EXPLORE_SCREENSHOTS`

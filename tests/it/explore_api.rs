@@ -846,6 +846,41 @@ fn a_deep_targets_digits_survive_viewing_and_keying() {
     assert!(edited.contains("value: (0.25, -1.1, 0)"), "{edited}");
 }
 
+/// Digits go both ways: the page is told a point's strings of digits,
+/// and strings it sends are viewed and written as they are; a parameter
+/// that takes numbers refuses them.
+#[test]
+fn a_point_is_shown_viewed_and_keyed_in_its_digits() {
+    let d = Dir::new();
+    let tip = "-1.10408951367381233764950538762334472132";
+    let text = format!(
+        "(fps: 4, frames: 2, size: (32, 18), scene: (camera: (position: (1.5, -2.4, 1.2), target: (\"0\", \"{tip}\", \"0\"), fov_degrees: 40), fractal: (iterations: 40)), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: 1e-30)]) }})"
+    );
+    d.write("deep.ron", &text);
+    let s = explore(&d, "deep.ron");
+    let digits = s.get("/api/digits?frame=1").expect(200).json();
+    assert_eq!(digits["camera.target"], json!(["0", tip, "0"]), "{digits}");
+    assert_eq!(digits["camera.position"], Value::Null, "{digits}");
+    s.get("/api/digits?frame=2").expect(422);
+    // 2e-30 along x: a pixel's width at this depth, which f64 rounds away.
+    let moved = json!(["0.000000000000000000000000000002", tip, "0"]);
+    let view = |overrides: Value| {
+        let view = json!({"frame": 1, "overrides": overrides});
+        let shown = s.post("/api/render", json!({"view": view, "stage": "final"}));
+        pixels(&shown.expect(200).body)
+    };
+    assert!(view(json!({})) != view(json!({ "camera.target": moved })));
+    let key = |track: &str, value: &Value| json!({"edits": [{"kind": "set_key", "track": track, "time": 0.25, "value": value}]});
+    s.post("/api/edit", key("camera.target", &moved))
+        .expect(200);
+    let edited = s.state()["text"].as_str().unwrap().to_string();
+    let written = format!("(\"0.000000000000000000000000000002\", \"{tip}\", \"0\")");
+    assert!(edited.contains(&format!("value: {written}")), "{edited}");
+    let refused = s.post("/api/edit", key("camera.up", &json!(["0.1", 1, 0])));
+    let message = refused.expect(422).text();
+    assert!(message.contains("camera.up: takes numbers"), "{message}");
+}
+
 /// Beyond loopback only when asked for, saying where and that it is plain
 /// HTTP.
 #[test]

@@ -12,6 +12,8 @@ const page = {
   iterations: null,     // this frame's count, as /api/iterations shows it
   frame: 0,
   overrides: {},        // parameter -> numbers, laid over the tracks' values
+  typed: {},            // parameter -> per component, digits typed past f64's (or undefined)
+  digits: {},           // parameter -> the strings of digits this frame's point is held in
   selected: null,       // {track, index} of the selected key
   serial: 0,            // the latest view asked for; older renders are dropped
   dragging: false,
@@ -40,7 +42,9 @@ async function api(path, body) {
 }
 
 function currentView(withOverrides = true) {
-  const view = { frame: page.frame, overrides: withOverrides ? page.overrides : {} };
+  const overrides = {};
+  if (withOverrides) for (const name of Object.keys(page.overrides)) overrides[name] = sent(name);
+  const view = { frame: page.frame, overrides };
   const size = $("size").value.trim();
   if (size) view.size = size;
   const samples = parseInt($("samples").value, 10);
@@ -85,12 +89,14 @@ async function showFrame(frame) {
   $("frame").value = $("slider").value = frame;
   $("time").textContent = `t = ${(frame / page.state.fps).toFixed(3)} s of ${(page.state.frames / page.state.fps).toFixed(2)} s`;
   const serial = page.valuesAsked = (page.valuesAsked || 0) + 1;
-  const [values, iterations] = await Promise.all([
+  const [values, iterations, digits] = await Promise.all([
     api(`/api/values?frame=${frame}`).then((r) => r.json()),
     api(`/api/iterations?frame=${frame}`).then((r) => r.json()),
+    api(`/api/digits?frame=${frame}`).then((r) => r.json()),
   ]);
   if (serial !== page.valuesAsked) return;  // asked again meanwhile
   page.values = values;
+  page.digits = digits;
   page.iterations = iterations;
   drawStrip();
   fillControls();
@@ -200,6 +206,20 @@ function value(name) { return page.overrides[name] || page.values[name]; }
 
 function change(name, numbers) {
   page.overrides[name] = numbers.map((v) => Number(v.toPrecision(15)));
+  delete page.typed[name];
+}
+
+// A value as the server gets it: the numbers, with the digits typed for
+// components that f64 would round (a deep target's), as strings.
+function sent(name, numbers = page.overrides[name]) {
+  const typed = page.typed[name];
+  return typed ? numbers.map((v, i) => typed[i] ?? v) : numbers;
+}
+
+// Significant digits of a number as typed: more than 15 and f64 may round it.
+function significant(text) {
+  const mantissa = text.replace(/^[+-]/, "").split(/[eE]/)[0].replace(".", "");
+  return mantissa.replace(/^0+/, "").replace(/0+$/, "").length;
 }
 
 // Rodrigues' rotation of v about unit axis k.
@@ -408,7 +428,7 @@ function changeKeys() {
       values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
     }
   }
-  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
+  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: sent(track, v) }));
 }
 
 // A first key on a parameter without a track would set it for the whole
@@ -428,6 +448,7 @@ async function edit(edits, done, then = () => {}) {
     alertShown("");
     say(done);
     page.overrides = {};
+    page.typed = {};
     then();
     await loadState(state);
   } catch (error) {
@@ -461,12 +482,13 @@ function setInScene() {
     return;
   }
   if (!names.length) return;
-  const edits = names.map((parameter) => ({ kind: "set_scene", parameter, value: page.overrides[parameter] }));
+  const edits = names.map((parameter) => ({ kind: "set_scene", parameter, value: sent(parameter) }));
   edit(edits, `Set ${names.join(", ")} in the scene.`);
 }
 
 function discard() {
   page.overrides = {};
+  page.typed = {};
   fillControls();
   refresh();
 }
@@ -596,8 +618,11 @@ function fillControls() {
     row.hidden = !numbers && ["camera.projection.degrees", "camera.stereo.eye_separation"].includes(name);
     row.querySelectorAll("input").forEach((input, i) => {
       // Every digit the file holds (the shortest text that reads back as
-      // the number): a component nobody touched goes back unchanged.
-      input.value = numbers ? String(numbers[i]) : "";
+      // the number, or the point's own strings of digits): a component
+      // nobody touched goes back unchanged.
+      const typed = (page.typed[name] || [])[i];
+      const held = page.overrides[name] ? undefined : (page.digits[name] || [])[i];
+      input.value = typed ?? held ?? (numbers ? String(numbers[i]) : "");
       input.title = input.value;
       input.placeholder = numbers ? "" : "off";
     });
@@ -625,9 +650,14 @@ function showAutoIterations() {
 }
 
 function changeFromControl(row, name) {
-  const numbers = [...row.querySelectorAll("input")].map((input) => parseFloat(input.value));
+  const texts = [...row.querySelectorAll("input")].map((input) => input.value.trim());
+  const numbers = texts.map(parseFloat);
   if (numbers.some((v) => !Number.isFinite(v))) { say(`${name}: every field needs a number.`); return; }
   page.overrides[name] = numbers;
+  // Digits past f64's go to the server as typed: a deep target keeps them.
+  const typed = texts.map((t) => (significant(t) > 15 ? t : undefined));
+  if (typed.some((t) => t !== undefined)) page.typed[name] = typed;
+  else delete page.typed[name];
   row.classList.add("changed");
   refresh();
 }
@@ -696,6 +726,7 @@ async function reload() {
     alertShown("");
     say("Read the file again.");
     page.overrides = {};
+    page.typed = {};
     await loadState(state);
   } catch (error) { alertShown(error.message); }
 }
