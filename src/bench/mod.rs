@@ -20,6 +20,6 @@ mod rows;
 mod run;
 mod scenes;
 
-pub use child::{measure_child, Measurement};
+pub use child::measure_child;
 pub use peak::{default_machine_name, Peak};
 pub use run::{run_and_write, Options};
