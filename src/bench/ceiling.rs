@@ -1,8 +1,8 @@
 //! The machine's measured ceiling: a loop of fused multiply-adds in registers
 //! on the widest f64 vectors, timed on each pool.
 
+use super::options::Options;
 use super::rows::{pool_rows, sampled_passes, Row};
-use super::run::Options;
 use super::scenes::Work;
 
 /// The scene name of the machine's own ceiling rows (`ceiling_rows`).

@@ -1,8 +1,8 @@
 //! Depth error against the accuracy reference: mandelreel's frame, and
 //! Mandelbulber2's z-buffer read back and fitted to absolute depths.
 
+use super::options::{log, Options};
 use super::rows::Row;
-use super::run::{log, Options};
 use super::scenes::BenchScene;
 use crate::error::Error;
 use crate::error::Result;

@@ -14,6 +14,7 @@
 mod ceiling;
 mod child;
 mod mandelbulber2;
+mod options;
 mod peak;
 mod report;
 mod rows;
@@ -21,5 +22,6 @@ mod run;
 mod scenes;
 
 pub use child::measure_child;
+pub use options::Options;
 pub use peak::{default_machine_name, Peak};
-pub use run::{run_and_write, Options};
+pub use run::run_and_write;

@@ -2,8 +2,8 @@
 //! rate columns, thread scaling, and the in-process render-only and kernel rows.
 
 use super::child::Measurement;
+use super::options::Options;
 use super::peak::Peak;
-use super::run::Options;
 use super::scenes::{BenchScene, Work};
 use crate::error::Error;
 use crate::error::Result;

@@ -4,7 +4,7 @@
 use super::ceiling::ceiling_rows;
 use super::child::{mandelbulber_args, render_args, timed};
 use super::mandelbulber2::depth_rows;
-use super::peak::Peak;
+use super::options::{log, Options};
 use super::report::{to_csv, to_markdown};
 use super::rows::{
     alternate, kernel_rows, mpixels_per_s, render_only_rows, thread_pools, thread_rows, timing_row,
@@ -15,39 +15,6 @@ use crate::error::Error;
 use crate::error::Result;
 use crate::render::Film;
 use std::path::{Path, PathBuf};
-
-/// What the bench is asked to do.
-#[derive(Clone, Debug)]
-pub struct Options {
-    /// Folder of benchmark timelines (`timelines/bench`).
-    pub scenes: PathBuf,
-    /// Folder of the matching Mandelbulber2 settings (`bench/mandelbulber2`).
-    pub fract_dir: PathBuf,
-    /// The Mandelbulber2 program, when it is to be compared.
-    pub mandelbulber: Option<PathBuf>,
-    /// A/B pairs per scene, and samples per pool of the in-process
-    /// (render only), kernel and ceiling rows.
-    pub runs: usize,
-    /// Thread counts for the scaling rows (every scene; in-process on the
-    /// first; the kernel alone).
-    pub threads: Vec<usize>,
-    /// Size of the peak-memory render; `None` skips it.
-    pub memory_size: Option<(u32, u32)>,
-    /// Size of the depth comparison against the accuracy reference; `None` skips it.
-    pub depth_size: Option<(u32, u32)>,
-    /// Where `<machine>.csv` and `<machine>.md` go.
-    pub results: PathBuf,
-    pub machine: String,
-    /// The machine's peak, detected once for every row.
-    pub peak: Peak,
-    pub quiet: bool,
-}
-
-pub(super) fn log(quiet: bool, message: &str) {
-    if !quiet {
-        eprintln!("{message}");
-    }
-}
 
 /// What every render a bench run times shares: the options, this program,
 /// the scratch folder its renders go to, and the machine's thread count.
