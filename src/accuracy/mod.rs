@@ -20,15 +20,11 @@ mod sweep;
 mod timing;
 
 pub use chart::write_chart;
-pub use front::{
-    flagged, front_of, mark_pareto, pareto_front, recommended, FrontPoint, OVERSHOOT_FLAG,
-    TIMING_NOISE, VISIBLE_PSNR_DB,
-};
+pub use front::{flagged, front_of, recommended, OVERSHOOT_FLAG, TIMING_NOISE, VISIBLE_PSNR_DB};
 pub use metrics::{depth_errors, film_hits, footprints_at, DepthErrors};
 pub use reference::{reference_depths, reference_scene, Convergence, REFERENCE_STEP};
-pub use report::{front_rule_text, to_csv, to_markdown};
-pub use sweep::{measure, variants, Variant};
-pub use timing::{MAX_TIMED_RUNS, MIN_TIMED_RUNS};
+pub use report::{to_csv, to_markdown};
+pub use sweep::measure;
 
 /// What one variant cost and how far it is from the reference.
 #[derive(Clone, Debug, Serialize)]
