@@ -638,6 +638,7 @@ mod tests {
             overshoot: 0.0,
             image_rmse: rmse,
             psnr_db: crate::math::psnr_db(rmse * rmse, 1.0),
+            surface_distance_px: None,
             pareto: false,
         }
     }

@@ -16,6 +16,7 @@ mod front;
 mod metrics;
 mod reference;
 mod report;
+mod surface;
 mod sweep;
 mod timing;
 
@@ -49,6 +50,9 @@ pub struct Measurement {
     pub image_rmse: f64,
     /// Peak signal-to-noise ratio of that difference in dB (infinite when identical).
     pub psnr_db: f64,
+    /// Median 3D distance from the hits of a grid of centre rays to the set,
+    /// in footprints (`surface::median_distance`); none on a deep frame.
+    pub surface_distance_px: Option<f64>,
     /// On the Pareto front of median time against image error, timing noise
     /// allowed for (`pareto_front`).
     pub pareto: bool,
@@ -77,6 +81,7 @@ fn row(knob: &'static str, seconds: f64, rmse: f64) -> Measurement {
         overshoot: 0.0,
         image_rmse: rmse,
         psnr_db: metrics::psnr(rmse),
+        surface_distance_px: None,
         pareto: false,
     }
 }

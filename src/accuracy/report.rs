@@ -37,7 +37,7 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
         .unwrap_or(1.0)
         .max(1e-9);
     let mut out = format!(
-        "{title}\n\nReference: the scene's set ({} iterations, bailout {}), Analytic f64, hit threshold {}, fudge {}, {} steps, normal step {}, {} samples per pixel; depths by membership steps of 1/{} footprint. Against steps twice as long, its depths move by {:.2} px on average and {:.2}% of pixels change hit/miss: differences below that are within the reference's own uncertainty.\n\n| knob | setting | time (s) | × scene | DE evals | depth err mean (px) | depth err p99 (px) | hit/miss differ | overshoot | PSNR (dB) | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n",
+        "{title}\n\nReference: the scene's set ({} iterations, bailout {}), Analytic f64, hit threshold {}, fudge {}, {} steps, normal step {}, {} samples per pixel; depths by membership steps of 1/{} footprint. Against steps twice as long, its depths move by {:.2} px on average and {:.2}% of pixels change hit/miss: differences below that are within the reference's own uncertainty.\n\n| knob | setting | time (s) | × scene | DE evals | depth err mean (px) | depth err p99 (px) | hit/miss differ | overshoot | 3D distance to the set (median, px) | PSNR (dB) | Pareto |\n|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|:-:|\n",
         r.fractal.iterations,
         r.fractal.bailout,
         r.quality.hit_threshold,
@@ -51,7 +51,7 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
     );
     for r in rows {
         out += &format!(
-            "| {} | {} | {:.3} | {:.2} | {} | {:.2} | {:.2} | {:.2}% | {:.2}% | {} | {} |\n",
+            "| {} | {} | {:.3} | {:.2} | {} | {:.2} | {:.2} | {:.2}% | {:.2}% | {} | {} | {} |\n",
             r.knob,
             r.setting,
             r.seconds,
@@ -61,6 +61,8 @@ pub fn to_markdown(report: &Report, title: &str) -> String {
             r.depth_error_p99_px,
             100.0 * r.hit_mismatch,
             100.0 * r.overshoot,
+            r.surface_distance_px
+                .map_or("–".into(), |d| format!("{d:.2}")),
             if r.psnr_db.is_finite() {
                 format!("{:.1}", r.psnr_db)
             } else {

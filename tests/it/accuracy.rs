@@ -68,6 +68,20 @@ fn accuracy_writes_csv_table_and_chart() {
         differs |= r[col("image_rmse")].parse::<f64>().unwrap() > 0.0;
     }
     assert!(differs);
+    // The hits' 3D distance to the set, in footprints, on every row: the
+    // reference's below a footprint, the coarsest hit threshold's farther.
+    let surface = |r: &Vec<String>| r[col("surface_distance_px")].parse::<f64>().unwrap();
+    assert!(surface(&rows[0]) < 1.0, "{}", surface(&rows[0]));
+    let coarsest = rows
+        .iter()
+        .filter(|r| r[0] == "hit_threshold")
+        .max_by(|a, b| {
+            a[1].parse::<f64>()
+                .unwrap()
+                .total_cmp(&b[1].parse::<f64>().unwrap())
+        })
+        .unwrap();
+    assert!(surface(coarsest) > surface(&rows[0]), "{coarsest:?}");
     let md = std::fs::read_to_string(d.path().join("out/t/accuracy.md")).unwrap();
     assert_eq!(
         md.lines().filter(|l| l.starts_with("| ")).count(),
