@@ -298,8 +298,8 @@ mod tests {
     #[test]
     fn a_map_past_the_texel_limit_is_refused_from_its_header() {
         // A 2×2 EXR whose header is made to say 4097×2048: refused from the
-        // header, where its texels were allocated first (100 MB here, and
-        // as much as any header claims).
+        // header, before any texel is allocated (reading first would take
+        // 100 MB here, and as much as any header claims).
         use exr::prelude::*;
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("sky.exr");

@@ -637,7 +637,7 @@ mod tests {
             hit_mismatch: 0.0,
             overshoot: 0.0,
             image_rmse: rmse,
-            psnr_db: crate::math::psnr_db(rmse * rmse, 1.0),
+            psnr_db: crate::math::psnr_db_of_rmse(rmse, 1.0),
             surface_distance_px: None,
             pareto: false,
         }

@@ -123,7 +123,7 @@ pub(super) fn compare(
 
 /// PSNR of an RMSE in unit values.
 pub(super) fn psnr(rmse: f64) -> f64 {
-    crate::math::psnr_db(rmse * rmse, 1.0)
+    crate::math::psnr_db_of_rmse(rmse, 1.0)
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@ pub(super) const SLOW_BUDGET_SECONDS: f64 = 3.0;
 
 /// Renders `scene` and returns the film with the median wall time of
 /// several runs. The median, not the fastest run: a single lucky run of a
-/// 15 ms frame moved variants on and off the Pareto front.
+/// 15 ms frame would move variants on and off the Pareto front.
 pub(super) fn timed_render(
     scene: &Scene,
     frame_index: u32,

@@ -80,6 +80,8 @@ struct TimelineState {
     samples: u32,
     tracks: Vec<TrackShown>,
     parameters: Vec<(&'static str, usize)>,
+    /// The parameters whose value may be strings of digits (points).
+    digit_points: Vec<&'static str>,
     plan: Vec<String>,
     command: String,
     text: String,
@@ -119,6 +121,10 @@ fn state_of(document: &super::Document) -> TimelineState {
         samples: t.base.samples_per_pixel.max(1),
         tracks,
         parameters: crate::timeline::PARAMETERS.to_vec(),
+        digit_points: crate::timeline::parameters::all()
+            .filter(|p| p.digits.is_some())
+            .map(|p| p.name)
+            .collect(),
         plan: crate::job::describe::plan_lines(&t.base),
         text: document.text.clone(),
     }
@@ -345,12 +351,12 @@ fn key_value(name: &str, value: &[Component]) -> Result<crate::timeline::KeyValu
     let digits = value.iter().any(|c| matches!(c, Component::Digits(..)));
     let takes = crate::timeline::parameters::find(name).is_some_and(|p| p.digits.is_some());
     match value {
-        [x, y, z] if digits && takes => Ok(KeyValue::Digits(Coordinates::from_components([
+        [_] | [_, _, _] if digits && !takes => Err(format!("{name}: {NOT_DIGITS}")),
+        [x, y, z] if digits => Ok(KeyValue::Digits(Coordinates::from_components([
             x.clone(),
             y.clone(),
             z.clone(),
         ]))),
-        _ if digits => Err(format!("{name}: {NOT_DIGITS}")),
         [v] => Ok(KeyValue::Number(v.value())),
         [x, y, z] => Ok(KeyValue::Triple(x.value(), y.value(), z.value())),
         _ => Err(format!(

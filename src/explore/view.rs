@@ -53,11 +53,17 @@ impl Override {
         self.0.iter().map(Component::value).collect()
     }
 
-    /// The point it is, where a component is a string of digits.
+    /// Whether a component is a string of digits.
+    fn has_digits(&self) -> bool {
+        self.0.iter().any(|c| matches!(c, Component::Digits(..)))
+    }
+
+    /// The point it is, where it is three components and one a string of
+    /// digits.
     fn digits(&self) -> Option<Coordinates> {
-        let any = self.0.iter().any(|c| matches!(c, Component::Digits(..)));
         let parts: [Component; 3] = self.0.clone().try_into().ok()?;
-        any.then(|| Coordinates::from_components(parts))
+        self.has_digits()
+            .then(|| Coordinates::from_components(parts))
     }
 }
 
@@ -143,14 +149,14 @@ impl View {
             let values = &given.numbers();
             let wanted = parameter.shape.components();
             let digits = given.digits();
-            if digits.is_some() && parameter.digits.is_none() {
-                return Err(format!("{name}: {NOT_DIGITS}"));
-            }
             if values.len() != wanted {
                 return Err(format!(
                     "{name}: takes {wanted} numbers, got {}",
                     values.len()
                 ));
+            }
+            if given.has_digits() && parameter.digits.is_none() {
+                return Err(format!("{name}: {NOT_DIGITS}"));
             }
             if let Some(bad) = values.iter().find(|v| !v.is_finite()) {
                 return Err(format!("{name}: values must be finite, got {bad}"));
@@ -461,6 +467,17 @@ mod tests {
             ..View::default()
         };
         assert!(view.prepare(&t).err().unwrap().contains("takes numbers"));
+        let refused = |name: &str, json: &str| {
+            let view = View {
+                overrides: [(name.to_string(), serde_json::from_str(json).unwrap())].into(),
+                ..View::default()
+            };
+            view.prepare(&t).err().unwrap()
+        };
+        assert!(
+            refused("camera.distance", r#"["1e-30"]"#).contains("camera.distance: takes numbers")
+        );
+        assert!(refused("camera.target", r#"["1", 2]"#).contains("takes 3 numbers, got 2"));
     }
 
     #[test]

@@ -20,7 +20,7 @@ pub use geometry::{normalize_or, sphere_interval};
 pub use ln::{in_ln_range, ln, ln_in_range, Lanes};
 pub use number::{Arith, Number};
 pub use sample::{sample_1d, shell_points};
-pub use stats::{median, psnr_db};
+pub use stats::{median, psnr_db, psnr_db_of_rmse};
 pub use vector::Vector;
 
 /// The floating-point type of all geometry and distance estimation.

@@ -22,6 +22,16 @@ pub fn psnr_db(mse: f64, peak: f64) -> f64 {
     10.0 * (peak * peak / mse).log10()
 }
 
+/// `psnr_db` of a root-mean-square error: 20·log10(peak/rmse) dB, taken
+/// as 20·(log10 peak − log10 rmse), so an RMSE that squaring would
+/// underflow still has its figure.
+pub fn psnr_db_of_rmse(rmse: f64, peak: f64) -> f64 {
+    if rmse <= 0.0 {
+        return f64::INFINITY;
+    }
+    20.0 * (peak.log10() - rmse.log10())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -41,5 +51,9 @@ mod tests {
         assert!((psnr_db(1e-4, 1.0) - 40.0).abs() < 1e-12);
         assert!((psnr_db(1.0, 255.0) - 48.1308).abs() < 1e-4);
         assert!((psnr_db(4.0, 255.0) - 42.1102).abs() < 1e-4);
+        assert_eq!(psnr_db_of_rmse(0.0, 1.0), f64::INFINITY);
+        assert_eq!(psnr_db_of_rmse(0.1, 1.0), -20.0 * 0.1f64.log10());
+        assert!((psnr_db_of_rmse(2.0, 255.0) - psnr_db(4.0, 255.0)).abs() < 1e-12);
+        assert_eq!(psnr_db_of_rmse(1e-200, 1.0), 4000.0);
     }
 }

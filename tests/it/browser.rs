@@ -473,7 +473,7 @@ fn a_first_key_away_from_the_start_keeps_the_films_start() {
 
 /// A still whose target is held in digits, as a deep zoom's is.
 const HELD: &str = r#"(fps: 24, frames: 2, size: (64, 36), scene: (
-    camera: (position: (0, 0.4, 2.6), target: ("0.1", "-0.110408951367381233764950538762334472", "0"), fov_degrees: 40),
+    camera: (position: (0.30000000000000004, 0.4, 2.6), target: ("0.1", "-0.110408951367381233764950538762334472", "0"), fov_degrees: 40),
     fractal: (iterations: 8),
 ))"#;
 
@@ -502,6 +502,20 @@ fn digits_typed_into_a_field_are_saved_as_typed() {
         x.send_keys(TYPED).await.expect("type x");
         js(&client, "document.activeElement.blur();").await;
         until(&client, "page.typed['camera.target']").await;
+        // A plain point's field of f64's own 17 digits stays a number.
+        let position = ".param[data-name=\"camera.position\"] input";
+        let fields = client
+            .find_all(Locator::Css(position))
+            .await
+            .expect("position");
+        fields[1].clear().await.expect("clear y");
+        fields[1].send_keys("0.5").await.expect("type y");
+        js(&client, "document.activeElement.blur();").await;
+        until(
+            &client,
+            "page.overrides['camera.position'] && page.overrides['camera.position'][1] === 0.5",
+        )
+        .await;
         press(&client, "set-scene").await;
         until(
             &client,
@@ -516,11 +530,10 @@ fn digits_typed_into_a_field_are_saved_as_typed() {
     // The field showed the digits the file holds, not their f64.
     assert_eq!(shown, json!("-0.110408951367381233764950538762334472"));
     let saved = String::from_utf8(dir.bytes("held.ron")).expect("text");
-    assert!(
-        saved.contains(&format!("\"{TYPED}\""))
-            && saved.contains("\"-0.110408951367381233764950538762334472\""),
-        "{saved}"
-    );
+    // Every digit typed, and the untouched components as they were written.
+    let target = format!("(\"{TYPED}\", \"-0.110408951367381233764950538762334472\", \"0\")");
+    assert!(saved.contains(&target), "{saved}");
+    assert!(saved.contains("(0.30000000000000004, 0.5, 2.6)"), "{saved}");
 }
 
 /// Every parameter's name whole, nothing wider than the window, disabled

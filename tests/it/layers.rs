@@ -167,7 +167,14 @@ fn named_paths(own: &[String], text: &str) -> Vec<Vec<String>> {
             .collect()
     };
     let mut found = Vec::new();
-    for line in text.lines().filter(|l| !l.trim_start().starts_with("//")) {
+    // One line of code, so that a `use` group over several lines is whole.
+    let code: Vec<&str> = text
+        .lines()
+        .filter(|l| !l.trim_start().starts_with("//"))
+        .collect();
+    let code = code.join(" ");
+    {
+        let line = code.as_str();
         for (i, _) in line.match_indices("crate::") {
             if line[..i]
                 .chars()
@@ -201,7 +208,7 @@ fn named_paths(own: &[String], text: &str) -> Vec<Vec<String>> {
                 rest = r;
             }
             let names: Vec<String> = match rest.strip_prefix('{') {
-                Some(group) => group.split([',', '}']).map(|s| ident(s.trim())).collect(),
+                Some(group) => group_items(group).iter().map(|s| ident(s.trim())).collect(),
                 None => vec![ident(rest)],
             };
             for name in names.into_iter().filter(|n| !n.is_empty()) {
@@ -212,6 +219,28 @@ fn named_paths(own: &[String], text: &str) -> Vec<Vec<String>> {
         }
     }
     found
+}
+
+/// The items of a `{…}` group, given its text after the `{`: split at its
+/// own commas, up to its own `}`.
+fn group_items(group: &str) -> Vec<&str> {
+    let (mut depth, mut start, mut items) = (0, 0, Vec::new());
+    for (i, c) in group.char_indices() {
+        match c {
+            '{' => depth += 1,
+            '}' if depth == 0 => {
+                items.push(&group[start..i]);
+                return items;
+            }
+            '}' => depth -= 1,
+            ',' if depth == 0 => {
+                items.push(&group[start..i]);
+                start = i + 1;
+            }
+            _ => {}
+        }
+    }
+    items
 }
 
 /// The circles among the files of one folder: `(folder, members)` for each
@@ -312,6 +341,25 @@ fn a_circle_between_two_files_is_found() {
         file("fractal/orbit", "use super::power::x;"),
     ];
     assert!(circles(&one_way).is_empty());
+    // A group over several lines, with groups inside it.
+    let split = [
+        file(
+            "bench/run",
+            "use super::{\n    rows::{pool_rows, Row},\n    ceiling,\n};",
+        ),
+        file(
+            "bench/ceiling",
+            "fn f(o: &super::run::Options) {}\nlet x = [1, 2];",
+        ),
+        file("bench/rows", "fn g() {}"),
+    ];
+    assert_eq!(
+        circles(&split),
+        [(
+            "bench".to_string(),
+            vec!["ceiling".to_string(), "run".to_string()]
+        )]
+    );
     let deep = [
         file("fractal/deep/lanes", "use super::super::orbit::Orbit;"),
         file("fractal/orbit", "fn f() -> super::deep::Derivative {}"),

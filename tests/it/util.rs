@@ -74,8 +74,8 @@ impl Dir {
 
     /// Runs `command` (the binary, or a shell around it) as `run` does, but
     /// fails the test, killing it, if it is still running after `seconds`:
-    /// for input that once made it hang, so a regression fails rather than
-    /// hangs. A guard against hanging, far above the time it takes.
+    /// for input that could make it hang, so a regression fails rather
+    /// than hangs. A guard against hanging, far above the time it takes.
     pub fn run_guarded(&self, mut command: Command, seconds: u64) -> Output {
         let (out, err) = (self.path().join(".stdout"), self.path().join(".stderr"));
         let file = |p: &Path| std::fs::File::create(p).expect("output file");

@@ -222,6 +222,25 @@ function significant(text) {
   return mantissa.replace(/^0+/, "").replace(/0+$/, "").length;
 }
 
+// What an HTML number field holds as written (it blanks "+0.5" and "5.").
+const NUMBER_TEXT = /^-?(\d+(\.\d+)?|\.\d+)([eE][+-]?\d+)?$/;
+
+// Component i of the strings of digits this frame's point `name` is held
+// in, where a number field can show it.
+function held(name, i) {
+  const text = (page.digits[name] || [])[i];
+  return text !== undefined && NUMBER_TEXT.test(text) ? text : undefined;
+}
+
+// Component text `text` (i of point `name`) as the server should get it: a
+// string where it says more than its f64 (digits typed past f64's, or the
+// point's own digits left as they were), else undefined for the number.
+function asTyped(name, i, text) {
+  if (!page.state.digit_points.includes(name)) return undefined;
+  if (text === held(name, i)) return text;
+  return significant(text) > 15 && String(parseFloat(text)) !== text ? text : undefined;
+}
+
 // Rodrigues' rotation of v about unit axis k.
 function rotate(v, k, angle) {
   const c = Math.cos(angle), s = Math.sin(angle);
@@ -621,8 +640,8 @@ function fillControls() {
       // the number, or the point's own strings of digits): a component
       // nobody touched goes back unchanged.
       const typed = (page.typed[name] || [])[i];
-      const held = page.overrides[name] ? undefined : (page.digits[name] || [])[i];
-      input.value = typed ?? held ?? (numbers ? String(numbers[i]) : "");
+      const digits = page.overrides[name] ? undefined : held(name, i);
+      input.value = typed ?? digits ?? (numbers ? String(numbers[i]) : "");
       input.title = input.value;
       input.placeholder = numbers ? "" : "off";
     });
@@ -655,7 +674,7 @@ function changeFromControl(row, name) {
   if (numbers.some((v) => !Number.isFinite(v))) { say(`${name}: every field needs a number.`); return; }
   page.overrides[name] = numbers;
   // Digits past f64's go to the server as typed: a deep target keeps them.
-  const typed = texts.map((t) => (significant(t) > 15 ? t : undefined));
+  const typed = texts.map((t, i) => asTyped(name, i, t));
   if (typed.some((t) => t !== undefined)) page.typed[name] = typed;
   else delete page.typed[name];
   row.classList.add("changed");

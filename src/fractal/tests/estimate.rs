@@ -138,8 +138,8 @@ fn analytic_estimate_tracks_the_brute_force_distance() {
 #[test]
 fn every_method_and_precision_is_finite_and_positive_outside() {
     // Near the bulb (radius ≤ 1.5) no true distance exceeds 1.5: an estimate
-    // above that would be a step that jumps the surface (as an infinite
-    // estimate turned into a huge step once did). Points on and next to
+    // above that would be a step that jumps the surface (an infinite
+    // estimate would become a huge step). Points on and next to
     // the axes are included, where derivatives blow up.
     let mut probes = points(200, 1.2..1.5, 3);
     for axis in [DVec3::X, DVec3::Y, DVec3::Z, -DVec3::Y] {
