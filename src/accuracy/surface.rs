@@ -4,14 +4,15 @@
 
 use crate::fractal::Fractal;
 use crate::march::judge::distance_to_set;
-use crate::march::march;
+use crate::march::{march, MarchSettings};
 use crate::math::{median, Real};
 use crate::scene::Scene;
 
 /// Centre rays along each side of the grid.
 const GRID: u32 = 12;
-/// Uniform samples of each ball searched around a hit: a bound within a
-/// few hundredths of a footprint of 50,000's (docs/surface.md).
+/// Uniform samples of each ball searched around a hit: fewer than
+/// `examples/surface.rs` takes, so a looser upper bound, kept cheap as
+/// every row of the sweep pays it.
 const SAMPLES: usize = 2_000;
 
 /// The median 3D distance, in footprints, from the hits of `scene`'s
@@ -44,6 +45,27 @@ pub(super) fn median_distance(
     (!distances.is_empty()).then(|| median(&mut distances))
 }
 
+/// `median_distance` of a sweep's variants, worked out once per marcher:
+/// the variants of sampling and shading march as the scene does.
+#[derive(Default)]
+pub(super) struct Distances(std::cell::RefCell<Vec<(Fractal, MarchSettings, Option<f64>)>>);
+
+impl Distances {
+    /// `median_distance` of `scene`, or the one a variant marching alike had.
+    pub(super) fn of(&self, scene: &Scene, set: &Fractal, width: u32, height: u32) -> Option<f64> {
+        let alike = |(f, q, _): &&(Fractal, MarchSettings, Option<f64>)| {
+            *f == scene.fractal && *q == scene.quality
+        };
+        if let Some((_, _, known)) = self.0.borrow().iter().find(alike) {
+            return *known;
+        }
+        let found = median_distance(scene, set, width, height);
+        let key = (scene.fractal.clone(), scene.quality.clone(), found);
+        self.0.borrow_mut().push(key);
+        found
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -56,6 +78,20 @@ mod tests {
         coarse.quality.hit_threshold = 8.0;
         let far = median_distance(&coarse, &scene.fractal, 64, 36).expect("hits");
         assert!(fine < 2.0 && far > 2.0 * fine, "{fine} against {far}");
+    }
+
+    #[test]
+    fn a_variant_marching_as_another_is_judged_once() {
+        let scene = Scene::default();
+        let distances = Distances::default();
+        let first = distances.of(&scene, &scene.fractal, 64, 36);
+        let mut more_samples = scene.clone();
+        more_samples.samples_per_pixel = 9;
+        assert_eq!(distances.of(&more_samples, &scene.fractal, 64, 36), first);
+        let mut coarse = scene.clone();
+        coarse.quality.hit_threshold = 8.0;
+        assert_ne!(distances.of(&coarse, &scene.fractal, 64, 36), first);
+        assert_eq!(distances.0.borrow().len(), 2);
     }
 
     #[test]

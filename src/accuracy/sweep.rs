@@ -4,7 +4,7 @@
 use super::front::mark_pareto;
 use super::metrics::{compare, depth_errors, film_hits, footprints_at, psnr, srgb, Errors};
 use super::reference::{reference_depths, reference_scene, Convergence, REFERENCE_STEP};
-use super::surface::median_distance;
+use super::surface::Distances;
 use super::timing::timed_render;
 use super::{Measurement, Report};
 use crate::fractal::{DeMethod, Precision};
@@ -158,6 +158,7 @@ pub fn measure(
         hit_change: settled.hit_mismatch,
     };
 
+    let distances = Distances::default();
     let measurement = |variant: &Variant, seconds: f64, evaluations: u64, e: Errors| Measurement {
         knob: variant.knob,
         setting: variant.setting.clone(),
@@ -169,7 +170,7 @@ pub fn measure(
         overshoot: e.depth.overshoot,
         image_rmse: e.rmse,
         psnr_db: psnr(e.rmse),
-        surface_distance_px: median_distance(&variant.scene, &reference.fractal, width, height),
+        surface_distance_px: distances.of(&variant.scene, &reference.fractal, width, height),
         pareto: false,
     };
     // The reference against itself, through the same comparison as every variant.

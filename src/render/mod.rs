@@ -188,5 +188,19 @@ pub fn render_samples_unless(
     !stopped.into_inner()
 }
 
+/// The default scene under adaptive sampling from `first` samples up to
+/// `cap`, for the tests of the sampler and of the waves.
+#[cfg(test)]
+fn adaptive_scene(first: u32, cap: u32) -> Scene {
+    Scene {
+        samples_per_pixel: cap,
+        adaptive: Some(crate::scene::Adaptive {
+            first,
+            ..crate::scene::Adaptive::default()
+        }),
+        ..Scene::default()
+    }
+}
+
 #[cfg(test)]
 mod tests;

@@ -96,18 +96,7 @@ fn gcd(a: usize, b: usize) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scene::Adaptive;
-
-    fn adaptive(first: u32, cap: u32) -> Scene {
-        Scene {
-            samples_per_pixel: cap,
-            adaptive: Some(Adaptive {
-                first,
-                ..Adaptive::default()
-            }),
-            ..Scene::default()
-        }
-    }
+    use crate::render::adaptive_scene as adaptive;
 
     #[test]
     fn subpixel_offsets_stay_in_the_pixel_and_cover_it() {

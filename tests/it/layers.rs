@@ -173,49 +173,47 @@ fn named_paths(own: &[String], text: &str) -> Vec<Vec<String>> {
         .filter(|l| !l.trim_start().starts_with("//"))
         .collect();
     let code = code.join(" ");
-    {
-        let line = code.as_str();
-        for (i, _) in line.match_indices("crate::") {
-            if line[..i]
+    let line = code.as_str();
+    for (i, _) in line.match_indices("crate::") {
+        if line[..i]
+            .chars()
+            .last()
+            .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '$')
+        {
+            continue;
+        }
+        let rest = &line[i + 7..];
+        found.push(
+            rest.split("::")
+                .map(ident)
+                .take_while(|s| !s.is_empty())
+                .collect(),
+        );
+    }
+    for (i, _) in line.match_indices("super::") {
+        let before = &line[..i];
+        if before.ends_with("super::")
+            || before
                 .chars()
                 .last()
-                .is_some_and(|c| c.is_alphanumeric() || c == '_' || c == '$')
-            {
-                continue;
-            }
-            let rest = &line[i + 7..];
-            found.push(
-                rest.split("::")
-                    .map(ident)
-                    .take_while(|s| !s.is_empty())
-                    .collect(),
-            );
+                .is_some_and(|c| c.is_alphanumeric() || c == '_')
+        {
+            continue; // counted from the first `super` of a chain
         }
-        for (i, _) in line.match_indices("super::") {
-            let before = &line[..i];
-            if before.ends_with("super::")
-                || before
-                    .chars()
-                    .last()
-                    .is_some_and(|c| c.is_alphanumeric() || c == '_')
-            {
-                continue; // counted from the first `super` of a chain
-            }
-            let mut base = own.to_vec();
-            let mut rest = &line[i..];
-            while let Some(r) = rest.strip_prefix("super::") {
-                base.pop();
-                rest = r;
-            }
-            let names: Vec<String> = match rest.strip_prefix('{') {
-                Some(group) => group_items(group).iter().map(|s| ident(s.trim())).collect(),
-                None => vec![ident(rest)],
-            };
-            for name in names.into_iter().filter(|n| !n.is_empty()) {
-                let mut path = base.clone();
-                path.push(name);
-                found.push(path);
-            }
+        let mut base = own.to_vec();
+        let mut rest = &line[i..];
+        while let Some(r) = rest.strip_prefix("super::") {
+            base.pop();
+            rest = r;
+        }
+        let names: Vec<String> = match rest.strip_prefix('{') {
+            Some(group) => group_items(group).iter().map(|s| ident(s.trim())).collect(),
+            None => vec![ident(rest)],
+        };
+        for name in names.into_iter().filter(|n| !n.is_empty()) {
+            let mut path = base.clone();
+            path.push(name);
+            found.push(path);
         }
     }
     found

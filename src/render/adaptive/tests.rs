@@ -2,16 +2,7 @@ use super::*;
 use crate::render::{render_samples, Layers};
 use crate::scene::Adaptive;
 
-fn adaptive(first: u32, cap: u32) -> Scene {
-    Scene {
-        samples_per_pixel: cap,
-        adaptive: Some(Adaptive {
-            first,
-            ..Adaptive::default()
-        }),
-        ..Scene::default()
-    }
-}
+use crate::render::adaptive_scene as adaptive;
 
 fn schedule(scene: &Scene) -> Vec<u32> {
     let mut done = 0;
