@@ -178,6 +178,17 @@ pub fn decimal(b: &Big, significant: usize) -> String {
     d.to_string()
 }
 
+/// `v` exactly, in decimal digits `parse_digits` accepts: below about
+/// 1e-148, where an f64's expansion is longer, to `MAX_DIGITS` of them.
+pub fn f64_digits(v: f64) -> String {
+    // 770 significant digits hold any f64's binary expansion exactly.
+    let exact: DBig = big_from_f64(v, 64)
+        .with_base_and_precision::<10>(770)
+        .value()
+        .with_rounding();
+    fitted(exact)
+}
+
 /// `anchor` (digits `parse_digits` accepts) moved by `delta`, exactly, as
 /// digits `parse_digits` accepts: what a track keyed with digits gives
 /// between its keys (`timeline::deep_keys`). Rounded to `MAX_DIGITS`
@@ -188,7 +199,12 @@ pub fn moved(anchor: &str, delta: f64) -> String {
     // Shortest decimal that reads back as `delta`: the step as f64 means it.
     let step = DBig::from_str(&format!("{delta:e}"))
         .unwrap_or_else(|_| unreachable!("a finite f64 prints as digits"));
-    let sum = start.with_precision(MAX_DIGITS).value() + step;
+    fitted(start.with_precision(MAX_DIGITS).value() + step)
+}
+
+/// `sum` as digits `parse_digits` accepts, to `MAX_DIGITS` significant
+/// digits or fewer.
+fn fitted(sum: DBig) -> String {
     // Fewer digits only where neither notation holds the sum within the
     // limits (digits far below anything f64 offsets reach).
     let mut precision = MAX_DIGITS;
@@ -198,8 +214,16 @@ pub fn moved(anchor: &str, delta: f64) -> String {
         if parse_digits(&plain).is_ok() {
             return plain;
         }
+        // One digit before the point keeps the exponent small.
         let (significand, exponent) = rounded.repr().clone().into_parts();
-        let scientific = format!("{significand}e{exponent}");
+        let written = significand.to_string();
+        let (sign, digits) = match written.strip_prefix('-') {
+            Some(digits) => ("-", digits),
+            None => ("", &*written),
+        };
+        let (first, rest) = digits.split_at(1);
+        let exponent = exponent as i64 + rest.len() as i64;
+        let scientific = format!("{sign}{first}.{rest}e{exponent}");
         if parse_digits(&scientific).is_ok() {
             return scientific;
         }
@@ -397,6 +421,21 @@ mod tests {
                 error <= 4e-16 * step,
                 "{anchor} + {step:e} = {text} ({value})"
             );
+        }
+    }
+
+    #[test]
+    fn an_f64_is_written_out_exactly() {
+        let tenth = "0.1000000000000000055511151231257827021181583404541015625";
+        assert_eq!(f64_digits(0.1), tenth);
+        assert_eq!(f64_digits(-2.0), "-2");
+        assert_eq!(f64_digits(0.0), "0");
+        for v in [1.1040895136738123, -3.7e-7, 1e-130, 1e-150, 1e-300, 5e-324] {
+            let text = f64_digits(v);
+            assert_eq!(parse_digits(&text), Ok(v), "{text}");
+            let error = big_from_digits(&text, 4000) - big_from_f64(v, 4000);
+            let exact = error == big_from_f64(0.0, 4000);
+            assert!(exact || v.abs() < 1e-148, "{v:e}: {text}");
         }
     }
 

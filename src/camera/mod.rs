@@ -113,10 +113,7 @@ impl From<CameraForm> for Camera {
 
 impl From<Camera> for CameraForm {
     fn from(c: Camera) -> CameraForm {
-        let unresolved = |o: &DVec3| {
-            let scale = c.target.abs().max_element();
-            o.abs().max_element() < OFFSET_IN_HASH * scale
-        };
+        let offset = c.offset.filter(|o| c.unresolved(*o));
         CameraForm {
             position: Coordinates {
                 value: c.position,
@@ -133,7 +130,7 @@ impl From<Camera> for CameraForm {
             focus_distance: c.focus_distance,
             projection: c.projection,
             stereo: c.stereo,
-            offset: c.offset.filter(unresolved),
+            offset,
         }
     }
 }
@@ -143,6 +140,26 @@ impl From<Camera> for CameraForm {
 const OFFSET_IN_HASH: Real = 1.0 / (1u64 << 30) as Real;
 
 impl Camera {
+    /// Whether `offset` from the target is below what f64 positions keep
+    /// of it (`OFFSET_IN_HASH` of the target's size).
+    fn unresolved(&self, offset: DVec3) -> bool {
+        let scale = self.target.abs().max_element();
+        offset.abs().max_element() < OFFSET_IN_HASH * scale
+    }
+
+    /// The position's digits where `camera.distance` placed it nearer the
+    /// target than its f64 keeps apart: the target's digits (or its f64,
+    /// exactly) moved by the offset.
+    pub fn placed_position_digits(&self) -> Option<[String; 3]> {
+        let offset = self.offset.filter(|o| self.unresolved(*o))?;
+        let target = self.target.to_array();
+        let anchor = |i: usize| match &self.target_digits {
+            Some(d) => d[i].clone(),
+            None => crate::exact::f64_digits(target[i]),
+        };
+        Some([0, 1, 2].map(|i| crate::exact::moved(&anchor(i), offset[i])))
+    }
+
     /// The position relative to the target as exactly as the scene knows
     /// it: `offset`, or the difference of the digits (or of the f64 values,
     /// which is exact where they are close) computed in `bits`.

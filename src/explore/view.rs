@@ -229,13 +229,21 @@ pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<
 
 /// The strings of digits the scene of `frame` holds a point in, by
 /// parameter: what the page shows and sends back for those points, which
-/// `values` gives only as their nearest numbers.
+/// `values` gives only as their nearest numbers. A camera the zoom's
+/// distance placed nearer its target than f64 keeps apart is held in the
+/// target's digits and that distance: its position's digits are theirs.
 pub fn digits(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, [String; 3]> {
     let scene = timeline.scene_at(frame);
+    let placed = scene.camera.placed_position_digits();
     crate::timeline::parameters::all()
         .filter_map(|p| {
-            let point = (p.digits?.get)(&scene)?;
-            Some((p.name, point.digits?.as_ref().clone()))
+            let point = (p.digits?.get)(&scene).and_then(|point| point.digits);
+            let held = match (point, p.name) {
+                (Some(digits), _) => digits.as_ref().clone(),
+                (None, "camera.position") => placed.clone()?,
+                (None, _) => return None,
+            };
+            Some((p.name, held))
         })
         .collect()
 }
@@ -347,6 +355,7 @@ fn effect_left_off(scene: &Scene, name: &str) -> Option<String> {
 mod tests {
     use super::*;
     use std::path::Path;
+    use std::sync::Arc;
 
     fn zoom() -> Timeline {
         let text = std::fs::read_to_string("timelines/zoom.ron").unwrap();
@@ -448,6 +457,20 @@ mod tests {
             ["0".to_string(), written.into(), "0".into()]
         );
         assert!(!digits(&zoom(), 0).contains_key("camera.target"));
+        // The camera the zoom placed 1e-30 below the target, in digits.
+        let position = &digits(&t, 539)["camera.position"];
+        let camera = t.scene_at(539).camera;
+        let held = Some(Arc::new(position.clone()));
+        let below = crate::exact::difference(
+            (camera.position, held.as_ref()),
+            (camera.target, camera.target_digits.as_ref()),
+        );
+        let exact = camera.relative_position();
+        assert!(
+            (below - exact).length() <= 1e-12 * exact.length(),
+            "{below}"
+        );
+        assert!(!digits(&t, 0).contains_key("camera.position"));
         // The same point 1e-40 along x, which no f64 tells from it.
         let moved = "0.0000000000000000000000000000000000000001";
         let typed: Override =

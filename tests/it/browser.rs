@@ -536,6 +536,75 @@ fn digits_typed_into_a_field_are_saved_as_typed() {
     assert!(saved.contains("(0.30000000000000004, 0.5, 2.6)"), "{saved}");
 }
 
+/// deep_zoom.ron's last shot as a still: a zoom track holds the camera
+/// 1e-30 below a target written in digits, nearer than f64 keeps apart.
+const DEEP: &str = r#"(fps: 24, frames: 2, size: (48, 27), scene: (
+    camera: (position: (0.575, -2.4, 0.482), target: ("0", "-1.10408951367381233764950538762334472132532660078012416551453", "0"), up: (0, 1, 0), fov_degrees: 40),
+    fractal: (iterations: 60),
+), tracks: {"camera.distance": (keys: [(time: 0, value: 1e-30)])})"#;
+
+#[test]
+fn a_deep_camera_orbits_and_zooms_by_keys_in_its_digits() {
+    if !tool("chromedriver", "--version") || !tool("chromium", "--version") {
+        return;
+    }
+    let dir = Dir::new();
+    dir.write("deep.ron", DEEP);
+    let session = Session::open(&dir, "deep.ron");
+    let url = session.url.clone();
+    session.runtime.block_on(async {
+        let client = session.client().await;
+        client.goto(&url).await.expect("load the page");
+        settled(&client).await;
+        let viewport = client
+            .find(Locator::Id("viewport"))
+            .await
+            .expect("viewport");
+        js(&client, "document.getElementById('viewport').focus();").await;
+        // Left turns the camera 0.16 radians about up; W brings it 0.8 as near.
+        viewport.send_keys("\u{E012}").await.expect("press left");
+        until(&client, "page.typed['camera.position']").await;
+        settled(&client).await;
+        viewport.send_keys("w").await.expect("press W");
+        until(&client, "page.overrides['camera.distance']").await;
+        settled(&client).await;
+        let alert = js(
+            &client,
+            "return document.getElementById('alert').textContent;",
+        )
+        .await;
+        assert_eq!(alert, json!(""), "the moved view was refused");
+        viewport.send_keys("k").await.expect("press K");
+        until(
+            &client,
+            "page.state.dirty && !Object.keys(page.overrides).length",
+        )
+        .await;
+        press(&client, "save").await;
+        until(&client, "!page.state.dirty").await;
+        client.close().await.expect("close the browser");
+    });
+    let away = |text: &str| {
+        let path = std::path::Path::new("deep.ron");
+        let timeline = mandelreel::timeline::Timeline::parse(text, path).expect("a timeline");
+        timeline.scene_at(0).camera.relative_position()
+    };
+    let saved = String::from_utf8(dir.bytes("deep.ron")).expect("text");
+    let (before, after) = (away(DEEP), away(&saved));
+    let ratio = after.length() / before.length();
+    assert!((ratio - 0.8).abs() < 1e-9, "{before} became {after}");
+    let (b, a) = (before.normalize(), after.normalize());
+    assert!(
+        (a.y - b.y).abs() < 1e-9,
+        "turned off the up axis: {b} to {a}"
+    );
+    let turn = (a.z.atan2(a.x) - b.z.atan2(b.x)).abs();
+    assert!(
+        (turn - 0.16).abs() < 1e-6,
+        "turned {turn} radians: {b} to {a}"
+    );
+}
+
 /// Every parameter's name whole, nothing wider than the window, disabled
 /// buttons unlike enabled ones, and what the page says kept to the latest:
 /// at a laptop's and a desktop's size. With `MANDELREEL_EXPLORE_SCREENSHOTS`

@@ -860,7 +860,17 @@ fn a_point_is_shown_viewed_and_keyed_in_its_digits() {
     let s = explore(&d, "deep.ron");
     let digits = s.get("/api/digits?frame=1").expect(200).json();
     assert_eq!(digits["camera.target"], json!(["0", tip, "0"]), "{digits}");
-    assert_eq!(digits["camera.position"], Value::Null, "{digits}");
+    // The zoom holds the camera 1e-30 from the target, towards (1.5, -2.4, 1.2).
+    let position = &digits["camera.position"];
+    let component = |i: usize| position[i].as_str().unwrap().parse::<f64>().unwrap();
+    let towards = [1.5, -2.4 - tip.parse::<f64>().unwrap(), 1.2];
+    let length = towards.iter().map(|v| v * v).sum::<f64>().sqrt();
+    for i in [0, 2] {
+        let expected = 1e-30 * towards[i] / length;
+        assert!((component(i) / expected - 1.0).abs() < 1e-9, "{digits}");
+    }
+    let y = position[1].as_str().unwrap();
+    assert!(y.starts_with(&tip[..30]) && y != tip, "{digits}");
     s.get("/api/digits?frame=2").expect(422);
     // 2e-30 along x: a pixel's width at this depth, which f64 rounds away.
     let moved = json!(["0.000000000000000000000000000002", tip, "0"]);

@@ -247,29 +247,142 @@ function rotate(v, k, angle) {
   return add(add(scale(v, c), scale(cross(k, v), s)), scale(k, dot(k, v) * (1 - c)));
 }
 
-function orbit(dx, dy) {
-  const target = value("camera.target");
+// ---- points in digits -----------------------------------------------------------
+// A deep camera is nearer its target than f64 tells apart: its moves take
+// the offsets between points, exact in decimal (m × 10^e, m a BigInt), and
+// add them to the points' digits, which the server keeps.
+
+const MAX_DIGITS = 400;  // the digits a coordinate may have (exact::MAX_DIGITS)
+
+function decimal(text) {
+  const [mantissa, exponent = "0"] = text.replace(/^\+/, "").split(/[eE]/);
+  const negative = mantissa.startsWith("-");
+  const [whole, fraction = ""] = mantissa.replace(/^-/, "").split(".");
+  const m = BigInt(whole + fraction || "0");
+  return { m: negative ? -m : m, e: Number(exponent) - fraction.length };
+}
+
+// An f64 exactly: its significand times a power of two, 2^-k = 5^k × 10^-k.
+function exactly(v) {
+  const view = new DataView(new ArrayBuffer(8));
+  view.setFloat64(0, v);
+  const bits = view.getBigUint64(0);
+  const biased = Number((bits >> 52n) & 0x7ffn);
+  let m = bits & ((1n << 52n) - 1n);
+  if (biased > 0) m |= 1n << 52n;
+  const power = Math.max(biased, 1) - 1075;
+  if (bits >> 63n) m = -m;
+  return power >= 0 ? { m: m << BigInt(power), e: 0 } : { m: m * 5n ** BigInt(-power), e: power };
+}
+
+function plus(a, b) {
+  const e = Math.min(a.e, b.e);
+  return { m: a.m * 10n ** BigInt(a.e - e) + b.m * 10n ** BigInt(b.e - e), e };
+}
+
+const minus = (a, b) => plus(a, { m: -b.m, e: b.e });
+const nearest = (d) => parseFloat(`${d.m}e${d.e}`);
+// The shortest digits that read back as v: what an offset in f64 means.
+const shortest = (v) => decimal(v.toExponential());
+
+// Digits the server takes: plain, or one digit before the point and an
+// exponent, rounded to MAX_DIGITS significant digits.
+function written(d) {
+  let digits = (d.m < 0n ? -d.m : d.m).toString(), e = d.e;
+  const sign = d.m < 0n ? "-" : "";
+  if (digits.length > MAX_DIGITS) {
+    const cut = digits.length - MAX_DIGITS;
+    const kept = (BigInt(digits) + 5n * 10n ** BigInt(cut - 1)) / 10n ** BigInt(cut);
+    digits = kept.toString();
+    e += cut + (digits.length - MAX_DIGITS);
+    digits = digits.slice(0, MAX_DIGITS);
+  }
+  const zeros = digits.match(/0*$/)[0].length;
+  if (zeros === digits.length) return "0";
+  digits = digits.slice(0, digits.length - zeros);
+  e += zeros;
+  const point = digits.length + e;  // digits before the decimal point
+  const plain = e >= 0 ? digits + "0".repeat(e)
+    : point > 0 ? `${digits.slice(0, point)}.${digits.slice(point)}`
+    : `0.${"0".repeat(-point)}${digits}`;
+  if (plain.replace(".", "").length <= MAX_DIGITS) return sign + plain;
+  return `${sign}${digits[0]}.${digits.slice(1) || "0"}e${point - 1}`;
+}
+
+// Point `name` in the view, exactly: its digits where it has them, else its numbers.
+function exactPoint(name) {
+  const numbers = value(name);
+  const over = page.overrides[name];
+  const typed = over ? page.typed[name] || [] : page.digits[name] || [];
+  return numbers.map((v, i) => (typed[i] !== undefined ? decimal(typed[i]) : exactly(v)));
+}
+
+function heldInDigits(name) {
+  return Boolean(page.overrides[name] ? page.typed[name] : page.digits[name]);
+}
+
+// Whether the camera, or its target, is held in digits and nearer the
+// target than f64 positions keep apart (2^-30 of its size, as the server
+// judges): its moves then take exactPoint.
+function deepCamera() {
+  if (!heldInDigits("camera.position") && !heldInDigits("camera.target")) return false;
+  const away = offsetTo(exactPoint("camera.position"), exactPoint("camera.target"));
+  const size = Math.max(...value("camera.target").map(Math.abs));
+  return Math.max(...away.map(Math.abs)) < 2 ** -30 * size;
+}
+
+function changeExact(name, point) {
+  change(name, point.map(nearest));
+  page.typed[name] = point.map(written);
+}
+
+// `origin` + `offset` (f64 numbers) as exact digits.
+const offsetFrom = (origin, offset) => origin.map((o, i) => plus(o, shortest(offset[i])));
+const offsetTo = (point, origin) => point.map((p, i) => nearest(minus(p, origin[i])));
+
+// The camera's offset from its target turned by a drag of (dx, dy) pixels.
+function turned(away, dx, dy) {
   const up = norm(value("camera.up"));
-  let away = sub(value("camera.position"), target);
   away = rotate(away, up, -dx * 0.008);
   const right = norm(cross(up, away));
-  const turned = rotate(away, right, -dy * 0.008);
+  const tilted = rotate(away, right, -dy * 0.008);
   // Not over the pole, where the view would flip about the up direction;
   // a turn away from it is always taken.
   const pole = (v) => Math.abs(dot(norm(v), up));
-  if (pole(turned) < 0.995 || pole(turned) < pole(away)) away = turned;
-  change("camera.position", add(target, away));
+  return pole(tilted) < 0.995 || pole(tilted) < pole(away) ? tilted : away;
+}
+
+function orbit(dx, dy) {
+  if (!deepCamera()) {
+    const target = value("camera.target");
+    change("camera.position", add(target, turned(sub(value("camera.position"), target), dx, dy)));
+    return;
+  }
+  const target = exactPoint("camera.target");
+  const away = offsetTo(exactPoint("camera.position"), target);
+  changeExact("camera.position", offsetFrom(target, turned(away, dx, dy)));
 }
 
 // Moves the camera and target towards `point` by `factor` (< 1 is closer):
-// the point stays where it is in the frame.
-function zoomAbout(point, factor) {
-  const typed = page.overrides["camera.distance"];
-  if (typed) change("camera.distance", [typed[0] * factor]);
-  change("camera.position", add(point, scale(sub(value("camera.position"), point), factor)));
-  if (point !== value("camera.target")) {
-    change("camera.target", add(point, scale(sub(value("camera.target"), point), factor)));
-  }
+// the point stays where it is in the frame. `exact` is the point's digits
+// as decimals where a pick gave them. A point held in digits moves in them.
+function zoomAbout(point, factor, exact) {
+  // A zoom track places the camera at its distance: the zoom changes that.
+  const distance = page.overrides["camera.distance"]
+    || (trackNamed("camera.distance") && value("camera.distance"));
+  if (distance) change("camera.distance", [distance[0] * factor]);
+  const target = value("camera.target");
+  const about = point === target ? exactPoint("camera.target") : exact || point.map(exactly);
+  const closer = (name, inDigits) => {
+    if (!inDigits) {
+      change(name, add(point, scale(sub(value(name), point), factor)));
+      return;
+    }
+    const away = offsetTo(exactPoint(name), about);
+    changeExact(name, offsetFrom(about, scale(away, factor)));
+  };
+  closer("camera.position", deepCamera());
+  if (point !== target) closer("camera.target", heldInDigits("camera.target"));
 }
 
 function roll(degrees) {
@@ -299,16 +412,19 @@ async function aimAt(pixel) {
   try {
     const hit = await pickAt(pixel);
     if (!hit) { say("That pixel sees no surface."); return; }
-    change("camera.target", hit);
-    say(`Aimed at (${hit.map((v) => v.toPrecision(8)).join(", ")}).`);
+    if (hit.exact) changeExact("camera.target", hit.exact);
+    else change("camera.target", hit.point);
+    say(`Aimed at (${hit.point.map((v) => v.toPrecision(8)).join(", ")}).`);
     refresh();
   } catch (error) { alertShown(error.message); }
 }
 
+// The surface point a pixel sees, with its digits (as decimals) in a deep frame.
 async function pickAt(pixel) {
   const response = await api("/api/pick", { view: currentView(), x: pixel[0], y: pixel[1] });
   const report = await response.json();
-  return report.point || null;
+  if (!report.point) return null;
+  return { point: report.point, exact: report.point_digits && report.point_digits.map(decimal) };
 }
 
 // ---- pointer, wheel and keys -------------------------------------------------
@@ -360,21 +476,21 @@ function setUpViewport() {
     event.preventDefault();
     const factor = Math.exp(Math.max(-1, Math.min(1, event.deltaY * 0.0015)));
     const pixel = pixelAt(event);
-    let point = value("camera.target");
+    let hit = null;
     if (pixel) {
       const cached = page.pickCache;
       if (cached && cached.x === pixel[0] && cached.y === pixel[1] && performance.now() - cached.at < 400) {
-        point = cached.hit || point;
+        hit = cached.hit;
       } else {
         try {
-          const hit = await pickAt(pixel);
+          hit = await pickAt(pixel);
           page.pickCache = { x: pixel[0], y: pixel[1], hit, at: performance.now() };
-          point = hit || point;
         } catch (error) { alertShown(error.message); return; }
       }
       page.pickCache.at = performance.now();
     }
-    zoomAbout(point, factor);
+    if (hit) zoomAbout(hit.point, factor, hit.exact);
+    else zoomAbout(value("camera.target"), factor);
     refreshSoon();
   }, { passive: false });
 }
@@ -436,18 +552,21 @@ function format(numbers) {
 // by its distance, so a moved camera keys that distance too.
 function changeKeys() {
   const time = page.frame / page.state.fps;
-  const values = { ...page.overrides };
+  // A point is keyed as the view holds it: in its digits where it has them.
+  const held = (name) => (page.overrides[name] ? sent(name) : page.digits[name] || value(name));
+  const values = Object.fromEntries(changedNames().map((name) => [name, held(name)]));
   // A zoom track places the camera along the line from the target through
-  // the position track's value: key all three as the view has them.
+  // the position track's value: key all three as the view has them. The
+  // line of a deep camera is keyed through a point a unit from the target,
+  // which f64 tells apart from it.
   const moved = values["camera.position"] || values["camera.target"];
   if (trackNamed("camera.distance") && moved) {
-    values["camera.position"] = value("camera.position");
-    values["camera.target"] = value("camera.target");
-    if (!values["camera.distance"]) {
-      values["camera.distance"] = [Math.hypot(...sub(value("camera.position"), value("camera.target")))];
-    }
+    const away = offsetTo(exactPoint("camera.position"), exactPoint("camera.target"));
+    values["camera.target"] = held("camera.target");
+    values["camera.position"] = deepCamera() ? add(value("camera.target"), norm(away)) : held("camera.position");
+    if (!values["camera.distance"]) values["camera.distance"] = [Math.hypot(...away)];
   }
-  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: sent(track, v) }));
+  return Object.entries(values).map(([track, v]) => ({ kind: "set_key", track, time, value: v }));
 }
 
 // A first key on a parameter without a track would set it for the whole
