@@ -461,6 +461,9 @@ fn no_ray_passes_through_the_set_in_a_wide_sphere_or_at_a_large_bailout() {
         (4.0, 6.0, DeMethod::Analytic, Precision::F32),
         (1e30, 1e6, DeMethod::Potential, Precision::F64),
         (4.0, 6.0, DeMethod::SinhPotential, Precision::F32),
+        (2.0, 3.0, DeMethod::EscapeLength, Precision::F64),
+        (4.0, 6.0, DeMethod::EscapeLength, Precision::F32),
+        (4.0, 1.5, DeMethod::EscapeLength, Precision::F64),
     ] {
         let f = Fractal {
             bailout,
