@@ -1,8 +1,8 @@
 //! How close the estimate's hits come to the set on every example, judged
 //! by membership alone (`march::judge`): the 3D distance from each hit to
 //! the set, and a scan of each ray for set it passed through before the hit.
-//! Optional arguments set every scene's `hit_threshold`, `membership_step`
-//! and `over_relaxation`.
+//! Optional arguments set every scene's `hit_threshold`, `membership_step`,
+//! `over_relaxation` and `refine_steps`.
 //! The measurement behind docs/surface.md:
 //! `cargo run --release --example surface` (half a minute on two cores).
 
@@ -40,6 +40,9 @@ fn measure(name: &str, path: &str, frame: u32) {
     }
     if let Some(omega) = arg(3) {
         scene.quality.over_relaxation = omega;
+    }
+    if let Some(steps) = arg(4) {
+        scene.quality.refine_steps = steps as u32;
     }
     let camera = scene.camera.frame();
     let (w, h, every) = (160u32, 90u32, 6u32);

@@ -36,4 +36,4 @@ mod shade;
 pub mod timeline;
 
 /// Bumped whenever a change alters rendered pixels, so resume re-renders old frames.
-pub const RENDERER_REVISION: u32 = 15;
+pub const RENDERER_REVISION: u32 = 16;

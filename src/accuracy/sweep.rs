@@ -83,6 +83,11 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     for v in [1, 4, 8, 16, 64] {
         add("cone_rays", v.to_string(), &|s| s.quality.cone_rays = v);
     }
+    for v in [0, 1, 2, 4] {
+        add("refine_steps", v.to_string(), &|s| {
+            s.quality.refine_steps = v
+        });
+    }
     for k in [0.25, 0.5, 2.0] {
         let v = scaled(q.max_steps, k);
         add("max_steps", v.to_string(), &|s| s.quality.max_steps = v);

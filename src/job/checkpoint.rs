@@ -283,6 +283,10 @@ mod tests {
         }
         assert_eq!(resumed, straight);
         let taken: Vec<u32> = straight.spread.iter().map(|p| p.taken).collect();
-        assert!(taken.contains(&4) && taken.contains(&16), "{taken:?}");
+        // Some pixels stopped early, after a checkpoint or before it.
+        assert!(
+            taken.iter().any(|&n| n < 16) && taken.contains(&16),
+            "{taken:?}"
+        );
     }
 }

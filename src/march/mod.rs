@@ -65,6 +65,11 @@ pub struct MarchSettings {
     /// glow, which needs each ray's nearest approach, nor with estimators
     /// other than the analytic one (`Scene::cone_rays`).
     pub cone_rays: u32,
+    /// Plain steps a hit takes on towards the surface once the estimate
+    /// falls under `hit_threshold`, while it keeps falling and until it is
+    /// under a quarter of it: the threshold decides hit or miss, these bring
+    /// the hit nearer the set (0 stops at the threshold).
+    pub refine_steps: u32,
     /// The bounding sphere's centre in the frame's coordinates: the world
     /// origin, or in a deep frame (measured from its anchor) minus the anchor.
     #[serde(skip)]
@@ -104,6 +109,7 @@ impl Default for MarchSettings {
             bounding_radius: 1.5,
             over_relaxation: 1.2,
             cone_rays: 16,
+            refine_steps: 2,
             centre: DVec3::ZERO,
         }
     }
@@ -212,7 +218,16 @@ struct Marcher {
     steps: u32,
     evaluations: u32,
     closest: Real,
+    /// Once the estimate falls under the hit threshold: the nearest point
+    /// so far and its estimate, and the plain steps taken on from it
+    /// (`Marcher::refine`).
+    nearest: Option<(Real, Estimate)>,
+    refined: u32,
 }
+
+/// A refined hit stops stepping once the estimate is under this share of
+/// the hit threshold (`MarchSettings::refine_steps`).
+const REFINED: Real = 0.25;
 
 impl Marcher {
     /// Starts at the bounding sphere, or the miss of a ray that passes it by.
@@ -247,6 +262,8 @@ impl Marcher {
             steps: 0,
             evaluations: 0,
             closest: Real::INFINITY,
+            nearest: None,
+            refined: 0,
         })
     }
 
@@ -261,6 +278,41 @@ impl Marcher {
         self.t += self.previous_distance - self.previous_step;
         self.previous_step = self.previous_distance;
         self.omega = 1.0;
+    }
+
+    /// A ray whose estimate is under the hit threshold (`near`) or was:
+    /// the hit at the nearest point so far, or `None` to step on by the
+    /// plain step towards the surface, while the estimate keeps falling
+    /// and is not yet `REFINED` of the threshold. A grazing ray whose
+    /// estimate rises again keeps the hit it had.
+    fn refine(
+        &mut self,
+        estimate: &Estimate,
+        near: bool,
+        footprint: Real,
+        settings: &MarchSettings,
+    ) -> Option<MarchResult> {
+        let t = self.t;
+        let nearer = self
+            .nearest
+            .is_none_or(|(_, e)| estimate.distance < e.distance);
+        if near && nearer {
+            self.nearest = Some((t, *estimate));
+        }
+        let (t_hit, at_hit) = self.nearest?;
+        let fine = estimate.distance < REFINED * settings.hit_threshold * footprint;
+        if !(near && nearer) || fine || self.refined >= settings.refine_steps {
+            return Some(self.hit(t_hit, at_hit));
+        }
+        self.refined += 1;
+        self.outside = Some(t);
+        let step = settings.step(estimate.distance);
+        (self.previous_distance, self.previous_step) = (step, step);
+        self.t += step;
+        if self.t > self.t_exit {
+            return Some(self.hit(t_hit, at_hit));
+        }
+        None
     }
 
     fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
@@ -298,9 +350,10 @@ impl Walk for Marcher {
             // along a surface it keeps almost touching (a grazing ray).
             // Calling that a miss punches background-coloured speckles into
             // the surface; call it a hit, and count it.
+            let (t, estimate) = self.nearest.unwrap_or((t, *estimate));
             return Some(MarchResult {
                 out_of_steps: true,
-                ..self.hit(t, *estimate)
+                ..self.hit(t, estimate)
             });
         }
         self.steps += 1;
@@ -336,8 +389,11 @@ impl Walk for Marcher {
         // the estimate, near enough.
         let trusted = settings.membership_step <= 0.0
             && estimate.distance < settings.hit_threshold * footprint;
-        if !estimate.escaped || trusted {
+        if !estimate.escaped {
             return Some(self.hit(t, *estimate));
+        }
+        if trusted || self.nearest.is_some() {
+            return self.refine(estimate, trusted, footprint, settings);
         }
         self.outside = Some(t);
         let step = settings.step(estimate.distance);

@@ -24,12 +24,15 @@ pub(super) const MAX_MARCH_STEPS: u32 = 1_000_000;
 pub(super) const MAX_SHADOW_STEPS: u32 = 100_000;
 pub(super) const MAX_OCCLUSION_SAMPLES: u32 = 64;
 pub(super) const MAX_BOUNCES: u32 = 1024;
+/// Past a few, refining steps stop on their own (the estimate is under a
+/// quarter of the threshold or rising).
+pub(super) const MAX_REFINE_STEPS: u32 = 64;
 
 /// Every whole-number field of a timeline with its limit, by its path in
 /// the file: a number too large for the field's type, or negative, is
 /// told the limit the field has rather than the type's. `scene.seed` may
 /// be any u64: its 0 stands for no limit of its own.
-const COUNTS: [(&str, u32); 12] = [
+const COUNTS: [(&str, u32); 13] = [
     ("frames", MAX_FRAMES),
     ("size[0]", MAX_SIDE),
     ("size[1]", MAX_SIDE),
@@ -38,6 +41,7 @@ const COUNTS: [(&str, u32); 12] = [
     ("scene.fractal.iterations", MAX_ITERATIONS),
     ("scene.quality.max_steps", MAX_MARCH_STEPS),
     ("scene.quality.cone_rays", MAX_CONE_RAYS),
+    ("scene.quality.refine_steps", MAX_REFINE_STEPS),
     ("scene.effects.shadows.max_steps", MAX_SHADOW_STEPS),
     (
         "scene.effects.ambient_occlusion.samples",
@@ -46,6 +50,11 @@ const COUNTS: [(&str, u32); 12] = [
     ("scene.effects.path_tracing.max_bounces", MAX_BOUNCES),
     ("scene.seed", 0),
 ];
+
+/// What `quality.refine_steps` past its limit is told: it may be 0.
+pub(super) fn refine_outside(got: impl std::fmt::Display) -> String {
+    format!("must be 0..={MAX_REFINE_STEPS}, got {got}")
+}
 
 /// What a count outside 1..=`most` is told: `got` as written or held.
 pub(super) fn count_outside(most: u32, got: impl std::fmt::Display) -> String {
@@ -65,6 +74,7 @@ pub(super) fn count_message(field: &str, written: &str) -> Option<String> {
         "frames" if negative => format!("must be at least 1, got {written}"),
         "frames" => format!("at most {MAX_FRAMES}, got {written}: {FRAMES_HINT}"),
         "size[0]" | "size[1]" => format!("width and height must be 1..={MAX_SIDE}, got {written}"),
+        "scene.quality.refine_steps" => refine_outside(written),
         _ => count_outside(*most, written),
     })
 }

@@ -5,7 +5,8 @@
 
 use super::checks::{colour, counted, non_negative, rule, Checked};
 use super::limits::{
-    MAX_BOUNCES, MAX_CONE_RAYS, MAX_OCCLUSION_SAMPLES, MAX_SAMPLES, MAX_SHADOW_STEPS,
+    refine_outside, MAX_BOUNCES, MAX_CONE_RAYS, MAX_OCCLUSION_SAMPLES, MAX_REFINE_STEPS,
+    MAX_SAMPLES, MAX_SHADOW_STEPS,
 };
 use super::messages::Shown;
 use super::parameters::Parameter;
@@ -73,6 +74,11 @@ pub fn validate_scene(s: &Scene) -> Result<(), Invalid> {
     at(
         "quality.cone_rays",
         counted(s.quality.cone_rays, MAX_CONE_RAYS),
+    )?;
+    let refine = s.quality.refine_steps;
+    at(
+        "quality.refine_steps",
+        rule(refine <= MAX_REFINE_STEPS, || refine_outside(refine)),
     )?;
     at(
         "samples_per_pixel",

@@ -264,9 +264,15 @@ fn info_names_the_deep_frames_and_pick_refine_recentres_the_target() {
     let report: serde_json::Value = serde_json::from_str(&pick).unwrap();
     assert_eq!(report["deep"], true);
     // The camera is 1e-24 from the refined target, and the surface is there,
-    // on the ray through the middle of the view (a pixel's centre at 49×27).
+    // on the ray through the middle of the view (a pixel's centre at 49×27):
+    // within a few footprints, as the last round's move (under half a
+    // pixel) shifts that ray across the surface's sheets.
     let distance = report["distance"].as_f64().unwrap();
-    assert!((distance - 1e-24).abs() < 0.05e-24, "{distance:e}");
+    let footprint = report["pixel_footprint"].as_f64().unwrap();
+    assert!(
+        (distance - 1e-24).abs() < 5.0 * footprint,
+        "{distance:e}, footprint {footprint:e}"
+    );
 }
 
 #[test]

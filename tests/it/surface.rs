@@ -59,6 +59,24 @@ fn hits_on_the_benchmark_scene_lie_near_the_set_and_never_past_it() {
 }
 
 #[test]
+fn refined_hits_on_a_zoom_frame_lie_within_three_quarters_of_a_footprint() {
+    // At the threshold alone the median hit was 0.87 footprints from the
+    // set here; two refining steps bring it under 0.75.
+    let mut scene = scene("timelines/zoom.ron", 60);
+    let median = |scene: &Scene| {
+        let (distances, _) = judged(scene);
+        distances[distances.len() / 2]
+    };
+    let refined = median(&scene);
+    scene.quality.refine_steps = 0;
+    let unrefined = median(&scene);
+    assert!(
+        refined <= 0.75 && unrefined > 0.75,
+        "median {refined} footprints refined, {unrefined} not"
+    );
+}
+
+#[test]
 fn the_judge_sees_a_hit_placed_past_or_away_from_the_set() {
     // The judge can fail: a "hit" 3 footprints past the first point of
     // the set on the centre ray reads 3 past it; the crossing itself reads

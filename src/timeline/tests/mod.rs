@@ -254,7 +254,7 @@ fn syntax_errors_point_where_the_mistake_is_and_say_it_plainly() {
 
 /// Every whole-number field of a timeline and the limit docs/timeline.md
 /// gives it.
-const COUNTED: [(&str, &str); 12] = [
+const COUNTED: [(&str, &str); 13] = [
     ("frames", "at most 1000000"),
     ("size[0]", "1..=32768"),
     ("size[1]", "1..=32768"),
@@ -263,6 +263,7 @@ const COUNTED: [(&str, &str); 12] = [
     ("scene.fractal.iterations", "1..=10000"),
     ("scene.quality.max_steps", "1..=1000000"),
     ("scene.quality.cone_rays", "1..=4096"),
+    ("scene.quality.refine_steps", "0..=64"),
     ("scene.effects.shadows.max_steps", "1..=100000"),
     ("scene.effects.ambient_occlusion.samples", "1..=64"),
     ("scene.effects.path_tracing.max_bounces", "1..=1024"),
