@@ -35,8 +35,9 @@ pub fn f32_too_coarse(scene: &Scene, size: [u32; 2]) -> bool {
 }
 
 /// The closest a camera may come to its target: a frame's offsets are f64,
-/// and lengths square them, which leaves f64's range below about 1e-154.
-pub const DEEPEST: Real = 1e-150;
+/// whose normal range ends at 2.2e-308, and a pixel there must keep a few
+/// decades above that for its sub-pixel steps (normals, hit thresholds).
+pub const DEEPEST: Real = 1e-302;
 
 /// Steps a deep frame's rays get for each decade of its depth, over
 /// `quality.max_steps`: a ray passing just by a structure steps a fixed
@@ -68,7 +69,7 @@ pub fn steps_of(scene: &Scene, size: [u32; 2]) -> u32 {
 
 /// The hash a deep frame's file adds to its scene's: what rendering it by
 /// perturbation means changes with it, as `RENDERER_REVISION` does for all.
-pub const DEEP_REVISION: u32 = 2;
+pub const DEEP_REVISION: u32 = 3;
 
 /// The least precision of a reference orbit, in bits.
 const MIN_BITS: usize = 128;
@@ -78,7 +79,7 @@ const MIN_BITS: usize = 128;
 /// distance.
 pub fn footprint(scene: &Scene, size: [u32; 2]) -> Real {
     let c = &scene.camera;
-    c.relative_position().length() * c.axis_pixel_angle(size)
+    c.distance() * c.axis_pixel_angle(size)
 }
 
 /// A pixel's width at the target over the size of the target's coordinates.

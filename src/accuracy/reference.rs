@@ -59,7 +59,7 @@ pub fn reference_depths(
     let camera = scene.camera.frame();
     // Never step finer than a millionth of the camera–target distance: bounds the
     // work for rays that start right on the surface in deep zooms.
-    let min_step = 1e-6 * scene.camera.relative_position().length();
+    let min_step = 1e-6 * scene.camera.distance();
     let rows: Vec<(Vec<Option<Real>>, u64)> = (0..height)
         .into_par_iter()
         .map(|y| {

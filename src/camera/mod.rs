@@ -173,6 +173,12 @@ impl Camera {
         )
     }
 
+    /// How far the camera is from its target, as exactly as the scene
+    /// knows it (`relative_position`), at any depth.
+    pub fn distance(&self) -> Real {
+        crate::math::length(self.relative_position())
+    }
+
     /// The size of one eye's image in a `width`×`height` image (the image
     /// itself without stereo), at least 1×1.
     pub fn eye_size(&self, [width, height]: [u32; 2]) -> [u32; 2] {
@@ -236,7 +242,7 @@ impl Camera {
             (right, up) = (right * c + up * s, up * c - right * s);
         }
         // Only a pair's eyes need the distance, exactly where digits give it.
-        let half = |s: Stereo| 0.5 * s.eye_separation * self.relative_position().length();
+        let half = |s: Stereo| 0.5 * s.eye_separation * self.distance();
         CameraFrame {
             origin: self.position,
             projection: self.projection,
@@ -248,7 +254,7 @@ impl Camera {
             aperture_radius: self.aperture_radius,
             focus_distance: self
                 .focus_distance
-                .unwrap_or_else(|| (self.target - self.position).length()),
+                .unwrap_or_else(|| crate::math::length(self.target - self.position)),
         }
     }
 }
@@ -394,7 +400,7 @@ impl CameraFrame {
         let origin = pinhole.origin + (across * angle.cos() + above * angle.sin()) * radius;
         Ray {
             origin,
-            dir: (focus - origin).normalize(),
+            dir: crate::math::direction(focus - origin),
             ..pinhole
         }
     }

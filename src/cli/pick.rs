@@ -183,7 +183,7 @@ struct Round {
 fn refine_rounds(t: &Timeline, args: &PickArgs, size: [u32; 2]) -> anyhow::Result<Round> {
     let text = crate::timeline::read_text(&args.timeline)?;
     let mut scene = t.scene_at(args.frame);
-    let pixel = scene.camera.axis_pixel_angle(size) * scene.camera.relative_position().length();
+    let pixel = scene.camera.axis_pixel_angle(size) * scene.camera.distance();
     let mut best: Option<Round> = None;
     let mut previous = f64::INFINITY;
     // The frame counts Auto's iterations at the whole image's size.

@@ -203,7 +203,7 @@ impl View {
 pub fn values(timeline: &Timeline, frame: u32) -> BTreeMap<&'static str, Option<Vec<f64>>> {
     let scene = timeline.scene_at(frame);
     // Exactly, where digits put the camera closer than f64 tells apart.
-    let distance = scene.camera.relative_position().length();
+    let distance = scene.camera.distance();
     let json = serde_json::to_value(&scene).unwrap_or_default();
     let tenths = serde_json::to_value(tenths(scene)).unwrap_or_default();
     crate::timeline::parameters::all()

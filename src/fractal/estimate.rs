@@ -376,7 +376,7 @@ impl Fractal {
         } else {
             let r = centre.r.value();
             let d = match self.de {
-                DeMethod::Analytic => half_r_ln_r_over(r, centre.dr.value()),
+                DeMethod::Analytic => half_r_ln_r_over(r, centre.dr.value()) * self.dr_scale(),
                 DeMethod::Jacobian => {
                     let jacobian = jacobian.expect("computed above for this method");
                     let mut norm = spectral_norm(jacobian);
@@ -384,7 +384,7 @@ impl Fractal {
                         // On the pole axis the dual numbers meet acos'(±1) = ∞. There
                         // the azimuthal stretch is n²·r^(n−1) against the scalar
                         // n·r^(n−1), so bound the norm by n·dr: conservative.
-                        norm = self.power * centre.dr.value();
+                        norm = self.power * centre.dr.value() / self.dr_scale();
                     }
                     half_r_ln_r_over(r, norm)
                 }
@@ -394,7 +394,7 @@ impl Fractal {
                     // A deep frame's points are offsets from its anchor, as
                     // fine as its pixels: no floor of a thousandth there.
                     let size = if self.deep.is_some() {
-                        p.length()
+                        crate::math::length(p)
                     } else {
                         p.length().max(1e-3)
                     };
@@ -424,7 +424,8 @@ impl Fractal {
                     // iterations leaps by orders across it (in f32, 3.4e-4·|p|
                     // wide, stopping rays 1e-3 … 1e-7 from the surface at
                     // once). Both fall back to the analytic estimate.
-                    let straddles = h > 0.25 * scale && h > guarded_distance(centre);
+                    let straddles =
+                        h > 0.25 * scale && h > guarded_distance(centre, self.dr_scale());
                     if !(slope.is_finite() && slope > 0.0)
                         || (self.de == DeMethod::EscapeLength && straddles)
                     {
@@ -432,7 +433,7 @@ impl Fractal {
                     } else {
                         match self.de {
                             DeMethod::EscapeLength => half_r_ln_r_over(r, slope)
-                                .min(ESCAPE_LENGTH_CAP * guarded_distance(centre)),
+                                .min(ESCAPE_LENGTH_CAP * guarded_distance(centre, self.dr_scale())),
                             DeMethod::Potential => {
                                 0.5 * potential(r, centre.iterations, self.power) / slope
                             }
@@ -447,7 +448,7 @@ impl Fractal {
             if d.is_finite() {
                 d.max(0.0)
             } else {
-                guarded_distance(centre)
+                guarded_distance(centre, self.dr_scale())
             }
         };
         Estimate {
@@ -501,8 +502,8 @@ const ESCAPE_LENGTH_CAP: Real = 4.0;
 /// running derivative beyond f32's range): the analytic estimate from the same
 /// orbit if that is finite, else 0, which the marcher treats as a hit: it may
 /// stop early but never skips surface.
-pub(super) fn guarded_distance<T: Number>(centre: &Orbit<T>) -> Real {
-    as_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()))
+pub(super) fn guarded_distance<T: Number>(centre: &Orbit<T>, dr_scale: Real) -> Real {
+    as_distance(half_r_ln_r_over(centre.r.value(), centre.dr.value()) * dr_scale)
 }
 
 /// `bailout`, or 2^`log2` where that is lower. Out of line: inlined, the

@@ -4,11 +4,43 @@ use super::{DVec3, Real};
 
 /// Returns `v` normalised, or `fallback` when `v` is zero or not finite.
 pub fn normalize_or(v: DVec3, fallback: DVec3) -> DVec3 {
+    let v = lifted(v);
     let len = v.length();
     if len.is_finite() && len > 1e-300 {
         v / len
     } else {
         fallback
+    }
+}
+
+/// Below this a vector's squared components leave f64's range (they
+/// pass under 1e-308): a deep frame's offsets go to 1e-300.
+const SQUARES_UNDERFLOW: Real = 1e-140;
+
+/// `v` over its largest component where that is below
+/// `SQUARES_UNDERFLOW`, so that its length can be taken; else `v`.
+fn lifted(v: DVec3) -> DVec3 {
+    let most = v.abs().max_element();
+    if most > 0.0 && most < SQUARES_UNDERFLOW {
+        v / most
+    } else {
+        v
+    }
+}
+
+/// glam's `normalize`, also where the squares of `v` underflow (a deep
+/// frame's offsets): the same bits wherever they do not.
+pub fn direction(v: DVec3) -> DVec3 {
+    lifted(v).normalize()
+}
+
+/// |v|, also where its squares underflow (a deep frame's offsets).
+pub fn length(v: DVec3) -> Real {
+    let most = v.abs().max_element();
+    if most > 0.0 && most < SQUARES_UNDERFLOW {
+        most * (v / most).length()
+    } else {
+        v.length()
     }
 }
 
@@ -73,5 +105,22 @@ mod tests {
         assert_eq!(normalize_or(DVec3::ZERO, DVec3::Y), DVec3::Y);
         assert_eq!(normalize_or(DVec3::splat(f64::NAN), DVec3::Y), DVec3::Y);
         assert!((normalize_or(DVec3::new(3.0, 4.0, 0.0), DVec3::Y).length() - 1.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn lengths_and_directions_hold_past_the_squares_range() {
+        let v = DVec3::new(3e-300, 4e-300, 0.0);
+        assert!((length(v) / 5e-300 - 1.0).abs() < 1e-15, "{}", length(v));
+        let unit = normalize_or(v, DVec3::Y);
+        assert!(
+            (unit - DVec3::new(0.6, 0.8, 0.0)).length() < 1e-15,
+            "{unit}"
+        );
+        // Where squares hold, the plain length to the bit.
+        let w = DVec3::new(0.3, -0.2, 0.7);
+        assert_eq!(length(w), w.length());
+        assert_eq!(normalize_or(w, DVec3::Y), w / w.length());
+        assert_eq!(direction(w), w.normalize());
+        assert!((direction(v) - DVec3::new(0.6, 0.8, 0.0)).length() < 1e-15);
     }
 }

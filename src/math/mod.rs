@@ -16,7 +16,7 @@ mod vector;
 
 pub use colour::{finite_or_zero, mix};
 pub use dual::Dual;
-pub use geometry::{normalize_or, sphere_interval};
+pub use geometry::{direction, length, normalize_or, sphere_interval};
 pub use ln::{in_ln_range, ln, ln_in_range, Lanes};
 pub use number::{Arith, Number};
 pub use sample::{sample_1d, shell_points};

@@ -142,7 +142,10 @@ pub fn refine(
     recount: &dyn Fn(&Scene) -> u32,
 ) -> Result<Refined, String> {
     let relative = scene.camera.relative_position();
-    let (last, away) = (relative.length(), relative.normalize());
+    let (last, away) = (
+        crate::math::length(relative),
+        crate::math::direction(relative),
+    );
     let size = scene.camera.target.abs().max_element();
     let afar = (REFINE_STEP * size).max(last);
     let mut distance = match from_afar {

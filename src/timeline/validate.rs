@@ -14,7 +14,7 @@ use super::parameters::{
     AMBIENT_OCCLUSION, CAMERA, FOG, FRACTAL, GLOW, LOOK, PALETTE, QUALITY, SHADOWS, SPECULAR,
 };
 use crate::error::Result;
-use crate::math::Real;
+use crate::math::{direction, Real};
 use crate::scene::Scene;
 use crate::shade::{Effects, PathTracing, Sky};
 
@@ -111,10 +111,11 @@ fn view(s: &Scene) -> Result<(), Invalid> {
     // `camera.distance`).
     let exact = c.offset.is_some() || c.position_digits.is_some() || c.target_digits.is_some();
     let coincide = if exact {
-        // Offsets are f64: past this their squares leave its range.
-        rule(view.abs().max_element() > crate::deep::DEEPEST, || {
+        // Offsets are f64: past this a pixel nears the end of its range.
+        rule(crate::math::length(view) >= crate::deep::DEEPEST, || {
             format!(
-                "the camera is closer to its target than {:.0e}, the deepest a frame can be",
+                "the camera is closer to its target than {:.0e}, the deepest a frame can be \
+                 (offsets are f64, whose range ends at 2.2e-308)",
                 crate::deep::DEEPEST
             )
         })
@@ -133,7 +134,7 @@ fn view(s: &Scene) -> Result<(), Invalid> {
         })
     };
     at("camera.target", coincide)?;
-    let parallel = rule(view.normalize().cross(c.up).length() > 1e-9, || {
+    let parallel = rule(direction(view).cross(c.up).length() > 1e-9, || {
         format!(
             "must not be zero or parallel to the view direction, got {}",
             c.up.shown()

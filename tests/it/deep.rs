@@ -64,7 +64,7 @@ fn check_against_the_oracle(
     samples: u32,
 ) {
     let outside = |offset: DVec3| deep_oracle::estimate(oracle, base, offset.to_array()).2;
-    let distance = s.camera.relative_position().length();
+    let distance = s.camera.distance();
     let deep = mandelreel::deep::prepare(s, SIZE).expect("a deep frame");
     let camera = deep.camera.frame();
     for (x, y) in pixels {
@@ -103,23 +103,39 @@ fn deep_hits_agree_with_high_precision_membership() {
 /// with b⁷ = 2, to 120 digits.
 const TIP: &str = "-1.10408951367381233764950538762334472132532660078012416551453246414210632288038098071659828988630200514689715906557993125397";
 
-#[test]
-fn a_few_pixels_a_hundred_decades_down() {
+/// The tip (`digits`) seen from the side, `distance` away, with
+/// `iterations`, checked against the oracle at `bits` on the tip and the
+/// crown above it (rays below it pass the tip by, a fixed share of their
+/// distance a step, and run out of steps).
+fn tip_from_the_side(digits: &str, distance: f64, iterations: u32, bits: usize) {
     let text = format!(
-        "(camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{TIP}\", \"0\"), fov_degrees: 40), fractal: (iterations: 100), quality: (over_relaxation: 1.0, max_steps: 1000))"
+        "(camera: (position: (1.5, -1.3, 1.2), target: (\"0\", \"{digits}\", \"0\"), fov_degrees: 40), fractal: (iterations: {iterations}), quality: (over_relaxation: 1.0, max_steps: 1000))"
     );
     let mut s: Scene = ron::from_str(&text).unwrap();
     let away = (DVec3::new(1.5, -1.3, 1.2) - s.camera.target).normalize();
-    s.camera.offset = Some(away * 1e-100);
+    s.camera.offset = Some(away * distance);
     let oracle = OracleFractal {
-        iterations: 100,
-        bits: 480,
+        iterations,
+        bits,
         ..oracle()
     };
-    let tip = ["0", TIP, "0"].map(String::from);
-    // On the tip and the crown above it (rays below it pass the tip by,
-    // a fixed share of their distance a step, and run out of steps).
+    let tip = ["0", digits, "0"].map(String::from);
     check_against_the_oracle(&s, &oracle, &tip, [(960, 540), (900, 420), (1040, 470)], 16);
+}
+
+#[test]
+fn a_few_pixels_a_hundred_decades_down() {
+    tip_from_the_side(TIP, 1e-100, 100, 480);
+}
+
+/// The same tip to 330 digits, for a camera 1e-300 from it.
+const TIP_330: &str = "-1.1040895136738123376495053876233447213253266007801241655145324641421063228803809807165982898863020051468971590655799312539692146804308557965106480583880819616391986439221558381455123439747633950789066468590292118061394214405628351921950077401104391392922233895379037673207050320639038098849444570708452792524058273072548646796718";
+
+#[test]
+fn a_few_pixels_three_hundred_decades_down() {
+    // Near the tip an orbit's offset grows 16 times an iteration: 250 of
+    // them carry a point 1e-300 away out to the bailout.
+    tip_from_the_side(TIP_330, 1e-300, 300, 1160);
 }
 
 #[test]
@@ -436,4 +452,34 @@ fn a_target_keyed_with_digits_pans_thirty_decades_down() {
         info.contains("5 frame(s) (0..=4) are finer than f64"),
         "{info}"
     );
+}
+
+/// One frame of the tip from below, `distance` away, at 32×18.
+fn tip_frame(distance: &str) -> String {
+    format!(
+        "(fps: 1, frames: 1, size: (32, 18), scene: (camera: (position: (0.575, -2.4, 0.482), target: (\"0\", \"{TIP_330}\", \"0\"), fov_degrees: 40), fractal: (iterations: Auto), samples_per_pixel: 1), tracks: {{ \"camera.distance\": (keys: [(time: 0, value: {distance})]) }})"
+    )
+}
+
+#[test]
+fn a_frame_three_hundred_decades_down_renders_and_deeper_is_refused() {
+    let dir = Dir::new();
+    dir.write("tip.ron", &tip_frame("1e-300"));
+    let out = dir.ok(&["render", "tip.ron", "--out", "tip", "--stats"]);
+    // The tunnel of terraces fills the frame: every sample hits, and no
+    // estimate overflows into a hit at the camera.
+    let said = stdout(&out) + &crate::util::stderr(&out);
+    assert!(said.contains("576 of 576 samples hit"), "{said}");
+    let image = image::open(dir.path().join("tip/frame_00000.png"))
+        .unwrap()
+        .to_luma8();
+    let (lo, hi) = image
+        .pixels()
+        .fold((255, 0), |(lo, hi), p| (lo.min(p[0]), hi.max(p[0])));
+    assert!(hi - lo > 100, "a flat frame: {lo}..{hi}");
+    dir.write("deeper.ron", &tip_frame("1e-303"));
+    let refused = dir.run(&["info", "deeper.ron"]);
+    assert!(!refused.status.success());
+    let said = crate::util::stderr(&refused);
+    assert!(said.contains("1e-302") && said.contains("camera"), "{said}");
 }

@@ -106,7 +106,14 @@ impl<S: pulp::Simd> Register<S> {
             planes: [infinity; 3],
             live,
             count: points.len(),
-            plus_one: Vector::splat(simd, if fractal.julia.is_none() { 1.0 } else { 0.0 }),
+            plus_one: Vector::splat(
+                simd,
+                if fractal.julia.is_none() {
+                    reference.dr_scale
+                } else {
+                    0.0
+                },
+            ),
             power: Vector::splat(simd, reference.n as Real),
         }
     }

@@ -39,9 +39,9 @@ impl Track {
     fn new(fractal: &Fractal, n: u32, points: &[[Big; 3]], bits: usize) -> Track {
         let escape = fractal.escape_radius::<Real>();
         let z: Vec<_> = points.iter().map(reference::rounded).collect();
-        let steps = z
+        let steps = points
             .iter()
-            .map(|&p| step::Point::new(fractal.formula, p, n))
+            .map(|p| step::Point::new(fractal.formula, p, n))
             .collect();
         let excess = points
             .iter()
@@ -80,7 +80,16 @@ pub struct Reference {
     /// at 0, and z₀ = c is its second point), 0 in Julia mode.
     start: usize,
     n: u32,
+    /// What an orbit's running derivative starts at (1, or `DR_SCALED`
+    /// where the frame is so deep that it would pass f64's range).
+    pub(super) dr_scale: Real,
 }
+
+/// Past this many bits of reference (a pixel below about 2⁻⁷⁰⁰ of the
+/// target) a running derivative reaches 1/pixel ≈ 2⁷⁰⁰ and more on its way
+/// out: orbits carry it times `DR_SCALED`, and estimates take that back.
+const DR_SCALED_BITS: usize = 800;
+const DR_SCALED: Real = 4.909093465297727e-91; // 2⁻³⁰⁰
 
 impl Reference {
     /// The reference for `fractal` at `anchor` (its components in high
@@ -114,6 +123,11 @@ impl Reference {
             critical,
             start,
             n,
+            dr_scale: if bits > DR_SCALED_BITS {
+                DR_SCALED
+            } else {
+                1.0
+            },
         })
     }
 
@@ -179,7 +193,7 @@ impl Reference {
             d: delta,
             z,
             r2: length_squared(z),
-            dr: delta[0].constant(1.0),
+            dr: delta[0].constant(self.dr_scale),
             traps: OrbitTraps {
                 origin: Real::INFINITY,
                 planes: DVec3::splat(Real::INFINITY),
@@ -210,7 +224,11 @@ impl Reference {
         let escape = fractal.escape_radius::<T>();
         // The tracks' excesses are over f64's escape radius; f32's may be lower.
         let exact = escape == fractal.escape_radius::<Real>();
-        let plus_one = T::from_real(if fractal.julia.is_none() { 1.0 } else { 0.0 });
+        let plus_one = T::from_real(if fractal.julia.is_none() {
+            self.dr_scale
+        } else {
+            0.0
+        });
         let nn = T::from_real(self.n as Real);
         let outside = |s: &State<T>| {
             if exact {
@@ -298,6 +316,12 @@ impl Reference {
 }
 
 impl Fractal {
+    /// What this frame's orbits carry their running derivative times
+    /// (`Reference::dr_scale`): 1 but in the deepest frames.
+    pub(in crate::fractal) fn dr_scale(&self) -> Real {
+        self.deep.as_ref().map_or(1.0, |r| r.dr_scale)
+    }
+
     /// The deep frame's reference, where its estimates go through the
     /// perturbed analytic kernel (f64 offsets).
     pub(in crate::fractal) fn perturbed_analytic(&self) -> Option<&Reference> {

@@ -9,6 +9,7 @@
 //! (a′ − a)·Σ a′ⁿ⁻¹⁻ʲ·aʲ, and a product's as δa·b′ + a·δb.
 
 use super::super::{Formula, Triplex};
+use crate::exact::Big;
 use crate::math::{Arith, Number, Real, Vector};
 
 /// What the perturbed step computes with: one number of the kernel's types
@@ -19,6 +20,8 @@ pub(crate) trait Delta: Arith {
     fn constant(self, v: Real) -> Self;
     /// Lane by lane: `then` where `self` > 0, else `otherwise`.
     fn positive_or(self, then: Self, otherwise: Self) -> Self;
+    /// Whether `self` > 0 in every lane.
+    fn all_positive(self) -> bool;
 }
 
 impl<T: Number> Delta for T {
@@ -34,6 +37,10 @@ impl<T: Number> Delta for T {
             otherwise
         }
     }
+    #[inline(always)]
+    fn all_positive(self) -> bool {
+        self.value() > 0.0
+    }
 }
 
 impl<S: pulp::Simd> Delta for Vector<S> {
@@ -46,6 +53,12 @@ impl<S: pulp::Simd> Delta for Vector<S> {
         let simd = self.0;
         let mask = simd.greater_than_f64s(self.1, simd.splat_f64s(0.0));
         Vector(simd, simd.select_f64s(mask, then.1, otherwise.1))
+    }
+    #[inline(always)]
+    fn all_positive(self) -> bool {
+        let simd = self.0;
+        let not = simd.not_m64s(simd.greater_than_f64s(self.1, simd.splat_f64s(0.0)));
+        simd.first_true_m64s(not) >= S::F64_LANES
     }
 }
 
@@ -79,7 +92,34 @@ pub(super) struct Point {
     /// qʲ and uʲ for j = 0..=n (index j).
     pub q_powers: Vec<[Real; 2]>,
     pub u_powers: Vec<[Real; 2]>,
+    /// The equatorial pair and ρ times 2ᵏ (`Far`), for offsets whose
+    /// squares f64 cannot hold.
+    pub far: Far,
 }
+
+/// A reference point's distance from the pole axis, and its equatorial
+/// pair, scaled by 2ᵏ into f64's range: offsets below 2⁻⁵⁰⁰ (past 1e-150)
+/// lose their squares, and a reference by the axis its equatorial pair
+/// (`off_the_axis` puts it 2⁻⁽ᵇⁱᵗˢ⁻³²⁾ of its size away), so the step takes
+/// ρ′ − ρ and u′ − u for them at that scale, where both are whole.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) struct Far {
+    pub scale: Real,
+    pub equator: [Real; 2],
+    pub rho: Real,
+}
+
+/// Below this distance from the pole axis f64's pair loses bits (it
+/// nears the subnormals): u is taken from the exact pair.
+const NEAR_AXIS: Real = 1e-290;
+
+/// Offsets from the pole axis below this (their squares below 2⁻¹⁰⁰⁰)
+/// take the step's scaled form (`Far`).
+const TINY_SQUARED: Real = 9.332636185032189e-302; // 2⁻¹⁰⁰⁰
+
+/// The most a `Far` scales by: 2ᵏ for k ≤ this keeps offsets up to 2⁻⁵⁰⁰
+/// (`TINY_SQUARED`'s root) and their squares within f64's range.
+const MOST_FAR: i32 = 1000;
 
 /// The pole coordinate and the equatorial pair whose angle is the azimuth.
 #[inline(always)]
@@ -111,14 +151,29 @@ fn q_of<T: Copy>(formula: Formula, pole: T, rho: T) -> C<T> {
 }
 
 impl Point {
-    /// The step's data for reference point `z` and power `n`; `None` on the
-    /// pole axis (and at the origin), where u is undefined.
-    pub fn new(formula: Formula, z: Triplex<Real>, n: u32) -> Option<Point> {
-        let (pole, equator) = split(formula, z);
-        let rho = equator[0].hypot(equator[1]);
-        if !(rho > 0.0 && rho.is_finite()) {
+    /// The step's data for reference point `z` (in high precision) and
+    /// power `n`; `None` on the pole axis (and at the origin), where u is
+    /// undefined.
+    pub fn new(formula: Formula, z: &[Big; 3], n: u32) -> Option<Point> {
+        let rounded = z.each_ref().map(|v| v.to_f64().value());
+        let (pole, equator) = split(formula, rounded);
+        let (_, [e1, e2]) = split(formula, z.each_ref());
+        let exact_rho = (e1 * e1 + e2 * e2).sqrt();
+        if exact_rho == Big::ZERO {
             return None;
         }
+        let far = Far::new(e1, e2, &exact_rho);
+        let rho = equator[0].hypot(equator[1]);
+        if !rho.is_finite() {
+            return None;
+        }
+        // Where f64 holds ρ to its last bit u comes from the rounded pair
+        // (as it always has); nearer the axis, from the exact one.
+        let u = if rho >= NEAR_AXIS {
+            [equator[0] / rho, equator[1] / rho]
+        } else {
+            [e1, e2].map(|e| (e / &exact_rho).to_f64().value())
+        };
         let powers = |a: [Real; 2]| {
             let mut out = vec![[1.0, 0.0]];
             for _ in 0..n {
@@ -133,7 +188,8 @@ impl Point {
             equator,
             rho,
             q_powers: powers([q.0, q.1]),
-            u_powers: powers([equator[0] / rho, equator[1] / rho]),
+            u_powers: powers(u),
+            far,
         })
     }
 
@@ -149,19 +205,29 @@ impl Point {
         // The pixel's distance from the pole axis, and its difference.
         let (w1, w2) = (e1 + d1, e2 + d2);
         let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
-        let d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
-        // qⁿ's difference.
-        let d_q = q_of(formula, d_pole, d_rho);
-        let q_pixel = C::constant(like, self.q_powers[1]).add(d_q);
-        let d_qn = d_q.mul(geometric_sum(q_pixel, &self.q_powers[..n]));
+        let squared = d1 * d1 + d2 * d2;
+        let mut d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + squared) / (rho_pixel + rho);
         // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
         let u = C::constant(like, self.u_powers[1]);
         let zero = k(0.0);
         let inverse = k(1.0) / rho_pixel;
-        let d_u = C(
+        let mut d_u = C(
             rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
             rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
         );
+        let usual = squared - k(TINY_SQUARED);
+        if !usual.all_positive() {
+            let (far_rho, far_u) = self.far.differences([d1, d2], u);
+            d_rho = usual.positive_or(d_rho, far_rho);
+            d_u = C(
+                usual.positive_or(d_u.0, far_u.0),
+                usual.positive_or(d_u.1, far_u.1),
+            );
+        }
+        // qⁿ's difference.
+        let d_q = q_of(formula, d_pole, d_rho);
+        let q_pixel = C::constant(like, self.q_powers[1]).add(d_q);
+        let d_qn = d_q.mul(geometric_sum(q_pixel, &self.q_powers[..n]));
         let d_un = d_u.mul(geometric_sum(u.add(d_u), &self.u_powers[..n]));
         let [qc, qs] = self.q_powers[n].map(k);
         let un = C::constant(like, self.u_powers[n]);
@@ -174,6 +240,47 @@ impl Point {
             // [rc·cp, rc·sp, rs]: pole rs, equator rc·u.
             Formula::Asin => join(formula, d_qn.1, times_u(qc, d_qn.0)),
         }
+    }
+}
+
+impl Far {
+    /// The scale that brings `rho` (> 0) near 1, up to 2^`MOST_FAR`, and
+    /// the pair and ρ at that scale.
+    fn new(e1: &Big, e2: &Big, rho: &Big) -> Far {
+        // Where f64 holds ρ, its own log; below, ρ is at least 2⁻¹²⁰⁰ of the
+        // reference's size (`crate::deep::bits`).
+        let plain = rho.to_f64().value();
+        let log2 = if plain >= NEAR_AXIS {
+            plain.log2()
+        } else {
+            (rho.clone() << 1200).to_f64().value().log2() - 1200.0
+        };
+        let k = ((-log2).floor() as i32).clamp(0, MOST_FAR);
+        let at = |v: &Big| (v.clone() << k as isize).to_f64().value();
+        Far {
+            scale: (2.0 as Real).powi(k),
+            equator: [at(e1), at(e2)],
+            rho: at(rho),
+        }
+    }
+
+    /// ρ′ − ρ and u′ − u for the equatorial offset `[d1, d2]` (each lane
+    /// under `TINY`), taken at the scale where they are whole.
+    #[inline(always)]
+    fn differences<T: Delta>(&self, [d1, d2]: [T; 2], u: C<T>) -> (T, C<T>) {
+        let k = |v: Real| d1.constant(v);
+        let (d1, d2) = (d1 * k(self.scale), d2 * k(self.scale));
+        let [e1, e2] = self.equator.map(k);
+        let (w1, w2) = (e1 + d1, e2 + d2);
+        let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
+        let d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + k(self.rho));
+        let inverse = k(1.0) / rho_pixel;
+        let zero = k(0.0);
+        let d_u = C(
+            rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
+            rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
+        );
+        (d_rho * k(1.0 / self.scale), d_u)
     }
 }
 

@@ -415,3 +415,53 @@ mod properties {
         }
     }
 }
+
+/// (Z + δ)ⁿ − Zⁿ by the perturbed step, against the high-precision
+/// difference, for reference points `rho` from the pole axis and offsets
+/// whose squares f64 cannot hold (`step::Far`).
+#[test]
+fn the_step_keeps_its_precision_three_hundred_decades_down_by_the_axis() {
+    let bits = 1400;
+    let power = |formula, z: &[Big; 3], n| {
+        let zero = big(DVec3::ZERO, bits);
+        reference::orbit(formula, n, z.clone(), &zero, 1, 1e300, bits).remove(1)
+    };
+    let mut compared = 0;
+    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+        for n in [3, 8] {
+            for log2_rho in [-1, -100, -600, -1068] {
+                // ρ times the equatorial direction (0.6, 0.8), and pole 1.1.
+                let rho = big_from_f64(1.0, bits) >> (-log2_rho) as isize;
+                let (e1, e2) = (
+                    &rho * big_from_f64(0.6, bits),
+                    &rho * big_from_f64(0.8, bits),
+                );
+                let pole = big_from_f64(1.1, bits);
+                let z = match formula {
+                    Formula::Quilez => [e2, pole, e1],
+                    _ => [e1, e2, pole],
+                };
+                let point = step::Point::new(formula, &z, n).expect("off the axis");
+                for depth in [1e-200, 1e-300] {
+                    for dir in directions(3) {
+                        let delta = (dir * depth).to_array();
+                        let got = point.power_difference(formula, delta);
+                        let moved: [Big; 3] =
+                            [0, 1, 2].map(|i| &z[i] + big_from_f64(delta[i], bits));
+                        let (a, b) = (power(formula, &moved, n), power(formula, &z, n));
+                        let want = [0, 1, 2].map(|i| (&a[i] - &b[i]).to_f64().value());
+                        let size = crate::math::length(DVec3::from_array(want));
+                        let error =
+                            crate::math::length(DVec3::from_array(got) - DVec3::from_array(want));
+                        assert!(
+                            error <= 1e-9 * size,
+                            "{formula:?} n {n} ρ 2^{log2_rho} δ {depth:e}: {got:?} vs {want:?}"
+                        );
+                        compared += 1;
+                    }
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 3 * 2 * 4 * 2 * 3);
+}
