@@ -270,9 +270,8 @@ fn stopped(best: Option<Round>, round: usize, problem: &str, json: bool) -> anyh
 /// How far apart two cameras' targets are, from their digits where a deep
 /// target has them (f64 would lose the difference).
 fn distance(a: &crate::camera::Camera, b: &crate::camera::Camera) -> f64 {
-    crate::exact::difference(
+    crate::math::length(crate::exact::difference(
         (a.target, a.target_digits.as_ref()),
         (b.target, b.target_digits.as_ref()),
-    )
-    .length()
+    ))
 }

@@ -379,14 +379,15 @@ impl Fractal {
                 DeMethod::Analytic => half_r_ln_r_over(r, centre.dr.value()) * self.dr_scale(),
                 DeMethod::Jacobian => {
                     let jacobian = jacobian.expect("computed above for this method");
-                    let mut norm = spectral_norm(jacobian);
-                    if !(norm.is_finite() && norm > 0.0) {
+                    let norm = spectral_norm(jacobian);
+                    if norm.is_finite() && norm > 0.0 {
+                        half_r_ln_r_over(r, norm)
+                    } else {
                         // On the pole axis the dual numbers meet acos'(±1) = ∞. There
                         // the azimuthal stretch is n²·r^(n−1) against the scalar
                         // n·r^(n−1), so bound the norm by n·dr: conservative.
-                        norm = self.power * centre.dr.value() / self.dr_scale();
+                        half_r_ln_r_over(r, self.power * centre.dr.value()) * self.dr_scale()
                     }
-                    half_r_ln_r_over(r, norm)
                 }
                 DeMethod::Potential | DeMethod::SinhPotential | DeMethod::EscapeLength => {
                     // Tetrahedral finite differences; the step is a fraction of the
@@ -415,7 +416,7 @@ impl Fractal {
                         gradient += dir * sample(p + dir * h);
                     }
                     orbits += 4;
-                    let slope = gradient.length() / (4.0 * h);
+                    let slope = crate::math::length(gradient) / (4.0 * h);
                     // Samples that overflowed make the slope infinite and the
                     // distance 0: a false hit. And where the precision's
                     // floor, not the footprint, set the step and the surface

@@ -172,7 +172,7 @@ impl ConeWalk {
         let mut t_start = Real::INFINITY;
         let mut t_end: Real = 0.0;
         for (ray, interval) in run.iter().zip(intervals) {
-            spread.0 = spread.0.max((ray.origin - origin).length());
+            spread.0 = spread.0.max(crate::math::length(ray.origin - origin));
             spread.1 = spread.1.max((ray.dir - dir).length());
             if let Some((enter, exit)) = *interval {
                 t_start = t_start.min(enter);

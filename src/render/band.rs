@@ -62,7 +62,7 @@ impl<'a> FrameSetup<'a> {
             cameras,
             scales: scenes
                 .iter()
-                .map(|s| (s.camera.position - s.camera.target).length())
+                .map(|s| crate::math::length(s.camera.position - s.camera.target))
                 .collect(),
             palettes: scenes
                 .iter()

@@ -171,7 +171,7 @@ fn bundle_of(set: &[(usize, ShadowWalk)]) -> Option<Bundle> {
             .map(|(_, w)| f(w))
             .fold(Real::NEG_INFINITY, Real::max)
     };
-    let radius = most(&|w| (w.from - centre - to_light * along(w)).length());
+    let radius = most(&|w| crate::math::length(w.from - centre - to_light * along(w)));
     let footprint = -most(&|w| -w.footprint);
     if radius.is_nan() || radius > WIDEST * footprint {
         return None;

@@ -85,11 +85,18 @@ pub struct Reference {
     pub(super) dr_scale: Real,
 }
 
-/// Past this many bits of reference (a pixel below about 2⁻⁷⁰⁰ of the
-/// target) a running derivative reaches 1/pixel ≈ 2⁷⁰⁰ and more on its way
-/// out: orbits carry it times `DR_SCALED`, and estimates take that back.
-const DR_SCALED_BITS: usize = 800;
+/// Where a frame's pixel is below 2^this, a running derivative reaches
+/// 1/pixel and more on its way out, near f64's range: orbits carry it
+/// times `DR_SCALED`, and estimates take that back (a power of two, so the
+/// estimates' bits are the same wherever neither passes the range).
+const DR_SCALED_BELOW: Real = -700.0;
 const DR_SCALED: Real = 4.909093465297727e-91; // 2⁻³⁰⁰
+
+/// log₂ of the pixel a reference of `bits` at `anchor` serves: `crate::deep::bits`
+/// keeps 96 bits past the pixel's share of the anchor's size.
+fn pixel_log2(anchor: DVec3, bits: usize) -> Real {
+    anchor.abs().max_element().max(Real::MIN_POSITIVE).log2() + 96.0 - bits as Real
+}
 
 impl Reference {
     /// The reference for `fractal` at `anchor` (its components in high
@@ -123,7 +130,7 @@ impl Reference {
             critical,
             start,
             n,
-            dr_scale: if bits > DR_SCALED_BITS {
+            dr_scale: if pixel_log2(anchor_f64, bits) < DR_SCALED_BELOW {
                 DR_SCALED
             } else {
                 1.0

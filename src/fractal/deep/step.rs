@@ -205,8 +205,7 @@ impl Point {
         // The pixel's distance from the pole axis, and its difference.
         let (w1, w2) = (e1 + d1, e2 + d2);
         let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
-        let squared = d1 * d1 + d2 * d2;
-        let mut d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + squared) / (rho_pixel + rho);
+        let mut d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
         // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
         let u = C::constant(like, self.u_powers[1]);
         let zero = k(0.0);
@@ -215,7 +214,7 @@ impl Point {
             rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
             rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
         );
-        let usual = squared - k(TINY_SQUARED);
+        let usual = d1 * d1 + d2 * d2 - k(TINY_SQUARED);
         if !usual.all_positive() {
             let (far_rho, far_u) = self.far.differences([d1, d2], u);
             d_rho = usual.positive_or(d_rho, far_rho);
