@@ -202,18 +202,9 @@ impl Point {
         let (d_pole, [d1, d2]) = split(formula, delta);
         let [e1, e2] = self.equator.map(k);
         let rho = k(self.rho);
-        // The pixel's distance from the pole axis, and its difference.
-        let (w1, w2) = (e1 + d1, e2 + d2);
-        let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
-        let mut d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
         // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
         let u = C::constant(like, self.u_powers[1]);
-        let zero = k(0.0);
-        let inverse = k(1.0) / rho_pixel;
-        let mut d_u = C(
-            rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
-            rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
-        );
+        let (mut d_rho, mut d_u) = equatorial_differences([e1, e2], rho, [d1, d2], u);
         let usual = d1 * d1 + d2 * d2 - k(TINY_SQUARED);
         if !usual.all_positive() {
             let (far_rho, far_u) = self.far.differences([d1, d2], u);
@@ -264,23 +255,37 @@ impl Far {
     }
 
     /// ρ′ − ρ and u′ − u for the equatorial offset `[d1, d2]` (each lane
-    /// under `TINY`), taken at the scale where they are whole.
+    /// under 2⁻⁵⁰⁰), taken at the scale where they are whole.
     #[inline(always)]
     fn differences<T: Delta>(&self, [d1, d2]: [T; 2], u: C<T>) -> (T, C<T>) {
         let k = |v: Real| d1.constant(v);
-        let (d1, d2) = (d1 * k(self.scale), d2 * k(self.scale));
-        let [e1, e2] = self.equator.map(k);
-        let (w1, w2) = (e1 + d1, e2 + d2);
-        let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
-        let d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + k(self.rho));
-        let inverse = k(1.0) / rho_pixel;
-        let zero = k(0.0);
-        let d_u = C(
-            rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
-            rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
-        );
+        let scaled = [d1 * k(self.scale), d2 * k(self.scale)];
+        let (d_rho, d_u) = equatorial_differences(self.equator.map(k), k(self.rho), scaled, u);
         (d_rho * k(1.0 / self.scale), d_u)
     }
+}
+
+/// ρ′ − ρ and u′ − u for a reference point's equatorial pair `e` (ρ from
+/// the pole axis, unit direction `u`) moved by `d`: (2e·d + d·d)/(ρ′ + ρ)
+/// and (d − u·δρ)/ρ′, each exact in d. u′ − u is 0 where ρ′ is.
+#[inline(always)]
+fn equatorial_differences<T: Delta>(
+    [e1, e2]: [T; 2],
+    rho: T,
+    [d1, d2]: [T; 2],
+    u: C<T>,
+) -> (T, C<T>) {
+    let k = |v: Real| d1.constant(v);
+    // The pixel's distance from the pole axis, and its difference.
+    let (w1, w2) = (e1 + d1, e2 + d2);
+    let rho_pixel = (w1 * w1 + w2 * w2).sqrt();
+    let d_rho = (k(2.0) * (e1 * d1 + e2 * d2) + d1 * d1 + d2 * d2) / (rho_pixel + rho);
+    let (inverse, zero) = (k(1.0) / rho_pixel, k(0.0));
+    let d_u = C(
+        rho_pixel.positive_or((d1 - u.0 * d_rho) * inverse, zero),
+        rho_pixel.positive_or((d2 - u.1 * d_rho) * inverse, zero),
+    );
+    (d_rho, d_u)
 }
 
 /// Σ a′ⁿ⁻¹⁻ʲ·aʲ over j = 0..n given aʲ (`powers`, n of them):
