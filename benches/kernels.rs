@@ -100,7 +100,7 @@ fn power8_complex_squaring<T: mandelreel::math::Number + Sync>(bencher: divan::B
     });
 }
 
-const FORMULAS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+const FORMULAS: [Formula; 4] = Formula::ALL;
 
 /// The analytic estimate in each convention (all take the whole-power path).
 #[divan::bench(args = FORMULAS)]

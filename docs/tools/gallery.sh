@@ -39,3 +39,4 @@ strip() {
 strip zoom 0 40 80 119
 strip julia_morph 0 36 72 108
 strip deep_zoom 0 180 360 539
+strip quaternion 0 24 48 72

@@ -1,5 +1,6 @@
-//! The Mandelbulb itself: the triplex power for each angle convention (whole
-//! powers by complex squaring, without trigonometry), one iteration driver
+//! The fractals: the Mandelbulb's triplex power in each angle convention and
+//! the quaternion's, both one row of `Formula::shape` (whole powers by
+//! complex squaring, without trigonometry), one iteration driver
 //! (bailout, running derivative, orbit traps, Julia mode) generic over f64, f32
 //! and dual numbers, its vector twin that iterates 16 orbits in SIMD registers
 //! bit-identically (`estimate_lanes`), and five distance
@@ -12,12 +13,15 @@
 //! potential-gradient, sinh and escape-length estimators and their costs;
 //! the y-up convention, the power-8 polynomial (a benchmark comparison) and
 //! the four orbit traps: Quilez, "Mandelbulb" ("The algorithm",
-//! "Optimizing", "Coloring").
+//! "Optimizing", "Coloring"). The quaternion Julia sets, and that the same
+//! estimate and scalar derivative hold for them (Hart; Dang, Kauffman and
+//! Sandin, "Hypercomplex Iterations"): Christensen, parts III and V.
 
 use crate::math::{DVec3, Real};
 use serde::{Deserialize, Serialize};
 
-/// Which spherical-coordinate convention defines the triplex power.
+/// The formula iterated: the bulb's triplex power in one of its three
+/// angle conventions, or the quaternion's power.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Formula {
     /// Quilez's y-up form: θ = acos(y/r), φ = atan2(x, z).
@@ -26,6 +30,9 @@ pub enum Formula {
     WhiteNylander,
     /// The asin form Mandelbulber2's "Mandelbulb" formula uses: θ = asin(z/r), φ = atan2(y, x).
     Asin,
+    /// Quaternions x + y·i + z·j + 0·k: zⁿ multiplies the angle
+    /// from the real axis x by n and keeps the imaginary direction.
+    Quaternion,
 }
 
 impl Formula {
@@ -34,6 +41,34 @@ impl Formula {
             Formula::Quilez => "Quilez",
             Formula::WhiteNylander => "WhiteNylander",
             Formula::Asin => "Asin",
+            Formula::Quaternion => "Quaternion",
+        }
+    }
+
+    pub const ALL: [Formula; 4] = [
+        Formula::Quilez,
+        Formula::WhiteNylander,
+        Formula::Asin,
+        Formula::Quaternion,
+    ];
+
+    /// The three conventions of the triplex (bulb) power.
+    pub const BULBS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+
+    /// Where the formula's power puts its axes (`power::Shape`).
+    #[inline(always)]
+    pub(crate) const fn shape(self) -> power::Shape {
+        let (pole, equator, from_equator, turns_azimuth) = match self {
+            Formula::Quilez => (1, [2, 0], false, true),
+            Formula::WhiteNylander => (2, [0, 1], false, true),
+            Formula::Asin => (2, [0, 1], true, true),
+            Formula::Quaternion => (0, [1, 2], false, false),
+        };
+        power::Shape {
+            pole,
+            equator,
+            from_equator,
+            turns_azimuth,
         }
     }
 }

@@ -1,4 +1,4 @@
-//! The triplex power in each angle convention: the trigonometric form, and
+//! Each formula's power, from its `Shape`: the trigonometric form, and
 //! whole powers by complex squaring without trigonometry.
 
 use super::{Formula, Triplex};
@@ -7,6 +7,40 @@ use crate::math::{Arith, Number, Real};
 #[inline(always)]
 pub(super) fn length_squared<T: Arith>(z: Triplex<T>) -> T {
     z[0] * z[0] + z[1] * z[1] + z[2] * z[2]
+}
+
+/// Where a formula's power puts its axes: the spherical power turns a
+/// point's polar angle, from its pole coordinate, by n, and its azimuth,
+/// the angle of its equatorial pair, by n too (the bulb) or not at all
+/// (the quaternion). Every form of the power (scalar, vector, dual
+/// numbers, high precision, perturbed) reads it, so a formula of this
+/// family is one row of `Formula::shape`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Shape {
+    /// The pole coordinate's index.
+    pub(crate) pole: usize,
+    /// The equatorial pair's indices, in the order whose angle is the azimuth.
+    pub(crate) equator: [usize; 2],
+    /// Whether the polar angle is measured from the equator (asin).
+    pub(crate) from_equator: bool,
+    /// Whether zⁿ multiplies the azimuth by n.
+    pub(crate) turns_azimuth: bool,
+}
+
+impl Shape {
+    /// The pole coordinate and the equatorial pair of `z`.
+    #[inline(always)]
+    pub(crate) fn split<T: Copy>(self, z: Triplex<T>) -> (T, [T; 2]) {
+        (z[self.pole], self.equator.map(|k| z[k]))
+    }
+
+    /// The point whose pole coordinate and equatorial pair are given.
+    #[inline(always)]
+    pub(crate) fn join<T: Clone>(self, pole: T, [e1, e2]: [T; 2]) -> Triplex<T> {
+        let mut out = [pole.clone(), pole.clone(), pole];
+        (out[self.equator[0]], out[self.equator[1]]) = (e1, e2);
+        out
+    }
 }
 
 /// Raises `z` (with length `r`, already computed) to the power `n` in the given
@@ -29,25 +63,32 @@ pub(super) fn triplex_power_trig_scaled<T: Number>(
     if rv <= 0.0 || !rv.is_finite() {
         return [T::from_real(0.0); 3];
     }
+    let shape = formula.shape();
     let nn = T::from_real(n);
-    let [x, y, zz] = z;
-    match formula {
-        Formula::Quilez => {
-            let (st, ct) = ((y / r).clamp_unit().acos() * nn).sin_cos();
-            let (sp, cp) = (x.atan2(zz) * nn).sin_cos();
-            [st * sp * rn, ct * rn, st * cp * rn]
+    let (pole, [e1, e2]) = shape.split(z);
+    let sine = (pole / r).clamp_unit();
+    let angle = if shape.from_equator {
+        sine.asin()
+    } else {
+        sine.acos()
+    };
+    let (st, ct) = (angle * nn).sin_cos();
+    let (sp, cp) = if shape.turns_azimuth {
+        (e2.atan2(e1) * nn).sin_cos()
+    } else {
+        // The azimuth's own cosine and sine; none on the pole axis.
+        let rho = (e1 * e1 + e2 * e2).sqrt();
+        match rho.value() > 0.0 {
+            true => (e2 / rho, e1 / rho),
+            false => (T::from_real(0.0), T::from_real(0.0)),
         }
-        Formula::WhiteNylander => {
-            let (st, ct) = ((zz / r).clamp_unit().acos() * nn).sin_cos();
-            let (sp, cp) = (y.atan2(x) * nn).sin_cos();
-            [st * cp * rn, st * sp * rn, ct * rn]
-        }
-        Formula::Asin => {
-            let (st, ct) = ((zz / r).clamp_unit().asin() * nn).sin_cos();
-            let (sp, cp) = (y.atan2(x) * nn).sin_cos();
-            [ct * cp * rn, ct * sp * rn, st * rn]
-        }
-    }
+    };
+    let (along, across) = if shape.from_equator {
+        (st, ct)
+    } else {
+        (ct, st)
+    };
+    shape.join(along * rn, [across * cp * rn, across * sp * rn])
 }
 
 /// `x` to the integer power `n` ≥ 1 by repeated squaring: about 2·log₂(n)
@@ -109,37 +150,33 @@ pub(super) fn triplex_power_int_unchecked<T: Arith>(
     n: u32,
     one: T,
 ) -> (Triplex<T>, T, T) {
-    let [x, y, zz] = z;
-    // The pole coordinate and the equatorial pair whose angle is the azimuth.
-    let (pole, (e1, e2)) = match formula {
-        Formula::Quilez => (y, (zz, x)),
-        Formula::WhiteNylander | Formula::Asin => (zz, (x, y)),
-    };
+    let shape = formula.shape();
+    let (pole, [e1, e2]) = shape.split(z);
     let rho2 = e1 * e1 + e2 * e2;
     let r2 = rho2 + pole * pole;
     let rho = rho2.sqrt();
-    // cos nφ + i sin nφ: (e1 + i·e2)ⁿ = ρⁿ(cos nφ + i sin nφ), divided by ρⁿ.
-    // For even n, ρⁿ comes from ρ² directly, so the division runs beside
-    // the square root instead of after it.
+    // cos mφ + i sin mφ: (e1 + i·e2)ᵐ = ρᵐ(cos mφ + i sin mφ), divided by ρᵐ,
+    // for the azimuth's power m (n, or 1 where it is kept). For even m, ρᵐ
+    // comes from ρ² directly, so the division runs beside the square root
+    // instead of after it.
+    let m = if shape.turns_azimuth { n } else { 1 };
     let mul = |a: T, b: T| a * b;
-    let rho_n = if n.is_multiple_of(2) {
-        powi(rho2, n / 2, mul)
+    let rho_m = if m.is_multiple_of(2) {
+        powi(rho2, m / 2, mul)
     } else {
-        powi(rho, n, mul)
+        powi(rho, m, mul)
     };
-    let inv_rho_n = one / rho_n;
-    let (a, b) = complex_powi(e1, e2, n);
-    let (cp, sp) = (a * inv_rho_n, b * inv_rho_n);
+    let inv_rho_m = one / rho_m;
+    let (a, b) = complex_powi(e1, e2, m);
+    let (cp, sp) = (a * inv_rho_m, b * inv_rho_m);
     // rⁿ(cos nθ + i sin nθ): θ from the pole, (pole + iρ)ⁿ; from the
-    // equator (asin), (ρ + i·pole)ⁿ.
-    let (rc, rs) = match formula {
-        Formula::Asin => complex_powi(rho, pole, n),
-        Formula::Quilez | Formula::WhiteNylander => complex_powi(pole, rho, n),
-    };
-    let out = match formula {
-        Formula::Quilez => [rs * sp, rc, rs * cp],
-        Formula::WhiteNylander => [rs * cp, rs * sp, rc],
-        Formula::Asin => [rc * cp, rc * sp, rs],
+    // equator (asin), (ρ + i·pole)ⁿ. The pole takes the part along it.
+    let out = if shape.from_equator {
+        let (rc, rs) = complex_powi(rho, pole, n);
+        shape.join(rs, [rc * cp, rc * sp])
+    } else {
+        let (rc, rs) = complex_powi(pole, rho, n);
+        shape.join(rc, [rs * cp, rs * sp])
     };
     (out, rho2, r2)
 }

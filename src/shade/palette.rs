@@ -251,9 +251,7 @@ fn smooth_count(iterations: u32, r: Real, [ln_escape, ln_power]: [Real; 2]) -> f
 
 /// The azimuth of `z` about `formula`'s pole axis, in turns from 0 to 1.
 fn azimuth_turns(formula: Formula, z: [Real; 3]) -> f32 {
-    let phi = match formula {
-        Formula::Quilez => z[0].atan2(z[2]),
-        Formula::WhiteNylander | Formula::Asin => z[1].atan2(z[0]),
-    };
+    let (_, [e1, e2]) = formula.shape().split(z);
+    let phi = e2.atan2(e1);
     (phi / std::f64::consts::TAU + 0.5) as f32
 }

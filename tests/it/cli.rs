@@ -345,6 +345,7 @@ fn example_timelines_are_valid() {
         "julia_morph.ron",
         "effects.ron",
         "path_traced.ron",
+        "quaternion.ron",
     ] {
         let path = root.join("timelines").join(name);
         let out = d.ok(&["info", path.to_str().unwrap()]);

@@ -99,6 +99,40 @@ fn deep_hits_agree_with_high_precision_membership() {
     }
 }
 
+/// A point on the surface of the rabbit's quaternion Julia set
+/// (`timelines/quaternion.ron`'s frame 0), `pick --refine` at 1e-20.
+const QUATERNION_TARGET: [&str; 3] = [
+    "0.28187549051015906631152909",
+    "0.19381999594507400873670005",
+    "0.40343175306428212063223989",
+];
+
+#[test]
+fn deep_quaternion_hits_agree_with_the_oracles_hamilton_products() {
+    let [x, y, z] = QUATERNION_TARGET;
+    let text = format!(
+        "(camera: (position: (1.6, 1.4, 2.6), target: (\"{x}\", \"{y}\", \"{z}\"), fov_degrees: 40), fractal: (formula: Quaternion, power: 2, julia: Some((\"-0.123\", \"0.745\", \"0\")), iterations: 125), quality: (over_relaxation: 1.0, max_steps: 1000))"
+    );
+    let mut s: Scene = ron::from_str(&text).unwrap();
+    let away = (DVec3::new(1.6, 1.4, 2.6) - s.camera.target).normalize();
+    s.camera.offset = Some(away * 1e-20);
+    let oracle = OracleFractal {
+        formula: Formula::Quaternion,
+        power: 2,
+        iterations: 125,
+        julia: Some(["-0.123", "0.745", "0"].map(String::from)),
+        ..oracle()
+    };
+    let target = QUATERNION_TARGET.map(String::from);
+    check_against_the_oracle(
+        &s,
+        &oracle,
+        &target,
+        [(960, 540), (700, 300), (1300, 800)],
+        32,
+    );
+}
+
 /// The bottom tip of the power-8 bulb (`deep_zoom.ron`'s target), c = −b
 /// with b⁷ = 2, to 120 digits.
 const TIP: &str = "-1.10408951367381233764950538762334472132532660078012416551453246414210632288038098071659828988630200514689715906557993125397";

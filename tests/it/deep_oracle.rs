@@ -111,8 +111,41 @@ fn real_pow(x: &Hp, n: u32, one: &Hp) -> Hp {
     result
 }
 
+/// The Hamilton product of quaternions (real part first).
+fn hamilton(a: &[Hp; 4], b: &[Hp; 4]) -> [Hp; 4] {
+    let [a0, a1, a2, a3] = a;
+    let [b0, b1, b2, b3] = b;
+    [
+        a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3,
+        a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2,
+        a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1,
+        a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0,
+    ]
+}
+
+/// zⁿ for the quaternion x + y·i + z·j + 0·k, by n − 1 Hamilton products:
+/// its k part stays 0, which the oracle checks.
+fn quaternion_power(z: &[Hp; 3], n: u32, bits: usize) -> [Hp; 3] {
+    let q = [z[0].clone(), z[1].clone(), z[2].clone(), hp_f64(0.0, bits)];
+    let mut out = q.clone();
+    for _ in 1..n {
+        out = hamilton(&out, &q);
+    }
+    let [a, b, c, d] = out;
+    // Exactly 0 but for rounding: i·j products cancel.
+    let (k2, size2) = (&d * &d, &a * &a + &b * &b + &c * &c);
+    assert!(
+        k2 <= size2 * hp_f64(1e-60, bits),
+        "the quaternion left the slice k = 0: {d:?} against {z:?}"
+    );
+    [a, b, c]
+}
+
 /// zⁿ in `formula`'s convention, without trigonometry.
 fn hp_power(formula: Formula, z: &[Hp; 3], n: u32, bits: usize) -> [Hp; 3] {
+    if formula == Formula::Quaternion {
+        return quaternion_power(z, n, bits);
+    }
     let [x, y, w] = z;
     let zero = hp_f64(0.0, bits);
     let one = hp_f64(1.0, bits);
@@ -122,6 +155,7 @@ fn hp_power(formula: Formula, z: &[Hp; 3], n: u32, bits: usize) -> [Hp; 3] {
     let (pole, ec, es) = match formula {
         Formula::Quilez => (y, w, x),
         Formula::WhiteNylander | Formula::Asin => (w, x, y),
+        Formula::Quaternion => unreachable!("taken by quaternion_power"),
     };
     let rho2 = ec * ec + es * es;
     let r2 = &rho2 + pole * pole;
@@ -140,6 +174,7 @@ fn hp_power(formula: Formula, z: &[Hp; 3], n: u32, bits: usize) -> [Hp; 3] {
         Formula::Quilez | Formula::WhiteNylander => (pole / &r, &rho / &r),
         // θ = asin(pole/r) in [−π/2, π/2]: cos θ = ρ/r ≥ 0.
         Formula::Asin => (&rho / &r, pole / &r),
+        Formula::Quaternion => unreachable!("taken by quaternion_power"),
     };
     let (cnt, snt) = complex_pow(&cos_theta, &sin_theta, n);
     let (cnp, snp) = complex_pow(&cos_phi, &sin_phi, n);
@@ -148,6 +183,7 @@ fn hp_power(formula: Formula, z: &[Hp; 3], n: u32, bits: usize) -> [Hp; 3] {
         Formula::Quilez => [&snt * &snp * &rn, &cnt * &rn, &snt * &cnp * &rn],
         Formula::WhiteNylander => [&snt * &cnp * &rn, &snt * &snp * &rn, &cnt * &rn],
         Formula::Asin => [&cnt * &cnp * &rn, &cnt * &snp * &rn, &snt * &rn],
+        Formula::Quaternion => unreachable!("taken by quaternion_power"),
     }
 }
 
@@ -295,7 +331,7 @@ mod tests {
     use mandelreel::fractal::{triplex_power_trig, Fractal};
     use mandelreel::march::{MarchSettings, Ray};
 
-    const FORMULAS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+    const FORMULAS: [Formula; 4] = Formula::ALL;
 
     /// xorshift64*: uniform in [−1, 1).
     struct Rng(u64);
@@ -360,7 +396,11 @@ mod tests {
                     })
                     .collect();
                 // The pole axis, both ways, where φ = 0.
-                let pole = if formula == Formula::Quilez { 1 } else { 2 };
+                let pole = match formula {
+                    Formula::Quilez => 1,
+                    Formula::Quaternion => 0,
+                    Formula::WhiteNylander | Formula::Asin => 2,
+                };
                 for s in [0.7, -0.7] {
                     let mut p = [0.0; 3];
                     p[pole] = s;

@@ -588,6 +588,40 @@ fn bad_views_are_refused_with_the_reason() {
 }
 
 #[test]
+fn the_explorer_shows_the_quaternion_as_render_writes_it() {
+    let d = Dir::new();
+    let text = std::fs::read_to_string(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/timelines/quaternion.ron"
+    ))
+    .unwrap();
+    d.write("q.ron", &text);
+    let s = explore(&d, "q.ron");
+    let view = json!({"frame": 30, "size": "48x27", "samples": 1});
+    let shown = s
+        .post("/api/render", json!({"view": view, "stage": "final"}))
+        .expect(200);
+    d.ok(&[
+        "render",
+        "q.ron",
+        "--frames",
+        "30",
+        "--size",
+        "48x27",
+        "--samples",
+        "1",
+        "--out",
+        "o",
+        "-q",
+    ]);
+    assert!(pixels(&shown.body) == pixels(&d.bytes("o/frame_00030.png")));
+    let pick = json!({"view": view, "x": 24, "y": 13});
+    let report = s.post("/api/pick", pick).expect(200).json();
+    assert_eq!(report["hit"], true, "{report}");
+    assert_eq!(report["fractal"]["formula"], "Quaternion", "{report}");
+}
+
+#[test]
 fn a_pick_at_the_centre_of_the_zoom_finds_its_target() {
     let d = Dir::new();
     d.write("zoom.ron", &zoom_ron());

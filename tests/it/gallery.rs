@@ -31,8 +31,8 @@ fn the_gallery_script_renders_times_and_strips_every_example() {
         .lines()
         .filter(|l| l.starts_with("| ") && !l.starts_with("| film"))
         .collect();
-    assert_eq!(rows.len(), 12, "{table}");
-    for film in ["zoom", "julia_morph", "deep_zoom"] {
+    assert_eq!(rows.len(), 16, "{table}");
+    for film in ["zoom", "julia_morph", "deep_zoom", "quaternion"] {
         let strip = image::open(d.path().join(format!("docs/{film}_strip.png"))).expect("a strip");
         // Four frames of 32x18 side by side, each shown 640 wide.
         assert_eq!(strip.height(), 360, "{film}");

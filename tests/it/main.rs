@@ -22,6 +22,7 @@ mod names;
 mod palette;
 mod projections;
 mod quality;
+mod quaternion;
 mod recipes;
 mod resume;
 mod sampling;

@@ -374,10 +374,7 @@ impl Fractal {
 /// (`crate::deep::bits` keeps 96 bits past the pixel), so points keep their
 /// offsets from the target.
 fn off_the_axis(formula: Formula, mut anchor: [Big; 3], bits: usize) -> [Big; 3] {
-    let equator = match formula {
-        Formula::Quilez => [2, 0],
-        Formula::WhiteNylander | Formula::Asin => [0, 1],
-    };
+    let equator = formula.shape().equator;
     let zero = big_from_f64(0.0, bits);
     if equator.iter().all(|&k| anchor[k] == zero) {
         let size = anchor

@@ -11,29 +11,25 @@ use crate::math::Real;
 fn power(formula: Formula, z: &[Big; 3], n: u32, bits: usize) -> [Big; 3] {
     let zero = || big_from_f64(0.0, bits);
     let one = || big_from_f64(1.0, bits);
-    let [x, y, zz] = z;
-    let (pole, e1, e2) = match formula {
-        Formula::Quilez => (y, zz, x),
-        Formula::WhiteNylander | Formula::Asin => (zz, x, y),
-    };
+    let shape = formula.shape();
+    let (pole, [e1, e2]) = shape.split(z.each_ref());
     let rho2 = e1 * e1 + e2 * e2;
+    let m = if shape.turns_azimuth { n } else { 1 };
     let (cp, sp, rho) = if rho2 == zero() {
         (one(), zero(), zero())
     } else {
         let rho = rho2.sqrt();
-        let (a, b) = complex_power(e1, e2, n);
-        let rho_n = power_of(&rho, n);
-        (a / &rho_n, b / &rho_n, rho)
+        let (a, b) = complex_power(e1, e2, m);
+        let rho_m = power_of(&rho, m);
+        (a / &rho_m, b / &rho_m, rho)
     };
-    let (rc, rs) = match formula {
-        Formula::Asin => complex_power(&rho, pole, n),
-        Formula::Quilez | Formula::WhiteNylander => complex_power(pole, &rho, n),
+    let (along, across) = if shape.from_equator {
+        let (rc, rs) = complex_power(&rho, pole, n);
+        (rs, rc)
+    } else {
+        complex_power(pole, &rho, n)
     };
-    match formula {
-        Formula::Quilez => [&rs * &sp, rc, rs * cp],
-        Formula::WhiteNylander => [&rs * &cp, rs * sp, rc],
-        Formula::Asin => [&rc * &cp, rc * sp, rs],
-    }
+    shape.join(along, [&across * &cp, across * sp])
 }
 
 fn power_of(x: &Big, n: u32) -> Big {
@@ -102,7 +98,7 @@ mod tests {
 
     #[test]
     fn the_high_precision_power_is_the_trigonometric_one() {
-        for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+        for formula in Formula::ALL {
             for n in [2, 3, 8] {
                 for z in [
                     [0.3, -0.7, 0.4],

@@ -124,29 +124,16 @@ const MOST_FAR: i32 = 1000;
 /// The pole coordinate and the equatorial pair whose angle is the azimuth.
 #[inline(always)]
 pub(super) fn split<T: Copy>(formula: Formula, z: Triplex<T>) -> (T, [T; 2]) {
-    let [x, y, zz] = z;
-    match formula {
-        Formula::Quilez => (y, [zz, x]),
-        Formula::WhiteNylander | Formula::Asin => (zz, [x, y]),
-    }
-}
-
-/// The point whose pole coordinate and equatorial pair are given.
-#[inline(always)]
-fn join<T: Copy>(formula: Formula, pole: T, [e1, e2]: [T; 2]) -> Triplex<T> {
-    match formula {
-        Formula::Quilez => [e2, pole, e1],
-        Formula::WhiteNylander | Formula::Asin => [e1, e2, pole],
-    }
+    formula.shape().split(z)
 }
 
 /// q from the pole coordinate and ρ: the complex number whose argument is
 /// the polar angle in the formula's convention.
 #[inline(always)]
 fn q_of<T: Copy>(formula: Formula, pole: T, rho: T) -> C<T> {
-    match formula {
-        Formula::Asin => C(rho, pole),
-        Formula::Quilez | Formula::WhiteNylander => C(pole, rho),
+    match formula.shape().from_equator {
+        true => C(rho, pole),
+        false => C(pole, rho),
     }
 }
 
@@ -174,7 +161,7 @@ impl Point {
         } else {
             [e1, e2].map(|e| (e / &exact_rho).to_f64().value())
         };
-        let powers = |a: [Real; 2]| {
+        let powers = |a: [Real; 2], n: u32| {
             let mut out = vec![[1.0, 0.0]];
             for _ in 0..n {
                 let p = out[out.len() - 1];
@@ -187,8 +174,9 @@ impl Point {
             pole,
             equator,
             rho,
-            q_powers: powers([q.0, q.1]),
-            u_powers: powers(u),
+            q_powers: powers([q.0, q.1], n),
+            // The azimuth turns n times, or not at all (`Shape`).
+            u_powers: powers(u, if formula.shape().turns_azimuth { n } else { 1 }),
             far,
         })
     }
@@ -196,7 +184,7 @@ impl Point {
     /// (Z + δ)ⁿ − Zⁿ for this reference point Z.
     #[inline(always)]
     pub fn power_difference<T: Delta>(&self, formula: Formula, delta: Triplex<T>) -> Triplex<T> {
-        let n = self.q_powers.len() - 1;
+        let (n, m) = (self.q_powers.len() - 1, self.u_powers.len() - 1);
         let like = delta[0];
         let k = |v: Real| like.constant(v);
         let (d_pole, [d1, d2]) = split(formula, delta);
@@ -218,17 +206,17 @@ impl Point {
         let d_q = q_of(formula, d_pole, d_rho);
         let q_pixel = C::constant(like, self.q_powers[1]).add(d_q);
         let d_qn = d_q.mul(geometric_sum(q_pixel, &self.q_powers[..n]));
-        let d_un = d_u.mul(geometric_sum(u.add(d_u), &self.u_powers[..n]));
+        let d_un = d_u.mul(geometric_sum(u.add(d_u), &self.u_powers[..m]));
         let [qc, qs] = self.q_powers[n].map(k);
-        let un = C::constant(like, self.u_powers[n]);
+        let un = C::constant(like, self.u_powers[m]);
         let un_pixel = un.add(d_un);
         // (radial part) × (azimuthal part), differenced as δa·b′ + a·δb.
         let times_u = |a: T, d_a: T| [d_a * un_pixel.0 + a * d_un.0, d_a * un_pixel.1 + a * d_un.1];
-        match formula {
-            // [rs·sp, rc, rs·cp] and [rs·cp, rs·sp, rc]: pole rc, equator rs·u.
-            Formula::Quilez | Formula::WhiteNylander => join(formula, d_qn.0, times_u(qs, d_qn.1)),
-            // [rc·cp, rc·sp, rs]: pole rs, equator rc·u.
-            Formula::Asin => join(formula, d_qn.1, times_u(qc, d_qn.0)),
+        // Along the pole rc and across it rs·uᵐ, or the other way round
+        // from the equator (asin).
+        match formula.shape().from_equator {
+            false => formula.shape().join(d_qn.0, times_u(qs, d_qn.1)),
+            true => formula.shape().join(d_qn.1, times_u(qc, d_qn.0)),
         }
     }
 }

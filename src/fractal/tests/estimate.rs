@@ -4,7 +4,7 @@ use super::*;
 
 #[test]
 fn origin_is_inside_the_mandelbrot_bulb() {
-    for f in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for f in Formula::ALL {
         let e = bulb(f).estimate(DVec3::ZERO, 0.0);
         assert!(!e.escaped);
         assert_eq!(e.distance, 0.0);
@@ -17,7 +17,7 @@ fn distance_outside_is_positive_finite_and_a_lower_bound() {
     // R, the distance to the origin, which is inside. (Far away, beyond the
     // bounding sphere the marcher never leaves, the scalar estimate grows
     // like ½·R·ln R and is no longer a bound; there it must only stay finite.)
-    for f in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for f in Formula::ALL {
         let far = bulb(f).estimate(DVec3::new(0.0, 10.0, 0.0), 0.0);
         assert!(far.distance.is_finite() && far.distance > 0.0);
         for &radius in &[1.3, 2.0, 3.0] {

@@ -33,7 +33,7 @@ fn bulb(formula: Formula) -> Fractal {
 /// its own loop, and 3) and a fractional one.
 fn variants() -> Vec<Fractal> {
     let mut fractals = vec![];
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for formula in Formula::ALL {
         for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
             for power in [8.0, 3.0, 7.5] {
                 fractals.push(Fractal {

@@ -31,7 +31,7 @@ fn power_two_is_complex_squaring_on_each_conventions_meridian() {
 #[test]
 fn power_scales_length_by_r_to_the_n() {
     let z = DVec3::new(0.4, 0.5, -0.6);
-    for f in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for f in Formula::ALL {
         let w = power(f, z, 8.0);
         assert!((w.length() - z.length().powi(8)).abs() < 1e-12);
     }
@@ -70,7 +70,7 @@ fn asin_form_at_a_general_point() {
 
 #[test]
 fn whole_powers_match_the_trigonometric_form_in_every_convention() {
-    let formulas = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+    let formulas = Formula::ALL;
     let (mut compared, mut polynomial) = (0, 0);
     for (i, p) in points(1500, 0.05..3.0, 11).into_iter().enumerate() {
         let z = [p.x, p.y, p.z];
@@ -130,12 +130,8 @@ fn power8_on_the_pole_axis_falls_back_to_the_exact_value() {
         assert!((w[1] - Real::powi(y, 8)).abs() < 1e-15, "{w:?}");
     }
     assert!(power8_polynomial([0.0, 0.5, 0.0]).is_none());
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
-        let pole: Triplex<Real> = if formula == Formula::Quilez {
-            [0.0, 0.5, 0.0]
-        } else {
-            [0.0, 0.0, 0.5]
-        };
+    for formula in Formula::ALL {
+        let pole: Triplex<Real> = formula.shape().join(0.5, [0.0, 0.0]);
         assert!(triplex_power_int(formula, pole, 8).is_none(), "{formula:?}");
         // The pole itself takes the trigonometric form, finite there.
         let w = triplex_power(formula, pole, 0.5, 8.0);

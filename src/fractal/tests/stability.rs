@@ -5,7 +5,7 @@ use super::*;
 
 fn every_variant() -> Vec<Fractal> {
     let mut v = Vec::new();
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for formula in Formula::ALL {
         for de in DeMethod::ALL {
             for precision in [Precision::F64, Precision::F32] {
                 for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
@@ -57,7 +57,7 @@ fn pole_axis_points_give_the_trig_value_without_nan() {
     let k3 = x * x + z * z;
     let k2 = 1.0 / (k3 * k3 * k3 * k3 * k3 * k3 * k3).sqrt();
     assert!((64.0 * x * y * z * k2).is_nan());
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for formula in Formula::ALL {
         for axis in [
             DVec3::X,
             DVec3::Y,
@@ -82,11 +82,10 @@ fn pole_axis_points_give_the_trig_value_without_nan() {
     // Beside each convention's pole axis, inside the hand-over band
     // (1e-7) and just outside it where complex squaring runs (1e-5), the
     // result still agrees with the trigonometric form.
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
-        let (pole, across) = match formula {
-            Formula::Quilez => (DVec3::Y, DVec3::new(0.6, 0.0, 0.8)),
-            _ => (DVec3::Z, DVec3::new(0.6, 0.8, 0.0)),
-        };
+    for formula in Formula::ALL {
+        let shape = formula.shape();
+        let pole = DVec3::from_array(shape.join(1.0, [0.0, 0.0]));
+        let across = DVec3::from_array(shape.join(0.0, [0.6, 0.8]));
         for offset in [1e-7, 1e-5] {
             for radius in [0.3, 1.0, 1.9] {
                 let p = (pole + across * offset) * radius;

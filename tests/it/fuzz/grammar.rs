@@ -157,7 +157,7 @@ const CAMERA: &[Field] = &[
 const FRACTAL: &[Field] = &[
     field(
         "formula",
-        Kind::Word(&["Quilez", "WhiteNylander", "Asin"]),
+        Kind::Word(&["Quilez", "WhiteNylander", "Asin", "Quaternion"]),
         30,
     ),
     field("power", Kind::Real(2.0, 12.0), 50),

@@ -2,7 +2,7 @@ use super::*;
 use crate::fractal::Formula;
 use std::sync::Arc;
 
-const FORMULAS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
+const FORMULAS: [Formula; 4] = Formula::ALL;
 
 fn fractals() -> Vec<Fractal> {
     let mut all = Vec::new();
@@ -16,8 +16,13 @@ fn fractals() -> Vec<Fractal> {
             });
         }
     }
-    // Powers that are not 8: Horner's rule (3) and the product form (4).
-    for (power, formula) in [(3.0, Formula::Quilez), (4.0, Formula::Asin)] {
+    // Powers that are not 8: Horner's rule (3), the product form (4) and
+    // the quaternion's classic square.
+    for (power, formula) in [
+        (3.0, Formula::Quilez),
+        (4.0, Formula::Asin),
+        (2.0, Formula::Quaternion),
+    ] {
         all.push(Fractal {
             formula,
             power,
@@ -308,7 +313,7 @@ fn lanes_are_bit_identical_to_the_scalar_orbit() {
             assert_eq!(lane, fractal.estimate(*p, 1e-12));
         }
     }
-    assert_eq!(compared, 8 * 48);
+    assert_eq!(compared, fractals().len() * 48);
 }
 
 #[test]
@@ -427,7 +432,7 @@ fn the_step_keeps_its_precision_three_hundred_decades_down_by_the_axis() {
         reference::orbit(formula, n, z.clone(), &zero, 1, 1e300, bits).remove(1)
     };
     let mut compared = 0;
-    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Asin] {
+    for formula in Formula::ALL {
         for n in [3, 8] {
             for log2_rho in [-1, -100, -600, -1068] {
                 // ρ times the equatorial direction (0.6, 0.8), and pole 1.1.
@@ -437,10 +442,7 @@ fn the_step_keeps_its_precision_three_hundred_decades_down_by_the_axis() {
                     &rho * big_from_f64(0.8, bits),
                 );
                 let pole = big_from_f64(1.1, bits);
-                let z = match formula {
-                    Formula::Quilez => [e2, pole, e1],
-                    _ => [e1, e2, pole],
-                };
+                let z = formula.shape().join(pole, [e1, e2]);
                 let point = step::Point::new(formula, &z, n).expect("off the axis");
                 for depth in [1e-200, 1e-300] {
                     for dir in directions(3) {
@@ -463,5 +465,5 @@ fn the_step_keeps_its_precision_three_hundred_decades_down_by_the_axis() {
             }
         }
     }
-    assert_eq!(compared, 3 * 2 * 4 * 2 * 3);
+    assert_eq!(compared, Formula::ALL.len() * 2 * 4 * 2 * 3);
 }
