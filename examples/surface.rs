@@ -101,6 +101,13 @@ fn main() {
             frame,
         );
     }
+    for frame in [0, 48] {
+        measure(
+            &format!("quaternion {frame}"),
+            "timelines/quaternion.ron",
+            frame,
+        );
+    }
     for example in ["effects", "path_traced", "dof_motion_blur"] {
         measure(example, &format!("timelines/{example}.ron"), 0);
     }
