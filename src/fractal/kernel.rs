@@ -271,8 +271,9 @@ pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
         .take(pairs)
         .enumerate()
     {
-        // For power 8, one copy of the loop per convention, so those loops
-        // have no branch on either and unroll; other powers share one copy.
+        // One copy of the loop per formula, with its shape a constant, and
+        // for each one's classic power (the bulb's 8, the quaternion's 2)
+        // one whose powers unroll.
         let f = fractal;
         let (a, b) = match (f.formula, n) {
             (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez),
@@ -280,7 +281,13 @@ pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
             (Formula::WhiteNylander, 8) => {
                 orbit_registers(simd, f, points, 8, Formula::WhiteNylander)
             }
-            (formula, n) => orbit_registers(simd, f, points, n, formula),
+            (Formula::Quaternion, 2) => orbit_registers(simd, f, points, 2, Formula::Quaternion),
+            (Formula::Quilez, n) => orbit_registers(simd, f, points, n, Formula::Quilez),
+            (Formula::Asin, n) => orbit_registers(simd, f, points, n, Formula::Asin),
+            (Formula::WhiteNylander, n) => {
+                orbit_registers(simd, f, points, n, Formula::WhiteNylander)
+            }
+            (Formula::Quaternion, n) => orbit_registers(simd, f, points, n, Formula::Quaternion),
         };
         let (first, second) = out.split_at_mut(lanes);
         Out::write(&a, f, &points[..lanes], first);
@@ -427,8 +434,9 @@ impl<S: pulp::Simd> Register<S> {
         let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n, one);
         // `triplex_power_int`'s test, lane by lane.
         let finite = |v: Vector<S>| simd.less_than_f64s(simd.abs_f64s(v.1), infinity.1);
+        let margin = self.splat(formula.shape().axis_margin());
         let usable = simd.and_m64s(
-            simd.greater_than_f64s(rho2.1, (self.splat(1e-12) * power_r2).1),
+            simd.greater_than_f64s(rho2.1, (margin * power_r2).1),
             simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
         );
         let near_axis = simd.and_m64s(running, simd.not_m64s(usable));

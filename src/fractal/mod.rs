@@ -45,15 +45,13 @@ impl Formula {
         }
     }
 
+    /// Every formula: what tests and sweeps run over.
     pub const ALL: [Formula; 4] = [
         Formula::Quilez,
         Formula::WhiteNylander,
         Formula::Asin,
         Formula::Quaternion,
     ];
-
-    /// The three conventions of the triplex (bulb) power.
-    pub const BULBS: [Formula; 3] = [Formula::Quilez, Formula::WhiteNylander, Formula::Asin];
 
     /// Where the formula's power puts its axes (`power::Shape`).
     #[inline(always)]

@@ -34,6 +34,19 @@ impl Shape {
         (z[self.pole], self.equator.map(|k| z[k]))
     }
 
+    /// How near the pole axis, as a share of r², the whole power hands
+    /// over to the trigonometric form: the bulb's azimuth is undefined on
+    /// the axis and loses bits beside it; the quaternion's, kept as the
+    /// equatorial pair over ρ, stays exact until ρ² is 0.
+    #[inline(always)]
+    pub(crate) const fn axis_margin(self) -> Real {
+        if self.turns_azimuth {
+            1e-12
+        } else {
+            0.0
+        }
+    }
+
     /// The point whose pole coordinate and equatorial pair are given.
     #[inline(always)]
     pub(crate) fn join<T: Clone>(self, pole: T, [e1, e2]: [T; 2]) -> Triplex<T> {
@@ -66,11 +79,15 @@ pub(super) fn triplex_power_trig_scaled<T: Number>(
     let shape = formula.shape();
     let nn = T::from_real(n);
     let (pole, [e1, e2]) = shape.split(z);
-    let sine = (pole / r).clamp_unit();
+    let ratio = (pole / r).clamp_unit();
+    // The quaternion's angle by atan2: acos loses it near the axis, where
+    // its whole power stays exact (`Shape::axis_margin`).
     let angle = if shape.from_equator {
-        sine.asin()
+        ratio.asin()
+    } else if shape.turns_azimuth {
+        ratio.acos()
     } else {
-        sine.acos()
+        (e1 * e1 + e2 * e2).sqrt().atan2(pole)
     };
     let (st, ct) = (angle * nn).sin_cos();
     let (sp, cp) = if shape.turns_azimuth {
@@ -121,21 +138,22 @@ pub(super) fn complex_powi<T: Arith>(re: T, im: T, n: u32) -> (T, T) {
 }
 
 /// The integer power `n` of a point whose exponent is a whole number, with no
-/// trigonometry: the spherical power multiplies both angles by n, and an angle
-/// times n is the argument of a complex number to the n-th power (de Moivre).
-/// The polar angle comes from (pole, ρ) as one complex number, the azimuth
-/// from the unit vector of the equatorial pair as another, where ρ is the
-/// distance from the pole axis; multiplying them out gives the three
-/// conventions of Quilez's "Mandelbulb" with the trigonometric form's exact result. For
-/// n = 8 that is three complex squarings each, cheaper than Quilez's
-/// expanded polynomial, which this replaces. Returns `None` within a relative
-/// 1e-6 of the pole axis, where the azimuth is undefined; the caller then
-/// uses the trigonometric form, which is exact there.
+/// trigonometry: the spherical power multiplies the polar angle by n (and
+/// the bulb's azimuth too), and an angle times n is the argument of a
+/// complex number to the n-th power (de Moivre). The polar angle comes from
+/// (pole, ρ) as one complex number, the azimuth from the unit vector of the
+/// equatorial pair as another, where ρ is the distance from the pole axis;
+/// multiplying them out gives each formula's result (`Shape`). For the
+/// bulb's n = 8 that is three complex squarings each, cheaper than Quilez's
+/// expanded polynomial, which this replaces. Returns `None` within
+/// `Shape::axis_margin` of the pole axis; the caller then uses the
+/// trigonometric form, which is exact there.
 #[inline(always)]
 pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> Option<Triplex<T>> {
     let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n, T::from_real(1.0));
-    // ρ² > 1e-12·r² also fails for an infinite or NaN r².
-    let usable = rho2.value() > 1e-12 * r2.value() && out.iter().all(|v| v.value().is_finite());
+    // ρ² > margin·r² also fails for an infinite or NaN r².
+    let margin = formula.shape().axis_margin();
+    let usable = rho2.value() > margin * r2.value() && out.iter().all(|v| v.value().is_finite());
     usable.then_some(out)
 }
 

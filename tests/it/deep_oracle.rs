@@ -428,8 +428,62 @@ mod tests {
         let a = power_f64(Formula::Asin, z, 8, 128);
         assert!((0..3).any(|i| (q[i] - w[i]).abs() > 1e-3));
         assert!((0..3).any(|i| (a[i] - w[i]).abs() > 1e-3));
+        let h = power_f64(Formula::Quaternion, z, 8, 128);
+        assert!((0..3).any(|i| (h[i] - q[i]).abs() > 1e-3));
         // The origin maps to the origin.
         assert_eq!(power_f64(Formula::Asin, [0.0; 3], 8, 128), [0.0; 3]);
+    }
+
+    /// Beside the quaternion's real axis its whole power keeps every
+    /// component to f64's precision, as the Hamilton products do, where an
+    /// angle by acos would lose the imaginary part.
+    #[test]
+    fn the_quaternion_power_beside_its_real_axis_matches_hamilton_products() {
+        use mandelreel::fractal::triplex_power_int;
+        for off in [1e-5, 1e-7, 1e-9, 1e-12, 1e-30] {
+            for n in [2u32, 3, 8] {
+                for z in [[0.5, 0.5 * off, 0.0], [-1.3, 0.6 * off, -0.8 * off]] {
+                    let want = power_f64(Formula::Quaternion, z, n, 256);
+                    let got = triplex_power_int(Formula::Quaternion, z, n).expect("off the axis");
+                    for i in 0..3 {
+                        let error = (got[i] - want[i]).abs();
+                        assert!(
+                            error <= 1e-14 * want[i].abs(),
+                            "n {n} at {z:?}: {got:?} against {want:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    /// Mandelbrot mode beside the real axis: the orbit of x + iε escapes
+    /// when the complex one does (the real axis holds the Mandelbrot set's
+    /// own cut), however small ε is.
+    #[test]
+    fn the_quaternion_mandelbrot_set_beside_its_real_axis_is_the_complex_one() {
+        let f = Fractal {
+            formula: Formula::Quaternion,
+            power: 2.0,
+            iterations: 200,
+            bailout: 4.0,
+            ..Default::default()
+        };
+        for off in [1e-6, 1e-8, 1e-9, 1e-12] {
+            let (x, y) = (-1.9, off);
+            let (mut a, mut b, mut escaped) = (x, y, 0);
+            for k in 1..=200 {
+                (a, b) = (a * a - b * b + x, 2.0 * a * b + y);
+                if a * a + b * b > 16.0 {
+                    escaped = k;
+                    break;
+                }
+            }
+            assert!(escaped > 0, "the complex orbit of {x} + {y}i stays");
+            let e = f.estimate(glam::DVec3::new(x, y, 0.0), 1e-3);
+            assert!(e.escaped, "{x} + {y}i: the quaternion orbit stays");
+            assert_eq!(e.iterations, escaped, "{x} + {y}i");
+        }
     }
 
     /// Decimal input: a point given as a long decimal equals its f64 part

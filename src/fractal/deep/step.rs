@@ -3,8 +3,8 @@
 //! powers in f64 would keep nothing of δ once it is below 2⁻⁵²·|Z|.
 //!
 //! The whole power is a product of two complex powers (`power.rs`): qⁿ with
-//! q = pole + iρ (or ρ + i·pole for the asin form) and uⁿ with u the unit
-//! equatorial direction. Each difference is taken exactly in δ: ρ′ − ρ as
+//! q = pole + iρ (or ρ + i·pole for the asin form) and uᵐ with u the unit
+//! equatorial direction (m = n for the bulb, 1 for the quaternion). Each difference is taken exactly in δ: ρ′ − ρ as
 //! (ρ′² − ρ²)/(ρ′ + ρ), u′ − u as (δw − u·δρ)/ρ′, a′ⁿ − aⁿ as
 //! (a′ − a)·Σ a′ⁿ⁻¹⁻ʲ·aʲ, and a product's as δa·b′ + a·δb.
 
@@ -89,7 +89,7 @@ pub(super) struct Point {
     pub equator: [Real; 2],
     /// Distance from the pole axis.
     pub rho: Real,
-    /// qʲ and uʲ for j = 0..=n (index j).
+    /// qʲ for j = 0..=n and uʲ for j = 0..=m (index j; `Shape`).
     pub q_powers: Vec<[Real; 2]>,
     pub u_powers: Vec<[Real; 2]>,
     /// The equatorial pair and ρ times 2ᵏ (`Far`), for offsets whose
@@ -190,7 +190,7 @@ impl Point {
         let (d_pole, [d1, d2]) = split(formula, delta);
         let [e1, e2] = self.equator.map(k);
         let rho = k(self.rho);
-        // uⁿ's difference; on the axis uⁿ's factor below is 0, so any u does.
+        // uᵐ's difference; on the axis uᵐ's factor below is 0, so any u does.
         let u = C::constant(like, self.u_powers[1]);
         let (mut d_rho, mut d_u) = equatorial_differences([e1, e2], rho, [d1, d2], u);
         let usual = d1 * d1 + d2 * d2 - k(TINY_SQUARED);

@@ -324,9 +324,11 @@ fn quantity_from_orbit(by: OrbitQuantity, fractal: &Fractal, point: DVec3) -> f3
     let o = fractal.orbit_at([point.x, point.y, point.z], fractal.iterations, true);
     match by {
         OrbitQuantity::Angle => {
+            use crate::fractal::Formula;
             let phi = match fractal.formula {
-                crate::fractal::Formula::Quilez => o.z[0].atan2(o.z[2]),
-                _ => o.z[1].atan2(o.z[0]),
+                Formula::Quilez => o.z[0].atan2(o.z[2]),
+                Formula::WhiteNylander | Formula::Asin => o.z[1].atan2(o.z[0]),
+                Formula::Quaternion => o.z[2].atan2(o.z[1]),
             };
             (phi / std::f64::consts::TAU + 0.5) as f32
         }
@@ -343,7 +345,7 @@ fn quantity_from_orbit(by: OrbitQuantity, fractal: &Fractal, point: DVec3) -> f3
 fn a_hits_quantities_from_its_estimate_are_its_orbits_to_the_bit() {
     use crate::fractal::{DeMethod, Formula, Precision};
     let mut fractals = vec![];
-    for formula in [Formula::Quilez, Formula::WhiteNylander] {
+    for formula in [Formula::Quilez, Formula::WhiteNylander, Formula::Quaternion] {
         for julia in [None, Some(DVec3::new(0.3, -0.5, 0.2))] {
             fractals.push(Fractal {
                 formula,

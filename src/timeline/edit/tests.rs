@@ -71,9 +71,8 @@ fn check_kept(original: &str, result: &str, within: Range<usize>) {
         );
     }
     let change = changed(original, result);
-    // An edit to the value already written changes nothing.
     assert!(
-        change.is_empty() || within.start <= change.start && change.end <= within.end,
+        within.start <= change.start && change.end <= within.end,
         "changed {change:?} outside {within:?}:\n{result}"
     );
 }
@@ -142,7 +141,7 @@ fn a_key_added_and_deleted_gives_back_every_example_byte_for_byte() {
 /// Parameters set in every example: some written there, some not.
 const SET: [(&str, KeyValue); 6] = [
     ("fractal.power", KeyValue::Number(7.5)),
-    ("fractal.iterations", KeyValue::Number(14.0)),
+    ("fractal.iterations", KeyValue::Number(13.0)),
     ("camera.target", KeyValue::Triple(0.1, -0.2, 0.3)),
     ("look.exposure", KeyValue::Number(1.25)),
     ("effects.fog.density", KeyValue::Number(0.125)),
