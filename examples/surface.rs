@@ -2,7 +2,7 @@
 //! by membership alone (`march::judge`): the 3D distance from each hit to
 //! the set, and a scan of each ray for set it passed through before the hit.
 //! Optional arguments set every scene's `hit_threshold`, `membership_step`,
-//! `over_relaxation` and `refine_steps`.
+//! `over_relaxation`, `refine_steps` and `confirm_hits` (1 or 0).
 //! The measurement behind docs/surface.md:
 //! `cargo run --release --example surface` (half a minute on two cores).
 
@@ -16,6 +16,9 @@ use std::path::Path;
 
 /// Uniform samples of each ball searched for the set around a hit.
 const SAMPLES: usize = 50_000;
+/// Uniform samples of each ball around a hit that `SAMPLES` put more than a
+/// footprint from the set.
+const SAMPLES_FAR: usize = 1_000_000;
 /// The overshoot scan's step, in footprints.
 const SCAN_STEP: Real = 1.0 / 64.0;
 
@@ -44,6 +47,9 @@ fn measure(name: &str, path: &str, frame: u32) {
     if let Some(steps) = arg(4) {
         scene.quality.refine_steps = steps as u32;
     }
+    if let Some(confirm) = arg(5) {
+        scene.quality.confirm_hits = confirm != 0.0;
+    }
     let camera = scene.camera.frame();
     let (w, h, every) = (160u32, 90u32, 6u32);
     let pixels: Vec<(u32, u32)> = (0..h)
@@ -57,8 +63,16 @@ fn measure(name: &str, path: &str, frame: u32) {
             let hit = march(&ray, &scene.fractal, &scene.quality).hit?;
             let footprint = ray.footprint(hit.t);
             let seed = u64::from(y * w + x);
+            // A sample of 50,000 can miss a sheet or speck thinner than its
+            // spacing; where it finds nothing within a footprint, look again
+            // with `SAMPLES_FAR`, as the bound tightens with samples.
+            let near = distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES, seed);
+            let distance = match near {
+                Some(d) if d <= 1.0 => near,
+                _ => distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES_FAR, seed),
+            };
             Some((
-                distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES, seed),
+                distance,
                 past_the_set(&scene.fractal, &scene.quality, &ray, hit.t, SCAN_STEP),
             ))
         })

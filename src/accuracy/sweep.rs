@@ -88,6 +88,10 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
             s.quality.refine_steps = v
         });
     }
+    let confirm = !q.confirm_hits;
+    add("confirm_hits", confirm.to_string(), &|s| {
+        s.quality.confirm_hits = confirm
+    });
     for k in [0.25, 0.5, 2.0] {
         let v = scaled(q.max_steps, k);
         add("max_steps", v.to_string(), &|s| s.quality.max_steps = v);

@@ -606,6 +606,18 @@ pub const TETRAHEDRON: [DVec3; 4] = [
     DVec3::new(1.0, 1.0, 1.0),
 ];
 
+impl Estimate {
+    /// The potential G = ln r/nᵏ of the estimate's orbit (0 where it stayed
+    /// bounded), n being the fractal's `power`.
+    pub fn potential(&self, power: Real) -> Real {
+        if !self.escaped {
+            return 0.0;
+        }
+        let r = self.end.iter().map(|c| c * c).sum::<Real>().sqrt();
+        potential(r, self.iterations, power)
+    }
+}
+
 /// The Hubbard–Douady potential G = ln r / n^k of an orbit that reached radius
 /// `r` after `k` iterations (0 for a bounded orbit, which has r ≤ bailout).
 pub(super) fn potential(r: Real, k: u32, n: Real) -> Real {

@@ -12,7 +12,7 @@
 // whole estimate wide, in place of the walk: once per ray, not worth a box.
 #![allow(clippy::result_large_err)]
 
-use crate::fractal::{Estimate, Fractal};
+use crate::fractal::{Estimate, Fractal, TETRAHEDRON};
 use crate::math::{sphere_interval, DVec3, Real};
 use serde::{Deserialize, Serialize};
 
@@ -70,6 +70,10 @@ pub struct MarchSettings {
     /// under a quarter of it: the threshold decides hit or miss, these bring
     /// the hit nearer the set (0 stops at the threshold).
     pub refine_steps: u32,
+    /// Whether a hit the analytic estimate settles on is checked by the
+    /// potential estimate (½·G/|∇G|, four more orbits): where that puts the
+    /// set a threshold or more away, the ray grazes it and marches on.
+    pub confirm_hits: bool,
     /// The bounding sphere's centre in the frame's coordinates: the world
     /// origin, or in a deep frame (measured from its anchor) minus the anchor.
     #[serde(skip)]
@@ -110,6 +114,7 @@ impl Default for MarchSettings {
             over_relaxation: 1.2,
             cone_rays: 16,
             refine_steps: 2,
+            confirm_hits: false,
             centre: DVec3::ZERO,
         }
     }
@@ -223,6 +228,23 @@ struct Marcher {
     /// (`Marcher::refine`).
     nearest: Option<(Real, Estimate)>,
     refined: u32,
+    /// A hit being confirmed (`Marcher::confirm`).
+    check: Option<Check>,
+    /// Set when a hit failed its check: until the estimate rises over the
+    /// threshold again, only a `REFINED` estimate stops the ray.
+    passing: bool,
+}
+
+/// A hit under the potential estimate's check: the stencil's samples of
+/// the potential so far, and where the ray goes on if it fails.
+#[derive(Clone, Copy)]
+struct Check {
+    t: Real,
+    estimate: Estimate,
+    h: Real,
+    sampled: usize,
+    gradient: DVec3,
+    resume: Real,
 }
 
 /// A refined hit stops stepping once the estimate is under this share of
@@ -264,6 +286,8 @@ impl Marcher {
             closest: Real::INFINITY,
             nearest: None,
             refined: 0,
+            check: None,
+            passing: false,
         })
     }
 
@@ -291,6 +315,7 @@ impl Marcher {
         near: bool,
         footprint: Real,
         settings: &MarchSettings,
+        fractal: &Fractal,
     ) -> Option<MarchResult> {
         let t = self.t;
         let nearer = self
@@ -301,18 +326,103 @@ impl Marcher {
         }
         let (t_hit, at_hit) = self.nearest?;
         let fine = estimate.distance < REFINED * settings.hit_threshold * footprint;
+        let step = settings.step(estimate.distance);
         if !(near && nearer) || fine || self.refined >= settings.refine_steps {
-            return Some(self.hit(t_hit, at_hit));
+            return self.confirm(t_hit, at_hit, step, fractal, settings);
         }
         self.refined += 1;
         self.outside = Some(t);
-        let step = settings.step(estimate.distance);
         (self.previous_distance, self.previous_step) = (step, step);
         self.t += step;
         if self.t > self.t_exit {
-            return Some(self.hit(t_hit, at_hit));
+            return self.confirm(t_hit, at_hit, step, fractal, settings);
         }
         None
+    }
+
+    /// The hit at `t`, or, where `confirm_hits` asks and the estimate there
+    /// was not yet `REFINED`, the start of its check: the next four points
+    /// are the potential's tetrahedral stencil around it (`checked`).
+    /// `resume` is the step the ray goes on by if the check fails.
+    fn confirm(
+        &mut self,
+        t: Real,
+        estimate: Estimate,
+        resume: Real,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<MarchResult> {
+        let footprint = self.ray.footprint(t);
+        let h = 0.25 * footprint;
+        // Checked only where the stencil resolves: f64 above its noise at
+        // this point, and not in a deep frame's offsets.
+        let resolved = h > 1e-7 * self.ray.at(t).length().max(1e-3);
+        let coarse = estimate.distance >= REFINED * settings.hit_threshold * footprint;
+        if !settings.confirm_hits
+            || self.passing
+            || !coarse
+            || !resolved
+            || fractal.de != crate::fractal::DeMethod::Analytic
+            || fractal.deep.is_some()
+            || fractal.precision != crate::fractal::Precision::F64
+        {
+            return Some(self.hit(t, estimate));
+        }
+        self.check = Some(Check {
+            t,
+            estimate,
+            h,
+            sampled: 0,
+            gradient: DVec3::ZERO,
+            resume,
+        });
+        None
+    }
+
+    /// Takes the estimate at the check's next stencil point; after the
+    /// fourth, the hit, or the ray marching on past a set the potential
+    /// estimate puts a threshold or more away.
+    fn checked(
+        &mut self,
+        sample: &Estimate,
+        fractal: &Fractal,
+        settings: &MarchSettings,
+    ) -> Option<MarchResult> {
+        let mut check = self.check.take().expect("a check under way");
+        self.evaluations += sample.orbits;
+        check.gradient += TETRAHEDRON[check.sampled] * sample.potential(fractal.power);
+        check.sampled += 1;
+        if check.sampled < TETRAHEDRON.len() {
+            self.check = Some(check);
+            return None;
+        }
+        let slope = check.gradient.length() / (4.0 * check.h);
+        let distance = 0.5 * check.estimate.potential(fractal.power) / slope;
+        let footprint = self.ray.footprint(check.t);
+        // A NaN (a slope of 0 or ∞) confirms: the estimate cannot judge.
+        let grazes = distance >= settings.hit_threshold * footprint;
+        if !grazes {
+            return Some(self.hit(check.t, check.estimate));
+        }
+        self.passing = true;
+        self.nearest = None;
+        self.refined = 0;
+        self.outside = Some(self.t);
+        (self.previous_distance, self.previous_step) = (check.resume, check.resume);
+        self.t += check.resume;
+        if self.t > self.t_exit {
+            return Some(self.miss());
+        }
+        None
+    }
+
+    fn miss(&self) -> MarchResult {
+        MarchResult {
+            hit: None,
+            evaluations: self.evaluations,
+            closest: self.closest,
+            out_of_steps: false,
+        }
     }
 
     fn hit(&self, t: Real, estimate: Estimate) -> MarchResult {
@@ -333,6 +443,10 @@ impl Walk for Marcher {
     type Output = MarchResult;
 
     fn next_point(&self) -> (DVec3, Real) {
+        if let Some(check) = &self.check {
+            let at = self.ray.at(check.t) + TETRAHEDRON[check.sampled] * check.h;
+            return (at, self.ray.footprint(check.t));
+        }
         (self.ray.at(self.t), self.ray.footprint(self.t))
     }
 
@@ -343,6 +457,9 @@ impl Walk for Marcher {
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<MarchResult> {
+        if self.check.is_some() {
+            return self.checked(estimate, fractal, settings);
+        }
         let (t, ray) = (self.t, self.ray);
         self.evaluations += estimate.orbits;
         if self.steps == settings.max_steps {
@@ -387,13 +504,16 @@ impl Walk for Marcher {
         }
         // Inside from the start (the camera is in the set), or, trusting
         // the estimate, near enough.
+        let near = estimate.distance < settings.hit_threshold * footprint;
+        self.passing &= near;
         let trusted = settings.membership_step <= 0.0
-            && estimate.distance < settings.hit_threshold * footprint;
+            && near
+            && !(self.passing && estimate.distance >= REFINED * settings.hit_threshold * footprint);
         if !estimate.escaped {
             return Some(self.hit(t, *estimate));
         }
         if trusted || self.nearest.is_some() {
-            return self.refine(estimate, trusted, footprint, settings);
+            return self.refine(estimate, trusted, footprint, settings, fractal);
         }
         self.outside = Some(t);
         let step = settings.step(estimate.distance);
@@ -412,12 +532,7 @@ impl Walk for Marcher {
             self.take_back();
         }
         if self.t > self.t_exit {
-            return Some(MarchResult {
-                hit: None,
-                evaluations: self.evaluations,
-                closest: self.closest,
-                out_of_steps: false,
-            });
+            return Some(self.miss());
         }
         None
     }

@@ -77,6 +77,27 @@ fn refined_hits_on_a_zoom_frame_lie_within_three_quarters_of_a_footprint() {
 }
 
 #[test]
+fn confirmed_hits_on_a_late_zoom_frame_drop_the_grazing_rays_far_from_the_set() {
+    // Late in the zoom the analytic estimate reads under half a footprint
+    // on rays that pass 2 to 7 footprints from the set; the potential
+    // estimate's check lets them march on.
+    let mut scene = scene("timelines/zoom.ron", 119);
+    let far = |scene: &Scene| {
+        let (distances, deepest) = judged(scene);
+        let far = distances.iter().filter(|&&d| d > 2.0).count();
+        (far, distances.len(), deepest)
+    };
+    let (before, n_before, _) = far(&scene);
+    scene.quality.confirm_hits = true;
+    let (after, n_after, deepest) = far(&scene);
+    assert!(
+        before >= 4 && after * 4 <= before,
+        "{before} of {n_before} hits over 2 footprints away unconfirmed, {after} of {n_after} confirmed"
+    );
+    assert_eq!(deepest, 0.0, "a hit {deepest:.2} footprints past the set");
+}
+
+#[test]
 fn the_judge_sees_a_hit_placed_past_or_away_from_the_set() {
     // The judge can fail: a "hit" 3 footprints past the first point of
     // the set on the centre ray reads 3 past it; the crossing itself reads

@@ -36,9 +36,10 @@ fn marching_many_side_by_side_is_bit_identical_to_one_at_a_time() {
         bulb(Formula::Quilez, 7.5, None),
         Fractal::unit_ball(),
     ];
-    for max_steps in [300, 7] {
+    for (max_steps, confirm_hits) in [(300, false), (7, false), (300, true), (7, true)] {
         let settings = MarchSettings {
             max_steps,
+            confirm_hits,
             ..MarchSettings::default()
         };
         for f in &fractals {
