@@ -4,7 +4,8 @@
 //! Optional arguments set every scene's `hit_threshold`, `membership_step`,
 //! `over_relaxation`, `refine_steps` and `confirm_hits` (1 or 0).
 //! The measurement behind docs/surface.md:
-//! `cargo run --release --example surface` (half a minute on two cores).
+//! `cargo run --release --example surface` (one and a half to three minutes
+//! on two cores).
 
 use mandelreel::march::judge::{distance_to_set, past_the_set};
 use mandelreel::march::march;
@@ -69,7 +70,11 @@ fn measure(name: &str, path: &str, frame: u32) {
             let near = distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES, seed);
             let distance = match near {
                 Some(d) if d <= 1.0 => near,
-                _ => distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES_FAR, seed),
+                _ => {
+                    let far =
+                        distance_to_set(&scene.fractal, hit.point, footprint, SAMPLES_FAR, seed);
+                    near.into_iter().chain(far).reduce(Real::min)
+                }
             };
             Some((
                 distance,

@@ -26,6 +26,7 @@ pub fn reference_scene(scene: &Scene) -> Scene {
     r.quality.normal_step = scene.quality.normal_step / 4.0;
     r.quality.over_relaxation = 1.0;
     r.quality.cone_rays = 1;
+    r.quality.confirm_hits = false;
     r.samples_per_pixel = scene.samples_per_pixel.max(16);
     r.adaptive = None;
     r

@@ -140,9 +140,16 @@ pub fn measure(
     // Perturbation is a knob only where the frame is deep.
     let deep = crate::deep::needed(scene, [width, height])
         && crate::fractal::whole_power(scene.fractal.power).is_some();
+    // The potential check works only with the analytic estimator in f64,
+    // walking by the estimate, and outside deep frames.
+    let checkable = !deep
+        && scene.fractal.de == DeMethod::Analytic
+        && scene.fractal.precision == Precision::F64
+        && scene.quality.membership_step <= 0.0;
     let all: Vec<Variant> = variants(scene)
         .into_iter()
         .filter(|v| deep || v.knob != "perturbation")
+        .filter(|v| checkable || v.knob != "confirm_hits")
         .map(|mut v| {
             if crate::deep::f32_too_coarse(&v.scene, [width, height]) {
                 v.setting += " (renders in f64: f32 cannot resolve these pixels)";

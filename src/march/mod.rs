@@ -73,6 +73,9 @@ pub struct MarchSettings {
     /// Whether a hit the analytic estimate settles on is checked by the
     /// potential estimate (½·G/|∇G|, four more orbits): where that puts the
     /// set a threshold or more away, the ray grazes it and marches on.
+    /// Left out of a scene's serialised form when off, so frames keep
+    /// their hashes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
     pub confirm_hits: bool,
     /// The bounding sphere's centre in the frame's coordinates: the world
     /// origin, or in a deep frame (measured from its anchor) minus the anchor.
@@ -235,17 +238,20 @@ struct Marcher {
     passing: bool,
 }
 
-/// A hit under the potential estimate's check: the stencil's samples of
-/// the potential so far, and where the ray goes on if it fails.
+/// The potential estimate's check of the hit at `Marcher::nearest`: the
+/// stencil's samples so far, and the step the ray goes on by if it fails.
 #[derive(Clone, Copy)]
 struct Check {
-    t: Real,
-    estimate: Estimate,
-    h: Real,
-    sampled: usize,
+    sampled: u8,
+    /// A sample in the set: the set is within the stencil, so it confirms.
+    inside: bool,
     gradient: DVec3,
     resume: Real,
 }
+
+/// The offset along each axis of the potential check's stencil points, in
+/// footprints of the hit.
+const STENCIL: Real = 0.25;
 
 /// A refined hit stops stepping once the estimate is under this share of
 /// the hit threshold (`MarchSettings::refine_steps`).
@@ -324,42 +330,44 @@ impl Marcher {
         if near && nearer {
             self.nearest = Some((t, *estimate));
         }
-        let (t_hit, at_hit) = self.nearest?;
+        self.nearest?;
         let fine = estimate.distance < REFINED * settings.hit_threshold * footprint;
         let step = settings.step(estimate.distance);
         if !(near && nearer) || fine || self.refined >= settings.refine_steps {
-            return self.confirm(t_hit, at_hit, step, fractal, settings);
+            return self.confirm(step, fractal, settings);
         }
         self.refined += 1;
         self.outside = Some(t);
         (self.previous_distance, self.previous_step) = (step, step);
         self.t += step;
         if self.t > self.t_exit {
-            return self.confirm(t_hit, at_hit, step, fractal, settings);
+            return self.confirm(step, fractal, settings);
         }
         None
     }
 
-    /// The hit at `t`, or, where `confirm_hits` asks and the estimate there
-    /// was not yet `REFINED`, the start of its check: the next four points
-    /// are the potential's tetrahedral stencil around it (`checked`).
-    /// `resume` is the step the ray goes on by if the check fails.
+    /// The hit at the nearest point, or, where `confirm_hits` asks and the
+    /// estimate there was not yet `REFINED`, the start of its check: the
+    /// next four points are the potential's tetrahedral stencil around it
+    /// (`checked`). `resume` is the step the ray goes on by if it fails.
     fn confirm(
         &mut self,
-        t: Real,
-        estimate: Estimate,
         resume: Real,
         fractal: &Fractal,
         settings: &MarchSettings,
     ) -> Option<MarchResult> {
+        let (t, estimate) = self.nearest.expect("a hit to confirm");
+        if !settings.confirm_hits {
+            return Some(self.hit(t, estimate));
+        }
         let footprint = self.ray.footprint(t);
-        let h = 0.25 * footprint;
-        // Checked only where the stencil resolves: f64 above its noise at
-        // this point, and not in a deep frame's offsets.
-        let resolved = h > 1e-7 * self.ray.at(t).length().max(1e-3);
+        let h = STENCIL * footprint;
+        // Checked only where the stencil resolves: above f64's noise at
+        // this point (the potential estimator's own floor), and not in a
+        // deep frame's offsets.
+        let resolved = h > Real::EPSILON.sqrt() * self.ray.at(t).length().max(1e-3);
         let coarse = estimate.distance >= REFINED * settings.hit_threshold * footprint;
-        if !settings.confirm_hits
-            || self.passing
+        if self.passing
             || !coarse
             || !resolved
             || fractal.de != crate::fractal::DeMethod::Analytic
@@ -369,10 +377,8 @@ impl Marcher {
             return Some(self.hit(t, estimate));
         }
         self.check = Some(Check {
-            t,
-            estimate,
-            h,
             sampled: 0,
+            inside: false,
             gradient: DVec3::ZERO,
             resume,
         });
@@ -390,19 +396,26 @@ impl Marcher {
     ) -> Option<MarchResult> {
         let mut check = self.check.take().expect("a check under way");
         self.evaluations += sample.orbits;
-        check.gradient += TETRAHEDRON[check.sampled] * sample.potential(fractal.power);
+        check.gradient += TETRAHEDRON[check.sampled as usize] * sample.potential(fractal.power);
+        check.inside |= !sample.escaped;
         check.sampled += 1;
-        if check.sampled < TETRAHEDRON.len() {
+        if (check.sampled as usize) < TETRAHEDRON.len() {
             self.check = Some(check);
             return None;
         }
-        let slope = check.gradient.length() / (4.0 * check.h);
-        let distance = 0.5 * check.estimate.potential(fractal.power) / slope;
-        let footprint = self.ray.footprint(check.t);
-        // A NaN (a slope of 0 or ∞) confirms: the estimate cannot judge.
-        let grazes = distance >= settings.hit_threshold * footprint;
+        let (t, estimate) = self.nearest.expect("the hit under the check");
+        let h = STENCIL * self.ray.footprint(t);
+        let slope = check.gradient.length() / (4.0 * h);
+        let distance = 0.5 * estimate.potential(fractal.power) / slope;
+        // A slope of 0 or ∞ cannot judge; and a ray out of steps keeps
+        // the hit it has rather than stopping where it judged none.
+        let grazes = !check.inside
+            && slope.is_finite()
+            && slope > 0.0
+            && distance >= settings.hit_threshold * self.ray.footprint(t)
+            && self.steps < settings.max_steps;
         if !grazes {
-            return Some(self.hit(check.t, check.estimate));
+            return Some(self.hit(t, estimate));
         }
         self.passing = true;
         self.nearest = None;
@@ -443,9 +456,10 @@ impl Walk for Marcher {
     type Output = MarchResult;
 
     fn next_point(&self) -> (DVec3, Real) {
-        if let Some(check) = &self.check {
-            let at = self.ray.at(check.t) + TETRAHEDRON[check.sampled] * check.h;
-            return (at, self.ray.footprint(check.t));
+        if let (Some(check), Some((t, _))) = (&self.check, self.nearest) {
+            let footprint = self.ray.footprint(t);
+            let at = self.ray.at(t) + TETRAHEDRON[check.sampled as usize] * (STENCIL * footprint);
+            return (at, footprint);
         }
         (self.ray.at(self.t), self.ray.footprint(self.t))
     }

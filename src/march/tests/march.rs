@@ -36,6 +36,8 @@ fn marching_many_side_by_side_is_bit_identical_to_one_at_a_time() {
         bulb(Formula::Quilez, 7.5, None),
         Fractal::unit_ball(),
     ];
+    // Whole-run results by confirm_hits, to see the check do something.
+    let mut runs = [String::new(), String::new()];
     for (max_steps, confirm_hits) in [(300, false), (7, false), (300, true), (7, true)] {
         let settings = MarchSettings {
             max_steps,
@@ -45,6 +47,7 @@ fn marching_many_side_by_side_is_bit_identical_to_one_at_a_time() {
         for f in &fractals {
             let mut many = vec![MarchResult::default(); rays.len()];
             march_many(&rays, f, &settings, &mut many);
+            runs[confirm_hits as usize] += &format!("{many:?}");
             let mut hits = 0;
             for (r, m) in rays.iter().zip(&many) {
                 let one = march(r, f, &settings);
@@ -81,6 +84,7 @@ fn marching_many_side_by_side_is_bit_identical_to_one_at_a_time() {
             assert_eq!(normals.iter().flatten().count(), hit_rays.len());
         }
     }
+    assert_ne!(runs[0], runs[1], "confirming hits changed no march");
 }
 
 #[test]
@@ -210,4 +214,17 @@ fn rays_out_of_steps_are_hits_every_time() {
         assert_eq!(march(&r, &f, &settings).hit.unwrap().t, first.t);
     }
     assert!(first.t.is_finite() && first.point.is_finite());
+}
+
+#[test]
+fn confirming_hits_is_left_out_of_the_settings_hash_when_off() {
+    // Frames are hashed from the serialised scene: a setting at its
+    // default must not change every frame's hash.
+    let off = ron::to_string(&MarchSettings::default()).unwrap();
+    assert!(!off.contains("confirm_hits"), "{off}");
+    let on = MarchSettings {
+        confirm_hits: true,
+        ..MarchSettings::default()
+    };
+    assert!(ron::to_string(&on).unwrap().contains("confirm_hits:true"));
 }
