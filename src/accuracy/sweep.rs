@@ -140,12 +140,9 @@ pub fn measure(
     // Perturbation is a knob only where the frame is deep.
     let deep = crate::deep::needed(scene, [width, height])
         && crate::fractal::whole_power(scene.fractal.power).is_some();
-    // The potential check works only with the analytic estimator in f64,
-    // walking by the estimate, and outside deep frames.
-    let checkable = !deep
-        && scene.fractal.de == DeMethod::Analytic
-        && scene.fractal.precision == Precision::F64
-        && scene.quality.membership_step <= 0.0;
+    // The potential check runs only where `Fractal::checks_hits` allows
+    // it, on rays that walk by the estimate.
+    let checkable = !deep && scene.fractal.checks_hits() && scene.quality.membership_step <= 0.0;
     let all: Vec<Variant> = variants(scene)
         .into_iter()
         .filter(|v| deep || v.knob != "perturbation")

@@ -6,6 +6,13 @@ use super::{DeMethod, Estimate, Fractal, Precision, Triplex};
 use crate::math::{DVec3, Dual, Number, Real};
 
 impl Fractal {
+    /// Whether a hit can be checked by the potential estimate's stencil
+    /// (`MarchSettings::confirm_hits`): with the analytic estimator in
+    /// f64, outside a deep frame's offsets.
+    pub fn checks_hits(&self) -> bool {
+        self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
+    }
+
     /// The radius past which an orbit counts as escaped in `T`: `bailout`,
     /// or lower where the step that passes it could leave `T`'s range. That
     /// step lands within Eⁿ + |c| of the origin, and |z|² of it must stay
@@ -613,8 +620,7 @@ impl Estimate {
         if !self.escaped {
             return 0.0;
         }
-        let r = self.end.iter().map(|c| c * c).sum::<Real>().sqrt();
-        potential(r, self.iterations, power)
+        potential(self.end_radius(), self.iterations, power)
     }
 }
 

@@ -367,13 +367,7 @@ impl Marcher {
         // deep frame's offsets.
         let resolved = h > Real::EPSILON.sqrt() * self.ray.at(t).length().max(1e-3);
         let coarse = estimate.distance >= REFINED * settings.hit_threshold * footprint;
-        if self.passing
-            || !coarse
-            || !resolved
-            || fractal.de != crate::fractal::DeMethod::Analytic
-            || fractal.deep.is_some()
-            || fractal.precision != crate::fractal::Precision::F64
-        {
+        if self.passing || !coarse || !resolved || !fractal.checks_hits() {
             return Some(self.hit(t, estimate));
         }
         self.check = Some(Check {
@@ -404,15 +398,15 @@ impl Marcher {
             return None;
         }
         let (t, estimate) = self.nearest.expect("the hit under the check");
-        let h = STENCIL * self.ray.footprint(t);
-        let slope = check.gradient.length() / (4.0 * h);
+        let footprint = self.ray.footprint(t);
+        let slope = check.gradient.length() / (4.0 * STENCIL * footprint);
         let distance = 0.5 * estimate.potential(fractal.power) / slope;
         // A slope of 0 or ∞ cannot judge; and a ray out of steps keeps
         // the hit it has rather than stopping where it judged none.
         let grazes = !check.inside
             && slope.is_finite()
             && slope > 0.0
-            && distance >= settings.hit_threshold * self.ray.footprint(t)
+            && distance >= settings.hit_threshold * footprint
             && self.steps < settings.max_steps;
         if !grazes {
             return Some(self.hit(t, estimate));
