@@ -2,7 +2,7 @@
 //! by membership alone (`march::judge`): the 3D distance from each hit to
 //! the set, and a scan of each ray for set it passed through before the hit.
 //! Optional arguments set every scene's `hit_threshold`, `membership_step`,
-//! `over_relaxation`, `refine_steps` and `confirm_hits` (1 or 0).
+//! `over_relaxation`, `refine_steps`, `confirm_hits` (1 or 0) and `fudge`.
 //! The measurement behind docs/surface.md:
 //! `cargo run --release --example surface` (one and a half to three minutes
 //! on two cores).
@@ -50,6 +50,9 @@ fn measure(name: &str, path: &str, frame: u32) {
     }
     if let Some(confirm) = arg(5) {
         scene.quality.confirm_hits = confirm != 0.0;
+    }
+    if let Some(fudge) = arg(6) {
+        scene.quality.fudge = fudge;
     }
     let camera = scene.camera.frame();
     let (w, h, every) = (160u32, 90u32, 6u32);

@@ -128,6 +128,31 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     out
 }
 
+/// `variants` of `scene` that a frame at `size` can tell apart from the
+/// scene itself, each saying where it renders in f64 instead of f32.
+pub fn sweep_for(scene: &Scene, size: [u32; 2]) -> Vec<Variant> {
+    // Perturbation is a knob only where the frame is deep.
+    let deep = crate::deep::needed(scene, size)
+        && crate::fractal::whole_power(scene.fractal.power).is_some();
+    // The potential check runs only where `Fractal::checks_hits` allows
+    // it, on rays that walk by the estimate, where its stencil resolves
+    // (taken at the target, where the frame looks).
+    let resolves =
+        crate::march::check_resolves(crate::deep::footprint(scene, size), scene.camera.target);
+    let checkable = resolves && scene.fractal.checks_hits() && scene.quality.membership_step <= 0.0;
+    variants(scene)
+        .into_iter()
+        .filter(|v| deep || v.knob != "perturbation")
+        .filter(|v| checkable || v.knob != "confirm_hits")
+        .map(|mut v| {
+            if crate::deep::f32_too_coarse(&v.scene, size) {
+                v.setting += " (renders in f64: f32 cannot resolve these pixels)";
+            }
+            v
+        })
+        .collect()
+}
+
 /// Runs the whole sweep on frame `frame_index` of `scene` at `width`×`height`.
 /// `progress` hears each variant's name before it is rendered.
 pub fn measure(
@@ -137,23 +162,7 @@ pub fn measure(
     height: u32,
     progress: &dyn Fn(usize, usize, &Variant),
 ) -> Report {
-    // Perturbation is a knob only where the frame is deep.
-    let deep = crate::deep::needed(scene, [width, height])
-        && crate::fractal::whole_power(scene.fractal.power).is_some();
-    // The potential check runs only where `Fractal::checks_hits` allows
-    // it, on rays that walk by the estimate.
-    let checkable = !deep && scene.fractal.checks_hits() && scene.quality.membership_step <= 0.0;
-    let all: Vec<Variant> = variants(scene)
-        .into_iter()
-        .filter(|v| deep || v.knob != "perturbation")
-        .filter(|v| checkable || v.knob != "confirm_hits")
-        .map(|mut v| {
-            if crate::deep::f32_too_coarse(&v.scene, [width, height]) {
-                v.setting += " (renders in f64: f32 cannot resolve these pixels)";
-            }
-            v
-        })
-        .collect();
+    let all = sweep_for(scene, [width, height]);
     let reference = &all[0].scene;
     progress(0, all.len(), &all[0]);
     let started = Instant::now();
@@ -223,6 +232,7 @@ pub fn measure(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::math::DVec3;
 
     #[test]
     fn variants_change_one_knob_each_and_are_distinct() {
@@ -238,5 +248,32 @@ mod tests {
         }
         // Every estimator in both precisions appears (the scene's own is the "scene" row).
         assert_eq!(all.iter().filter(|v| v.knob == "de").count(), 9);
+    }
+
+    /// The default scene looking at (0, 0, 1) from `distance` along z.
+    fn scene_at(distance: Real) -> Scene {
+        let mut scene = Scene::default();
+        scene.camera.target = DVec3::Z;
+        scene.camera.position = DVec3::Z * (1.0 + distance);
+        scene
+    }
+
+    #[test]
+    fn the_check_of_hits_is_swept_only_where_its_stencil_resolves() {
+        let size = [1024, 576];
+        let rows = |distance: Real| {
+            sweep_for(&scene_at(distance), size)
+                .iter()
+                .filter(|v| v.knob == "confirm_hits")
+                .count()
+        };
+        assert_eq!(rows(1.0), 1);
+        // A pixel of 3e-8 at the target: not deep (under 2^-26 of the
+        // target's size, 1.5e-8, is), but finer than the stencil takes,
+        // so the row would repeat "scene".
+        let footprint = crate::deep::footprint(&scene_at(2e-5), size);
+        assert!((2e-8..4e-8).contains(&footprint), "{footprint}");
+        assert!(!crate::deep::needed(&scene_at(2e-5), size));
+        assert_eq!(rows(2e-5), 0);
     }
 }

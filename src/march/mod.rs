@@ -236,6 +236,9 @@ struct Marcher {
     /// Set when a hit failed its check: until the estimate rises over the
     /// threshold again, only a `REFINED` estimate stops the ray.
     passing: bool,
+    /// The first hit that failed its check: where a ray that runs out of
+    /// steps after it stops, rather than wherever it has crept to.
+    grazed: Option<(Real, Estimate)>,
 }
 
 /// The potential estimate's check of the hit at `Marcher::nearest`: the
@@ -252,6 +255,13 @@ struct Check {
 /// The offset along each axis of the potential check's stencil points, in
 /// footprints of the hit.
 const STENCIL: Real = 0.25;
+
+/// Whether the potential check's stencil around `point`, a `footprint`
+/// wide, stands above f64's noise there (the potential estimator's own
+/// floor), so a hit there can be checked (`MarchSettings::confirm_hits`).
+pub fn check_resolves(footprint: Real, point: DVec3) -> bool {
+    STENCIL * footprint > Real::EPSILON.sqrt() * point.length().max(1e-3)
+}
 
 /// A refined hit stops stepping once the estimate is under this share of
 /// the hit threshold (`MarchSettings::refine_steps`).
@@ -294,6 +304,7 @@ impl Marcher {
             refined: 0,
             check: None,
             passing: false,
+            grazed: None,
         })
     }
 
@@ -361,13 +372,11 @@ impl Marcher {
             return Some(self.hit(t, estimate));
         }
         let footprint = self.ray.footprint(t);
-        let h = STENCIL * footprint;
-        // Checked only where the stencil resolves: above f64's noise at
-        // this point (the potential estimator's own floor), and not in a
-        // deep frame's offsets.
-        let resolved = h > Real::EPSILON.sqrt() * self.ray.at(t).length().max(1e-3);
+        let resolved = check_resolves(footprint, self.ray.at(t));
         let coarse = estimate.distance >= REFINED * settings.hit_threshold * footprint;
-        if self.passing || !coarse || !resolved || !fractal.checks_hits() {
+        // At the last step the check could only confirm the hit.
+        let last = self.steps >= settings.max_steps;
+        if self.passing || last || !coarse || !resolved || !fractal.checks_hits() {
             return Some(self.hit(t, estimate));
         }
         self.check = Some(Check {
@@ -401,17 +410,16 @@ impl Marcher {
         let footprint = self.ray.footprint(t);
         let slope = check.gradient.length() / (4.0 * STENCIL * footprint);
         let distance = 0.5 * estimate.potential(fractal.power) / slope;
-        // A slope of 0 or ∞ cannot judge; and a ray out of steps keeps
-        // the hit it has rather than stopping where it judged none.
+        // A slope of 0 or ∞ cannot judge.
         let grazes = !check.inside
             && slope.is_finite()
             && slope > 0.0
-            && distance >= settings.hit_threshold * footprint
-            && self.steps < settings.max_steps;
+            && distance >= settings.hit_threshold * footprint;
         if !grazes {
             return Some(self.hit(t, estimate));
         }
         self.passing = true;
+        self.grazed = self.grazed.or(self.nearest);
         self.nearest = None;
         self.refined = 0;
         self.outside = Some(self.t);
@@ -475,7 +483,7 @@ impl Walk for Marcher {
             // along a surface it keeps almost touching (a grazing ray).
             // Calling that a miss punches background-coloured speckles into
             // the surface; call it a hit, and count it.
-            let (t, estimate) = self.nearest.unwrap_or((t, *estimate));
+            let (t, estimate) = self.nearest.or(self.grazed).unwrap_or((t, *estimate));
             return Some(MarchResult {
                 out_of_steps: true,
                 ..self.hit(t, estimate)

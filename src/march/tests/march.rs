@@ -228,3 +228,79 @@ fn confirming_hits_is_left_out_of_the_settings_hash_when_off() {
     };
     assert!(ron::to_string(&on).unwrap().contains("confirm_hits:true"));
 }
+
+/// Rays fanned across the bulb's limb, where the analytic estimate
+/// understates on grazing rays and potential checks fail; each marched
+/// with the check off and on, at every `max_steps` from 1 to 59.
+fn limb_marches() -> Vec<(usize, Ray, u32, MarchResult, MarchResult)> {
+    let origin = DVec3::new(0.2, -2.8, 0.5);
+    let fractal = Fractal::default();
+    let mut out = vec![];
+    for i in 0..120 {
+        let a = i as Real / 120.0;
+        let r = ray(
+            origin,
+            -origin + DVec3::new(2.4 * a - 1.2, 0.0, 0.6 * (5.0 * a).sin()),
+        );
+        for max_steps in 1..60 {
+            let settings = |confirm_hits| MarchSettings {
+                max_steps,
+                confirm_hits,
+                ..MarchSettings::default()
+            };
+            let off = march(&r, &fractal, &settings(false));
+            let on = march(&r, &fractal, &settings(true));
+            out.push((i, r, max_steps, off, on));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_ray_out_of_steps_after_a_failed_check_stops_at_the_hit_it_failed() {
+    let (mut cases, mut stopped_back) = (0, 0);
+    for (i, r, max_steps, off, on) in limb_marches() {
+        let (Some(off_hit), Some(on_hit)) = (&off.hit, &on.hit) else {
+            continue;
+        };
+        if off.out_of_steps || !on.out_of_steps {
+            continue;
+        }
+        // The check failed the hit `off` stopped at and the ray went
+        // on: out of steps, it stops there or at a nearer point after.
+        cases += 1;
+        let threshold = MarchSettings::default().hit_threshold * r.footprint(on_hit.t);
+        assert!(
+            on_hit.t <= off_hit.t || on_hit.estimate.distance < threshold,
+            "ray {i} at {max_steps} steps stopped at {} past its hit at {}",
+            on_hit.t,
+            off_hit.t
+        );
+        stopped_back += (on_hit.t == off_hit.t) as usize;
+    }
+    assert!(stopped_back > 0, "{cases} rays out of steps after a check");
+}
+
+#[test]
+fn a_hit_at_the_last_step_is_not_checked() {
+    let marches = limb_marches();
+    let mut last_step_hits = 0;
+    for pair in marches.windows(2) {
+        let ((_, _, _, before, _), (i, _, max_steps, off, on)) = (&pair[0], &pair[1]);
+        // `off` hit at its last allowed step: one step fewer ran out.
+        let at_last =
+            *max_steps > 1 && before.out_of_steps && off.hit.is_some() && !off.out_of_steps;
+        if at_last {
+            last_step_hits += 1;
+            assert_eq!(
+                format!("{off:?}"),
+                format!("{on:?}"),
+                "ray {i} at {max_steps} steps"
+            );
+        }
+    }
+    assert!(
+        last_step_hits > 20,
+        "{last_step_hits} hits at the last step"
+    );
+}
