@@ -84,7 +84,7 @@ impl<T: Delta> C<T> {
 /// What the step needs of one reference point, all from its f64 value.
 #[derive(Clone, Debug, PartialEq)]
 pub(super) struct Point {
-    /// The pole coordinate and the equatorial pair (`split`).
+    /// The pole coordinate and the equatorial pair (`Shape::split`).
     pub pole: Real,
     pub equator: [Real; 2],
     /// Distance from the pole axis.
@@ -121,12 +121,6 @@ const TINY_SQUARED: Real = 9.332636185032189e-302; // 2⁻¹⁰⁰⁰
 /// (`TINY_SQUARED`'s root) and their squares within f64's range.
 const MOST_FAR: i32 = 1000;
 
-/// The pole coordinate and the equatorial pair whose angle is the azimuth.
-#[inline(always)]
-pub(super) fn split<T: Copy>(formula: Formula, z: Triplex<T>) -> (T, [T; 2]) {
-    formula.shape().split(z)
-}
-
 /// q from the pole coordinate and ρ: the complex number whose argument is
 /// the polar angle in the formula's convention.
 #[inline(always)]
@@ -143,8 +137,8 @@ impl Point {
     /// undefined.
     pub fn new(formula: Formula, z: &[Big; 3], n: u32) -> Option<Point> {
         let rounded = z.each_ref().map(|v| v.to_f64().value());
-        let (pole, equator) = split(formula, rounded);
-        let (_, [e1, e2]) = split(formula, z.each_ref());
+        let (pole, equator) = formula.shape().split(rounded);
+        let (_, [e1, e2]) = formula.shape().split(z.each_ref());
         let exact_rho = (e1 * e1 + e2 * e2).sqrt();
         if exact_rho == Big::ZERO {
             return None;
@@ -187,7 +181,7 @@ impl Point {
         let (n, m) = (self.q_powers.len() - 1, self.u_powers.len() - 1);
         let like = delta[0];
         let k = |v: Real| like.constant(v);
-        let (d_pole, [d1, d2]) = split(formula, delta);
+        let (d_pole, [d1, d2]) = formula.shape().split(delta);
         let [e1, e2] = self.equator.map(k);
         let rho = k(self.rho);
         // uᵐ's difference; on the axis uᵐ's factor below is 0, so any u does.
