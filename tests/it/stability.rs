@@ -389,13 +389,7 @@ fn a_bounding_sphere_past_the_bailout_draws_no_bailout_ball() {
         (4.0, 6.0, DeMethod::SinhPotential, Precision::F64, None),
         (3.0, 5.0, DeMethod::Analytic, Precision::F32, julia),
     ] {
-        let f = Fractal {
-            bailout,
-            de,
-            precision,
-            julia,
-            ..Fractal::default()
-        };
+        let f = bulb(bailout, de, precision, julia);
         sees_the_bulb(&f, radius);
     }
 }
@@ -424,12 +418,31 @@ fn large_bailouts_and_spheres_keep_the_bulb() {
     }
 }
 
+/// The default bulb, or Julia set where `julia` is given, with the bailout,
+/// estimator and precision given.
+fn bulb(bailout: f64, de: DeMethod, precision: Precision, julia: Option<DVec3>) -> Fractal {
+    Fractal {
+        bailout,
+        de,
+        precision,
+        julia,
+        ..Fractal::default()
+    }
+}
+
 /// The deepest point of the set, in footprints of the hit, that a ray of a
 /// 24×14 grid of the far camera's passes before its hit (`past_the_set` at a
 /// 64th of a footprint), and the number of hits.
 fn deepest_pass_through(fractal: &Fractal, radius: f64) -> (f64, usize) {
+    deepest_pass_through_with(fractal, radius, false)
+}
+
+/// `deepest_pass_through`, with hits checked by the potential estimate
+/// where `confirm_hits` says.
+fn deepest_pass_through_with(fractal: &Fractal, radius: f64, confirm_hits: bool) -> (f64, usize) {
     let settings = MarchSettings {
         bounding_radius: radius,
+        confirm_hits,
         ..MarchSettings::default()
     };
     let frame = far_camera().frame();
@@ -476,6 +489,50 @@ fn no_ray_passes_through_the_set_in_a_wide_sphere_or_at_a_large_bailout() {
         assert!(
             deepest == 0.0,
             "{f:?} inside {radius}: a hit {deepest:.2} footprints past the set"
+        );
+    }
+}
+
+#[test]
+fn no_ray_passes_through_the_set_by_jacobian_in_julia_mode_or_confirming_hits() {
+    // The rest of the class of the test above: the Jacobian estimator,
+    // Julia mode by each estimator, and the potential check of hits,
+    // which marches grazing rays on.
+    let julia = Some(DVec3::new(-0.2, 0.6, 0.3));
+    let cases = [
+        (4.0, 6.0, DeMethod::Jacobian, Precision::F64, None, false),
+        (100.0, 10.0, DeMethod::Jacobian, Precision::F64, None, false),
+        (4.0, 6.0, DeMethod::Jacobian, Precision::F32, None, false),
+        (4.0, 6.0, DeMethod::Analytic, Precision::F64, julia, false),
+        (
+            100.0,
+            10.0,
+            DeMethod::Potential,
+            Precision::F64,
+            julia,
+            false,
+        ),
+        (
+            2.0,
+            3.0,
+            DeMethod::EscapeLength,
+            Precision::F32,
+            julia,
+            false,
+        ),
+        (4.0, 6.0, DeMethod::Jacobian, Precision::F64, julia, false),
+        (4.0, 6.0, DeMethod::Analytic, Precision::F64, None, true),
+        (100.0, 10.0, DeMethod::Analytic, Precision::F64, None, true),
+        (4.0, 6.0, DeMethod::Analytic, Precision::F64, julia, true),
+    ];
+    for (bailout, radius, de, precision, julia, confirm_hits) in cases {
+        let f = bulb(bailout, de, precision, julia);
+        let (deepest, hits) = deepest_pass_through_with(&f, radius, confirm_hits);
+        let case = format!("{f:?} inside {radius}, confirming hits: {confirm_hits}");
+        assert!(hits > 50, "{case}: {hits} hits");
+        assert!(
+            deepest == 0.0,
+            "{case}: a hit {deepest:.2} footprints past the set"
         );
     }
 }
