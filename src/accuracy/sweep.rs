@@ -128,8 +128,9 @@ pub fn variants(scene: &Scene) -> Vec<Variant> {
     out
 }
 
-/// `variants` of `scene` that a frame at `size` can tell apart from the
-/// scene itself, each saying where it renders in f64 instead of f32.
+/// `variants` of `scene` for a frame at `size`: perturbation only where
+/// the frame is deep, `confirm_hits` only where the check can run, and
+/// each saying where it renders in f64 instead of f32.
 pub fn sweep_for(scene: &Scene, size: [u32; 2]) -> Vec<Variant> {
     // Perturbation is a knob only where the frame is deep.
     let deep = crate::deep::needed(scene, size)

@@ -52,9 +52,10 @@ pub fn deep_steps(s: &crate::scene::Scene, size: [u32; 2]) -> crate::scene::Scen
 /// last step and bisection (about 1 100 at most) and a normal; each
 /// light's shadow march; every occlusion sample; each bounce's march,
 /// normal and march towards each light. Gradient estimators take five
-/// orbits an estimate.
+/// orbits an estimate; checking hits (`confirm_hits`) four more a step.
 pub fn worst_orbits_per_sample(s: &crate::scene::Scene) -> u64 {
-    let march = s.quality.max_steps as u64 + 1_200 + 6;
+    let checks = if s.quality.confirm_hits { 5 } else { 1 };
+    let march = (s.quality.max_steps as u64 + 1_200 + 6) * checks;
     let lights = 1 + s.look.extra_lights.len() as u64;
     let e = &s.effects;
     let shadows = e

@@ -167,7 +167,9 @@ pub struct MarchResult {
     /// Smallest estimate along the ray, in pixel footprints (∞ when nothing
     /// was estimated): how near a miss came, for glow.
     pub closest: Real,
-    /// The march ran out of `max_steps` and its hit is where it stopped.
+    /// The march ran out of `max_steps`; its hit is the nearest point it
+    /// had under the threshold, else the hit that failed its check
+    /// (`confirm_hits`), else where it stopped.
     pub out_of_steps: bool,
 }
 
@@ -236,8 +238,8 @@ struct Marcher {
     /// Set when a hit failed its check: until the estimate rises over the
     /// threshold again, only a `REFINED` estimate stops the ray.
     passing: bool,
-    /// The first hit that failed its check: where a ray that runs out of
-    /// steps after it stops, rather than wherever it has crept to.
+    /// The first hit that failed its check: a ray that then runs out of
+    /// steps stops there, or at a later `nearest`, not wherever it crept to.
     grazed: Option<(Real, Estimate)>,
 }
 
@@ -252,6 +254,10 @@ struct Check {
     resume: Real,
 }
 
+/// Bumped whenever a change alters the frames of scenes that check hits
+/// (`confirm_hits`), so resume re-renders those and no others.
+pub const CONFIRM_REVISION: u32 = 1;
+
 /// The offset along each axis of the potential check's stencil points, in
 /// footprints of the hit.
 const STENCIL: Real = 0.25;
@@ -259,7 +265,7 @@ const STENCIL: Real = 0.25;
 /// Whether the potential check's stencil around `point`, a `footprint`
 /// wide, stands above f64's noise there (the potential estimator's own
 /// floor), so a hit there can be checked (`MarchSettings::confirm_hits`).
-pub fn check_resolves(footprint: Real, point: DVec3) -> bool {
+pub(crate) fn check_resolves(footprint: Real, point: DVec3) -> bool {
     STENCIL * footprint > Real::EPSILON.sqrt() * point.length().max(1e-3)
 }
 
@@ -374,7 +380,8 @@ impl Marcher {
         let footprint = self.ray.footprint(t);
         let resolved = check_resolves(footprint, self.ray.at(t));
         let coarse = estimate.distance >= REFINED * settings.hit_threshold * footprint;
-        // At the last step the check could only confirm the hit.
+        // A check failed at the last step would stop, out of steps, at
+        // this same hit: skip its four orbits.
         let last = self.steps >= settings.max_steps;
         if self.passing || last || !coarse || !resolved || !fractal.checks_hits() {
             return Some(self.hit(t, estimate));

@@ -62,6 +62,10 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         /// Only where f32 was asked for and f64 renders (`deep::f32_too_coarse`).
         #[serde(skip_serializing_if = "std::ops::Not::not")]
         f32_in_f64: bool,
+        /// Only where hits are checked (`MarchSettings::confirm_hits`), so
+        /// that the check's frames go stale when it changes and others do not.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        confirm: Option<u32>,
     }
     let deep = scenes
         .iter()
@@ -77,6 +81,10 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         f32_in_f64: scenes
             .iter()
             .any(|s| crate::deep::f32_too_coarse(s, [width, height])),
+        confirm: scenes
+            .iter()
+            .any(|s| s.quality.confirm_hits)
+            .then_some(crate::march::CONFIRM_REVISION),
     };
     let json = serde_json::to_vec(&inputs).expect("a scene of plain numbers always serialises");
     let digest = Sha256::digest(&json);

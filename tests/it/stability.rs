@@ -434,12 +434,17 @@ fn bulb(bailout: f64, de: DeMethod, precision: Precision, julia: Option<DVec3>) 
 /// 24×14 grid of the far camera's passes before its hit (`past_the_set` at a
 /// 64th of a footprint), and the number of hits.
 fn deepest_pass_through(fractal: &Fractal, radius: f64) -> (f64, usize) {
-    deepest_pass_through_with(fractal, radius, false)
+    let (deepest, hits, _) = deepest_pass_through_with(fractal, radius, false);
+    (deepest, hits)
 }
 
 /// `deepest_pass_through`, with hits checked by the potential estimate
-/// where `confirm_hits` says.
-fn deepest_pass_through_with(fractal: &Fractal, radius: f64, confirm_hits: bool) -> (f64, usize) {
+/// where `confirm_hits` says, and the orbits the marches took.
+fn deepest_pass_through_with(
+    fractal: &Fractal,
+    radius: f64,
+    confirm_hits: bool,
+) -> (f64, usize, u64) {
     let settings = MarchSettings {
         bounding_radius: radius,
         confirm_hits,
@@ -447,18 +452,20 @@ fn deepest_pass_through_with(fractal: &Fractal, radius: f64, confirm_hits: bool)
     };
     let frame = far_camera().frame();
     let (w, h) = (24, 14);
-    let (mut deepest, mut hits) = (0.0f64, 0);
+    let (mut deepest, mut hits, mut orbits) = (0.0f64, 0, 0);
     for y in 0..h {
         for x in 0..w {
             let ray = frame.ray(x as f64 + 0.5, y as f64 + 0.5, w, h);
-            if let Some(hit) = march(&ray, fractal, &settings).hit {
+            let m = march(&ray, fractal, &settings);
+            orbits += u64::from(m.evaluations);
+            if let Some(hit) = m.hit {
                 hits += 1;
                 let past = past_the_set(fractal, &settings, &ray, hit.t, 1.0 / 64.0);
                 deepest = deepest.max(past);
             }
         }
     }
-    (deepest, hits)
+    (deepest, hits, orbits)
 }
 
 #[test]
@@ -527,9 +534,14 @@ fn no_ray_passes_through_the_set_by_jacobian_in_julia_mode_or_confirming_hits() 
     ];
     for (bailout, radius, de, precision, julia, confirm_hits) in cases {
         let f = bulb(bailout, de, precision, julia);
-        let (deepest, hits) = deepest_pass_through_with(&f, radius, confirm_hits);
+        let (deepest, hits, orbits) = deepest_pass_through_with(&f, radius, confirm_hits);
         let case = format!("{f:?} inside {radius}, confirming hits: {confirm_hits}");
         assert!(hits > 50, "{case}: {hits} hits");
+        if confirm_hits {
+            // The check ran: it takes four orbits a checked hit.
+            let (_, _, unchecked) = deepest_pass_through_with(&f, radius, false);
+            assert!(orbits > unchecked, "{case}: no hit checked");
+        }
         assert!(
             deepest == 0.0,
             "{case}: a hit {deepest:.2} footprints past the set"

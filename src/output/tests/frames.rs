@@ -46,6 +46,38 @@ fn hash_changes_with_any_input() {
 }
 
 #[test]
+fn checking_hits_adds_its_revision_to_the_hash_and_other_frames_keep_theirs() {
+    use sha2::{Digest, Sha256};
+    // The digest of the inputs as the hash writes them, with `extra`
+    // fields after the scenes.
+    let digest = |s: &Scene, extra: &str| {
+        let json = format!(
+            r#"{{"renderer":"{}","revision":{},"frame_index":0,"width":4,"height":3,"scenes":{}{extra}}}"#,
+            env!("CARGO_PKG_VERSION"),
+            crate::RENDERER_REVISION,
+            serde_json::to_string(std::slice::from_ref(s)).unwrap()
+        );
+        let digest = Sha256::digest(json.as_bytes());
+        digest
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect::<String>()
+    };
+    let off = Scene::default();
+    assert_eq!(
+        frame_hash(std::slice::from_ref(&off), 0, 4, 3),
+        digest(&off, "")
+    );
+    let mut on = off.clone();
+    on.quality.confirm_hits = true;
+    let revision = format!(r#","confirm":{}"#, crate::march::CONFIRM_REVISION);
+    assert_eq!(
+        frame_hash(std::slice::from_ref(&on), 0, 4, 3),
+        digest(&on, &revision)
+    );
+}
+
+#[test]
 fn written_frames_carry_their_hash_and_leave_no_temporary() {
     let dir = tempfile::tempdir().unwrap();
     for format in [Format::Png, Format::Exr] {
