@@ -135,12 +135,13 @@ pub fn sweep_for(scene: &Scene, size: [u32; 2]) -> Vec<Variant> {
     // Perturbation is a knob only where the frame is deep.
     let deep = crate::deep::needed(scene, size)
         && crate::fractal::whole_power(scene.fractal.power).is_some();
-    // The potential check runs only where `Fractal::checks_hits` allows
+    // The potential check runs only where `Fractal::plain_analytic` allows
     // it, on rays that walk by the estimate, where its stencil resolves
     // (taken at the target, where the frame looks).
     let resolves =
         crate::march::check_resolves(crate::deep::footprint(scene, size), scene.camera.target);
-    let checkable = resolves && scene.fractal.checks_hits() && scene.quality.membership_step <= 0.0;
+    let checkable =
+        resolves && scene.fractal.plain_analytic() && scene.quality.membership_step <= 0.0;
     variants(scene)
         .into_iter()
         .filter(|v| deep || v.knob != "perturbation")

@@ -6,10 +6,10 @@ use super::{DeMethod, Estimate, Fractal, Precision, Triplex};
 use crate::math::{DVec3, Dual, Number, Real};
 
 impl Fractal {
-    /// Whether a hit can be checked by the potential estimate's stencil
-    /// (`MarchSettings::confirm_hits`): with the analytic estimator in
-    /// f64, outside a deep frame's offsets.
-    pub fn checks_hits(&self) -> bool {
+    /// The analytic estimator in f64 at world coordinates (no deep frame's
+    /// offsets): what the vector kernel runs, and where a hit can be checked
+    /// by the potential estimate's stencil (`MarchSettings::confirm_hits`).
+    pub fn plain_analytic(&self) -> bool {
         self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
     }
 

@@ -55,8 +55,7 @@ impl Fractal {
         if let Some(reference) = self.perturbed_analytic() {
             return reference.estimates_into(self, points, scales, out);
         }
-        if self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
-        {
+        if self.plain_analytic() {
             if let Some(n) = whole_power(self.power) {
                 self.in_vectors(points, n, out);
                 return self.bound_lanes(points, out);

@@ -383,7 +383,7 @@ impl Marcher {
         // A check failed at the last step would stop, out of steps, at
         // this same hit: skip its four orbits.
         let last = self.steps >= settings.max_steps;
-        if self.passing || last || !coarse || !resolved || !fractal.checks_hits() {
+        if self.passing || last || !coarse || !resolved || !fractal.plain_analytic() {
             return Some(self.hit(t, estimate));
         }
         self.check = Some(Check {
