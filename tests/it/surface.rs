@@ -92,10 +92,7 @@ fn confirmed_hits_on_a_late_zoom_frame_leave_fewer_hits_far_from_the_set() {
             deepest,
         )
     };
-    let (before, n_before, median_before) = {
-        let (far, n, median, _) = judge(&scene);
-        (far, n, median)
-    };
+    let (before, n_before, median_before, _) = judge(&scene);
     scene.quality.confirm_hits = true;
     let (after, n_after, median_after, deepest) = judge(&scene);
     let counts = format!(
