@@ -54,8 +54,10 @@ pub fn deep_steps(s: &crate::scene::Scene, size: [u32; 2]) -> crate::scene::Scen
 /// normal and march towards each light. Gradient estimators take five
 /// orbits an estimate; checking hits (`confirm_hits`) four more a step.
 pub fn worst_orbits_per_sample(s: &crate::scene::Scene) -> u64 {
-    let checks = if s.quality.confirm_hits { 5 } else { 1 };
-    let march = (s.quality.max_steps as u64 + 1_200 + 6) * checks;
+    // At most one check a step: a ray that failed one takes a step before
+    // the next, and a bisected hit is not checked.
+    let check = if s.quality.confirm_hits { 4 } else { 0 };
+    let march = s.quality.max_steps as u64 * (1 + check) + 1_200 + 6;
     let lights = 1 + s.look.extra_lights.len() as u64;
     let e = &s.effects;
     let shadows = e
@@ -166,5 +168,15 @@ mod tests {
             let (tw, th) = thumbnail_size(w, h, PROBE_SIDE);
             assert!((1..=PROBE_SIDE).contains(&tw) && (1..=PROBE_SIDE).contains(&th));
         }
+    }
+
+    #[test]
+    fn checking_hits_adds_four_orbits_a_step_to_the_worst_case_and_none_to_bisection() {
+        let mut s = crate::scene::Scene::default();
+        s.effects.path_tracing = None;
+        let off = worst_orbits_per_sample(&s);
+        s.quality.confirm_hits = true;
+        let on = worst_orbits_per_sample(&s);
+        assert_eq!(on - off, 4 * s.quality.max_steps as u64);
     }
 }
