@@ -60,6 +60,11 @@ impl Error {
         }
     }
 
+    /// True where a file that had to be new was already there.
+    pub fn is_already_exists(&self) -> bool {
+        matches!(self, Error::Io { cause, .. } if cause.kind() == std::io::ErrorKind::AlreadyExists)
+    }
+
     /// True for errors in the user's input (timeline or flags) rather than the machine.
     pub fn is_input_error(&self) -> bool {
         matches!(

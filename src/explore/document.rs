@@ -168,8 +168,7 @@ impl Document {
         }
         let path = self.folder.join(name);
         crate::output::atomic::write_new_text(&path, &self.text).map_err(|e| {
-            let exists = matches!(&e, crate::error::Error::Io { cause, .. } if cause.kind() == std::io::ErrorKind::AlreadyExists);
-            match exists {
+            match e.is_already_exists() {
                 true => format!(
                     "{} already exists: explore writes only its own timeline and new files",
                     path.display()

@@ -2,8 +2,8 @@
 //! folder take frames one at a time, with no server between them.
 //!
 //! A worker claims frame N by creating `.frame_0000N.claim` exclusively (the
-//! file system decides the one winner) holding its host, pid, a unique token
-//! and a heartbeat time, which a background thread refreshes while the frame
+//! file system decides the one winner), whole from its first instant,
+//! holding its host, pid, a unique token and a heartbeat time, which a background thread refreshes while the frame
 //! renders. A claim whose heartbeat is older than the timeout belongs to a dead
 //! worker; taking it over first needs `.frame_0000N.takeover-<its token>.0`,
 //! again created exclusively, so each dead claim is taken over exactly once.
@@ -278,17 +278,13 @@ pub fn try_claim(path: &Path, timeout: Duration) -> Result<Attempt> {
     let record = ClaimRecord::mine();
     let interval = timeout / 4;
     for _ in 0..3 {
-        // Created under the interrupt lock, with its release registered.
-        let created = {
-            let mut lock = crate::interrupt::hold();
-            let file = OpenOptions::new().write(true).create_new(true).open(&path);
-            file.map(|f| (f, lock.on_interrupt(releaser(&path, &record.token, &[]))))
-        };
-        match created {
-            Ok((mut file, release)) => {
-                let json = serde_json::to_string(&record).expect("serialises");
-                file.write_all(json.as_bytes())
-                    .map_err(|e| Error::io(&path, e))?;
+        // Its release registered first: an interrupt then removes it
+        // however far this got. Written whole through a temporary, so a
+        // worker killed here leaves no empty claim to wait out.
+        let release = released_on_interrupt(&path, &record.token, &[]);
+        let json = serde_json::to_string(&record).expect("serialises");
+        match crate::output::atomic::write_new_text(&path, &json) {
+            Ok(()) => {
                 return Ok(Attempt::Claimed(Claim::start(
                     path,
                     record,
@@ -298,8 +294,8 @@ pub fn try_claim(path: &Path, timeout: Duration) -> Result<Attempt> {
                     release,
                 )));
             }
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => {}
-            Err(e) => return Err(Error::io(&path, e)),
+            Err(e) if e.is_already_exists() => drop(release),
+            Err(e) => return Err(e),
         }
         let held = match read_claim(&path) {
             Some(held) => held,

@@ -220,3 +220,35 @@ fn heartbeat_keeps_a_long_claim_alive() {
     assert!(later.heartbeat_ms > first.heartbeat_ms);
     assert!(is_live(&later, timeout));
 }
+
+#[test]
+fn a_claim_appears_whole_never_empty() {
+    // A worker killed between creating its claim and filling it would
+    // leave an empty claim no one can name or see die: frames then wait
+    // out the whole timeout. A reader spinning on the path never sees one.
+    let dir = tempfile::tempdir().unwrap();
+    let timeout = Duration::from_secs(60);
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let rounds = 400;
+    let empty_seen = std::thread::scope(|s| {
+        let watcher = s.spawn(|| {
+            let mut empty = 0;
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                for frame in 0..rounds {
+                    let path = claim_path(dir.path(), frame);
+                    if std::fs::metadata(&path).is_ok_and(|m| m.len() == 0) {
+                        empty += 1;
+                    }
+                }
+            }
+            empty
+        });
+        let claims: Vec<_> = (0..rounds)
+            .map(|frame| try_claim(&claim_path(dir.path(), frame), timeout).unwrap())
+            .collect();
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        assert!(claims.iter().all(|c| matches!(c, Attempt::Claimed(_))));
+        watcher.join().unwrap()
+    });
+    assert_eq!(empty_seen, 0, "claims seen empty");
+}
