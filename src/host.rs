@@ -85,3 +85,18 @@ pub fn file_age(path: &Path) -> Option<std::time::Duration> {
         .elapsed()
         .ok()
 }
+
+/// Processor time this process has used, all threads, user and system, in
+/// seconds; `None` where the system does not say. Unlike the wall clock,
+/// it does not grow while other programs have the processors.
+pub fn cpu_seconds() -> Option<f64> {
+    #[cfg(unix)]
+    {
+        use nix::sys::resource::{getrusage, UsageWho};
+        let usage = getrusage(UsageWho::RUSAGE_SELF).ok()?;
+        let seconds = |t: nix::sys::time::TimeVal| t.tv_sec() as f64 + t.tv_usec() as f64 * 1e-6;
+        Some(seconds(usage.user_time()) + seconds(usage.system_time()))
+    }
+    #[cfg(not(unix))]
+    None
+}

@@ -17,8 +17,9 @@ const PROBE_WORST_ITERATIONS: u64 = 25_000_000;
 /// Orbit iterations a larger thumbnail may be expected to take, from the
 /// orbits the one before it took: about half a second on two cores.
 const PROBE_ITERATIONS: u64 = 30_000_000;
-/// Seconds a thumbnail may take for the next, four times as large, to be
-/// rendered: where orbits are slower than their weight says.
+/// Seconds a thumbnail may take, on all the pool's threads, for the next,
+/// four times as large, to be rendered: where orbits are slower than their
+/// weight says.
 const PROBE_STAGE_SECONDS: f64 = 0.1;
 
 /// Frame 0 rendered small by `cost_probe`, as declared (`with`) and with
@@ -119,16 +120,16 @@ pub fn cost_probe(t: &Timeline) -> Option<Probe> {
         crate::render::render_frame_into(&mut film, scenes, 0, w, h, layers, &|| {});
         film.stats
     };
-    let mut started = Instant::now();
+    let mut started = Stopwatch::start();
     let mut with = render(&scenes, side);
     while side < PROBE_SIDE {
         let grown = with.de_evaluations * pixels(side * 2) / pixels(side).max(1);
-        let slow = started.elapsed().as_secs_f64() > PROBE_STAGE_SECONDS;
+        let slow = started.seconds_per_thread() > PROBE_STAGE_SECONDS;
         if slow || grown.saturating_mul(iterations) > PROBE_ITERATIONS {
             break;
         }
         side *= 2;
-        started = Instant::now();
+        started = Stopwatch::start();
         with = render(&scenes, side);
     }
     let plain: Vec<_> = scenes
@@ -149,6 +150,30 @@ pub fn cost_probe(t: &Timeline) -> Option<Probe> {
         with,
         without: render(&plain, side),
     })
+}
+
+/// How long a thumbnail took: the processor time this process used, per
+/// thread of the pool, so that `info` sizes its thumbnail the same however
+/// busy the machine is; the wall clock where the system does not say.
+struct Stopwatch {
+    wall: Instant,
+    cpu: Option<f64>,
+}
+
+impl Stopwatch {
+    fn start() -> Stopwatch {
+        Stopwatch {
+            wall: Instant::now(),
+            cpu: crate::host::cpu_seconds(),
+        }
+    }
+
+    fn seconds_per_thread(&self) -> f64 {
+        match (self.cpu, crate::host::cpu_seconds()) {
+            (Some(then), Some(now)) => (now - then) / rayon::current_num_threads() as f64,
+            _ => self.wall.elapsed().as_secs_f64(),
+        }
+    }
 }
 
 #[cfg(test)]

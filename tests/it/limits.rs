@@ -180,6 +180,38 @@ fn info_measures_a_costly_frame_within_bounds_or_says_it_did_not() {
 }
 
 #[test]
+fn info_sizes_its_thumbnail_alike_on_a_busy_machine() {
+    // The thumbnail grew while each stage took under a tenth of a second
+    // of wall-clock time: with the processors shared, `info` measured a
+    // quarter of the pixels. Processor time per thread does not grow so.
+    let d = Dir::new();
+    let blurred = with_scene(
+        &tiny_timeline(1, 8.0),
+        "samples_per_pixel: 4096, effects: (motion_blur: ())",
+    );
+    d.write("blurred.ron", &blurred);
+    let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
+    let busy = std::sync::atomic::AtomicBool::new(true);
+    let out = std::thread::scope(|s| {
+        for _ in 0..3 * cores {
+            s.spawn(|| {
+                while busy.load(std::sync::atomic::Ordering::Relaxed) {
+                    std::hint::spin_loop();
+                }
+            });
+        }
+        let out = guarded(&d, &["info", "blurred.ron"]);
+        busy.store(false, std::sync::atomic::Ordering::Relaxed);
+        out
+    });
+    let text = stdout(&out);
+    assert!(
+        text.contains("cost:     frame 0 at 64x36 with 16 "),
+        "{text}"
+    );
+}
+
+#[test]
 fn info_looks_for_the_camera_inside_a_long_film_on_frames_spread_over_it() {
     // Inside the set every check takes all 10 000 iterations: a hundred
     // thousand frames were 1e9 iterations, tens of seconds. One frame in
