@@ -149,15 +149,18 @@ fn info_measures_tall_narrow_frames_on_a_thumbnail_of_their_shape() {
     );
 }
 
+/// A frame of 4096 motion-blurred samples a pixel: `info` measures 16.
+fn blurred_4096() -> String {
+    with_scene(
+        &tiny_timeline(1, 8.0),
+        "samples_per_pixel: 4096, effects: (motion_blur: ())",
+    )
+}
+
 #[test]
 fn info_measures_a_costly_frame_within_bounds_or_says_it_did_not() {
     let d = Dir::new();
-    // 4096 motion-blurred samples a pixel: 16 of them are measured.
-    let blurred = with_scene(
-        &tiny_timeline(1, 8.0),
-        "samples_per_pixel: 4096, effects: (motion_blur: ())",
-    );
-    d.write("blurred.ron", &blurred);
+    d.write("blurred.ron", &blurred_4096());
     let out = guarded(&d, &["info", "blurred.ron"]);
     let text = stdout(&out);
     assert!(
@@ -185,11 +188,7 @@ fn info_sizes_its_thumbnail_alike_on_a_busy_machine() {
     // of wall-clock time: with the processors shared, `info` measured a
     // quarter of the pixels. Processor time per thread does not grow so.
     let d = Dir::new();
-    let blurred = with_scene(
-        &tiny_timeline(1, 8.0),
-        "samples_per_pixel: 4096, effects: (motion_blur: ())",
-    );
-    d.write("blurred.ron", &blurred);
+    d.write("blurred.ron", &blurred_4096());
     let cores = std::thread::available_parallelism().map_or(2, |n| n.get());
     let busy = std::sync::atomic::AtomicBool::new(true);
     let out = std::thread::scope(|s| {
