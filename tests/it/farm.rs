@@ -512,7 +512,9 @@ fn a_worker_says_which_frames_it_waits_for_and_takes_them_after_the_timeout() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(2, 6.0));
     d.claim_elsewhere(1);
-    let out = d.ok(&["render", "t.ron", "--claim", "--claim-timeout", "2"]);
+    // Long enough that a loaded machine starts the worker and renders
+    // frame 0 before the claim on 1, beating when written, times out.
+    let out = d.ok(&["render", "t.ron", "--claim", "--claim-timeout", "6"]);
     let err = stderr(&out);
     assert!(
         err.contains("waiting for frame(s) 1 claimed by node7:42"),
@@ -546,8 +548,9 @@ fn the_waiting_line_names_only_frames_still_held_at_the_end_of_a_pass() {
         "render",
         "t.ron",
         "--claim",
+        // Room for a loaded machine to reach frames 0 and 1 while held.
         "--claim-timeout",
-        "3",
+        "8",
         "--checkpoint-seconds",
         "0",
         "--threads",
