@@ -2,9 +2,10 @@
 //! folder take frames one at a time, with no server between them.
 //!
 //! A worker claims frame N by creating `.frame_0000N.claim` exclusively (the
-//! file system decides the one winner), whole from its first instant,
-//! holding its host, pid, a unique token and a heartbeat time, which a background thread refreshes while the frame
-//! renders. A claim whose heartbeat is older than the timeout belongs to a dead
+//! file system decides the one winner), whole from its first instant where
+//! the file system can rename without replacing or link, holding its host,
+//! pid, a unique token and a heartbeat time, which a background thread
+//! refreshes while the frame renders. A claim whose heartbeat is older than the timeout belongs to a dead
 //! worker; taking it over first needs `.frame_0000N.takeover-<its token>.0`,
 //! again created exclusively, so each dead claim is taken over exactly once.
 //! A marker older than the timeout was left by a taker that died before
@@ -270,6 +271,24 @@ impl Drop for Claim {
     }
 }
 
+/// Creates the claim `path` holding `record`, with its release registered
+/// first (an interrupt then removes it however far this got); `None` where
+/// a claim is there. It is written whole through a temporary, so a worker
+/// killed here leaves no empty claim to wait out; where one is there
+/// already nothing is written, as workers look at held frames every second.
+fn create(path: &Path, record: &ClaimRecord) -> Result<Option<Registered>> {
+    if std::fs::symlink_metadata(path).is_ok() {
+        return Ok(None);
+    }
+    let release = released_on_interrupt(path, &record.token, &[]);
+    let json = serde_json::to_string(record).expect("a claim record always serialises");
+    match crate::output::atomic::write_new_text(path, &json) {
+        Ok(()) => Ok(Some(release)),
+        Err(e) if e.is_already_exists() => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 /// Tries to claim a frame by its claim file, `path` (`Plan::claim_path`).
 /// A claim older than `timeout` is taken over; the heartbeat is refreshed
 /// every quarter timeout.
@@ -277,25 +296,20 @@ pub fn try_claim(path: &Path, timeout: Duration) -> Result<Attempt> {
     let path = path.to_path_buf();
     let record = ClaimRecord::mine();
     let interval = timeout / 4;
+    let claimed = |release| {
+        let (path, record) = (path.clone(), record.clone());
+        Attempt::Claimed(Claim::start(
+            path,
+            record,
+            interval,
+            Vec::new(),
+            true,
+            release,
+        ))
+    };
     for _ in 0..3 {
-        // Its release registered first: an interrupt then removes it
-        // however far this got. Written whole through a temporary, so a
-        // worker killed here leaves no empty claim to wait out.
-        let release = released_on_interrupt(&path, &record.token, &[]);
-        let json = serde_json::to_string(&record).expect("serialises");
-        match crate::output::atomic::write_new_text(&path, &json) {
-            Ok(()) => {
-                return Ok(Attempt::Claimed(Claim::start(
-                    path,
-                    record,
-                    interval,
-                    Vec::new(),
-                    true,
-                    release,
-                )));
-            }
-            Err(e) if e.is_already_exists() => drop(release),
-            Err(e) => return Err(e),
+        if let Some(release) = create(&path, &record)? {
+            return Ok(claimed(release));
         }
         let held = match read_claim(&path) {
             Some(held) => held,
@@ -324,6 +338,11 @@ pub fn try_claim(path: &Path, timeout: Duration) -> Result<Attempt> {
                 }
             }
         };
+        if held.token == record.token {
+            // Ours after all: NFS may answer a link retried after it was
+            // made with "exists".
+            return Ok(claimed(released_on_interrupt(&path, &record.token, &[])));
+        }
         if is_live(&held, timeout) {
             return Ok(Attempt::Held(held));
         }

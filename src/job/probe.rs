@@ -153,8 +153,9 @@ pub fn cost_probe(t: &Timeline) -> Option<Probe> {
 }
 
 /// How long a thumbnail took: the processor time this process used, per
-/// thread of the pool, so that `info` sizes its thumbnail the same however
-/// busy the machine is; the wall clock where the system does not say.
+/// thread of the pool (a tiny thumbnail that leaves threads idle reads
+/// short), so that other programs' load barely moves `info`'s thumbnail;
+/// the wall clock where the system does not say.
 struct Stopwatch {
     wall: Instant,
     cpu: Option<f64>,
