@@ -172,13 +172,17 @@ pub fn write_frame(
 }
 
 /// Frames of `names` a live writer is working on: those with a temporary
-/// file (frame, claim or checkpoint) that is not stale.
+/// file of a frame or checkpoint that is not stale.
 pub fn frames_being_written(dir: &Path, names: &FrameName) -> std::collections::HashSet<u32> {
     super::atomic::partials(dir)
         .unwrap_or_default()
         .into_iter()
         .filter(|(_, _, stale)| !stale)
-        .filter_map(|(_, name, _)| names.frame_of_hidden(&name))
+        .filter_map(|(_, name, _)| names.hidden_kind(&name))
+        // A claim's temporary says nothing of pixels: the claim itself,
+        // once there, says whether the frame is in progress.
+        .filter(|&(_, kind)| kind != "claim")
+        .map(|(frame, _)| frame)
         .collect()
 }
 

@@ -108,6 +108,12 @@ impl FrameName {
     /// The frame a hidden file or temporary of these frames is for
     /// (`.shot_0042.png.<writer>.partial`, `.shot_0042.ckpt`, …).
     pub fn frame_of_hidden(&self, name: &str) -> Option<u32> {
+        self.hidden_kind(name).map(|(frame, _)| frame)
+    }
+
+    /// `frame_of_hidden`, with the kind of file it is or stands in for
+    /// (`png`, `exr`, `ckpt` or `claim`).
+    pub fn hidden_kind(&self, name: &str) -> Option<(u32, &'static str)> {
         let name = name.strip_prefix('.')?;
         let rest = name.strip_prefix(&self.prefix)?;
         let end = rest
@@ -120,7 +126,7 @@ impl FrameName {
             kind.strip_prefix(k)
                 .is_some_and(|t| t.is_empty() || t.starts_with('.'))
         };
-        KINDS.into_iter().any(ours).then_some(frame)
+        KINDS.into_iter().find(|&k| ours(k)).map(|k| (frame, k))
     }
 
     /// `number` as a frame, if this pattern names that frame `stem`.

@@ -88,6 +88,22 @@ fn thirty_random_kills_then_resume_match_an_uninterrupted_render() {
 }
 
 #[test]
+fn a_claims_leftover_temporary_does_not_mark_its_frame_in_progress() {
+    // A worker on another machine killed while writing its claim leaves
+    // the claim's temporary and no claim: nobody holds the frame.
+    let d = Dir::new();
+    d.write("t.ron", &tiny_timeline(2, 6.0));
+    std::fs::create_dir_all(d.path().join("out/t")).unwrap();
+    d.write("out/t/.frame_00001.claim.node7.42.Ab12Cd.partial", "{");
+    let (_, v) = d.status_json(&["t.ron"]);
+    assert_eq!(v["states"]["missing"], serde_json::json!([0, 1]), "{v}");
+    // A frame's own temporary still says a writer is finishing it.
+    d.write("out/t/.frame_00001.png.node7.42.Ab12Cd.partial", "half");
+    let (_, v) = d.status_json(&["t.ron"]);
+    assert_eq!(v["states"]["in_progress"], serde_json::json!([1]), "{v}");
+}
+
+#[test]
 fn status_reports_complete_stale_missing_and_in_progress() {
     let d = Dir::new();
     d.write("t.ron", &tiny_timeline(6, 6.0));
