@@ -5,9 +5,9 @@
 //! file system decides the one winner), whole from its first instant where
 //! the file system can rename without replacing or link, holding its host,
 //! pid, a unique token and a heartbeat time, which a background thread
-//! refreshes while the frame renders. A claim whose heartbeat is older than the timeout belongs to a dead
-//! worker; taking it over first needs `.frame_0000N.takeover-<its token>.0`,
-//! again created exclusively, so each dead claim is taken over exactly once.
+//! refreshes while the frame renders. A claim whose heartbeat is older than
+//! the timeout belongs to a dead worker; taking it over first needs
+//! `.frame_0000N.takeover-<its token>.0`, again created exclusively, so each dead claim is taken over exactly once.
 //! A marker older than the timeout was left by a taker that died before
 //! writing its claim; the next generation's marker (`.1`, …) decides then.
 //! Markers are never deleted while a takeover may be deciding, so no two
