@@ -34,6 +34,12 @@ pub fn f32_too_coarse(scene: &Scene, size: [u32; 2]) -> bool {
         && resolution(scene, size) < F32_RESOLVES
 }
 
+/// Whether the frame of `scene` at `size` renders in f32: asked for, and
+/// not finer than f32 resolves.
+pub fn renders_in_f32(scene: &Scene, size: [u32; 2]) -> bool {
+    scene.fractal.precision == crate::fractal::Precision::F32 && !f32_too_coarse(scene, size)
+}
+
 /// The closest a camera may come to its target: a frame's offsets are f64,
 /// whose normal range ends at 2.2e-308, and a pixel there must keep a few
 /// decades above that for its sub-pixel steps (normals, hit thresholds).

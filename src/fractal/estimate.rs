@@ -10,7 +10,14 @@ impl Fractal {
     /// offsets): what the vector kernel runs, and where a hit can be checked
     /// by the potential estimate's stencil (`MarchSettings::confirm_hits`).
     pub fn plain_analytic(&self) -> bool {
-        self.de == DeMethod::Analytic && self.precision == Precision::F64 && self.deep.is_none()
+        self.lane_analytic() == Some(Precision::F64)
+    }
+
+    /// The precision the vector kernel runs this fractal's analytic
+    /// estimates in at world coordinates (f64 or f32); `None` for other
+    /// estimators and deep frames.
+    pub(super) fn lane_analytic(&self) -> Option<Precision> {
+        (self.de == DeMethod::Analytic && self.deep.is_none()).then_some(self.precision)
     }
 
     /// The radius past which an orbit counts as escaped in `T`: `bailout`,

@@ -1,6 +1,6 @@
-//! The vector kernel: 16 orbits side by side in SIMD registers (pulp),
-//! each lane bit-identical to the scalar orbit, finished into analytic
-//! estimates in the registers.
+//! The vector kernel: 16 orbits side by side in SIMD registers (pulp), in
+//! f64 or f32, each lane bit-identical to the scalar orbit, finished into
+//! analytic estimates in the registers.
 
 use super::estimate::{distance_to_ball, no_bound_applies};
 #[cfg(test)]
@@ -10,7 +10,9 @@ use super::power::{
     length_squared, powi, triplex_power_int_unchecked, triplex_power_trig, whole_power,
 };
 use super::{DeMethod, Estimate, Formula, Fractal, OrbitTraps, Precision, Triplex};
-use crate::math::{Arith, DVec3, Real, Vector};
+pub(super) use crate::math::Stored;
+use crate::math::{Arith, DVec3, Lane, Number, Real, Stored32, Vector};
+use std::marker::PhantomData;
 
 impl Fractal {
     /// `N` orbits (Mandelbrot or Julia, stopping at the bailout) iterated
@@ -26,7 +28,7 @@ impl Fractal {
     ) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
         let mut out = [Orbit::IDLE; N];
-        self.in_vectors(&points, n, &mut out);
+        self.in_vectors::<N, f64, _>(&points, n, &mut out);
         Some(out)
     }
 
@@ -55,11 +57,17 @@ impl Fractal {
         if let Some(reference) = self.perturbed_analytic() {
             return reference.estimates_into(self, points, scales, out);
         }
-        if self.plain_analytic() {
-            if let Some(n) = whole_power(self.power) {
-                self.in_vectors(points, n, out);
-                return self.bound_lanes(points, out);
-            }
+        if let (Some(precision), Some(n)) = (self.lane_analytic(), whole_power(self.power)) {
+            return match precision {
+                Precision::F64 => {
+                    self.in_vectors::<N, f64, _>(points, n, out);
+                    self.bound_lanes::<f64>(points, out)
+                }
+                Precision::F32 => {
+                    self.in_vectors::<N, f32, _>(points, n, out);
+                    self.bound_lanes::<f32>(points, out)
+                }
+            };
         }
         for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
             *out = self.estimate(p, scale);
@@ -69,14 +77,14 @@ impl Fractal {
     /// The bounds `estimate` puts on its estimator (`bounded`), on the
     /// vector kernel's estimates, outside the kernel: a cheap test but for
     /// the rare lane a bound applies to.
-    pub(super) fn bound_lanes(&self, points: &[DVec3], out: &mut [Estimate]) {
+    pub(super) fn bound_lanes<T: Number>(&self, points: &[DVec3], out: &mut [Estimate]) {
         // `bounded`'s own first test, worked out once for all lanes.
-        let near = self.escape_radius::<f64>().min(2.0);
+        let near = self.escape_radius::<T>().min(2.0);
         let critical = self.julia.is_some();
         for (out, &p) in out.iter_mut().zip(points) {
             if out.escaped && !no_bound_applies(p, out.iterations, near, critical, out.distance) {
                 let (distance, orbits) =
-                    self.bounded::<f64>(p, 0.0, out.distance, out.iterations, true);
+                    self.bounded::<T>(p, 0.0, out.distance, out.iterations, true);
                 out.distance = distance;
                 out.orbits += orbits;
             }
@@ -88,34 +96,35 @@ impl Fractal {
     /// (lanes past the points start outside the bailout ball and cost no
     /// iterations), with the iterations counted for this thread.
     #[inline(always)]
-    pub(super) fn in_vectors<const N: usize, Out: Finished>(
+    pub(super) fn in_vectors<const N: usize, E: KernelLane, Out: Finished>(
         &self,
         points: &[DVec3; N],
         n: u32,
         out: &mut [Out; N],
     ) {
-        let arch = pulp::Arch::new();
         for (chunk, out) in points.chunks(VECTOR).zip(out.chunks_mut(VECTOR)) {
             // Chunks of points and of results have the same lengths.
             if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
                 let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
-                arch.dispatch(Kernel {
+                E::dispatch(Kernel::<E, Out> {
                     fractal: self,
                     points: lanes,
                     live: VECTOR,
                     n,
                     out: full,
+                    lane: PhantomData,
                 });
             } else {
                 let lanes: [DVec3; VECTOR] =
                     std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
                 let mut full = [Out::IDLE; VECTOR];
-                arch.dispatch(Kernel {
+                E::dispatch(Kernel::<E, Out> {
                     fractal: self,
                     points: &lanes,
                     live: chunk.len(),
                     n,
                     out: &mut full,
+                    lane: PhantomData,
                 });
                 out.copy_from_slice(&full[..out.len()]);
             }
@@ -133,36 +142,13 @@ pub const IDLE_POINT: DVec3 = DVec3::splat(Real::MAX);
 /// f64 in flight at once (with AVX2, two registers of four at a time, twice).
 pub const VECTOR: usize = 16;
 
-/// The most f64 lanes one register has (AVX-512's eight).
+/// The most f64 lanes one register has (AVX-512's eight), as `Stored` holds.
 pub(super) const REGISTER: usize = VECTOR / 2;
+const _: () = assert!(std::mem::size_of::<Stored>() == REGISTER * 8);
 
-/// One register's lanes in memory (the first `S::F64_LANES` used), aligned
-/// to a whole cache line so that moving a 512-bit register to or from it
-/// never splits across two lines, wherever the stack happens to be.
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-pub(super) struct Stored([f64; REGISTER]);
-
-impl Stored {
-    pub(super) const ZERO: Stored = Stored([0.0; REGISTER]);
-}
-
-impl std::ops::Deref for Stored {
-    type Target = [f64; REGISTER];
-    fn deref(&self) -> &[f64; REGISTER] {
-        &self.0
-    }
-}
-
-impl std::ops::DerefMut for Stored {
-    fn deref_mut(&mut self) -> &mut [f64; REGISTER] {
-        &mut self.0
-    }
-}
-
-/// The vector kernel: `VECTOR` orbits of a whole power `n`, compiled for
-/// each instruction set and picked at run time by the processor (pulp's
-/// `Arch`: AVX-512, AVX2 with FMA, or plain scalar code), so one binary runs
+/// The vector kernel: `VECTOR` orbits of a whole power `n` in `E` (f64 or
+/// f32), compiled for each instruction set and picked at run time by the
+/// processor (`KernelLane::dispatch`), so one binary runs
 /// everywhere and uses the widest registers it finds. Each operation is
 /// written out as the vector instruction it is, so the speed does not rest
 /// on the compiler vectorising; Rust never fuses a multiply and an add
@@ -173,16 +159,17 @@ impl std::ops::DerefMut for Stored {
 /// register of nothing but padding is loaded but neither iterated nor
 /// finished, its results left as they were (`Finished::IDLE` from
 /// `in_vectors`).
-pub(super) struct Kernel<'a, Out> {
+pub(super) struct Kernel<'a, E, Out> {
     pub(super) fractal: &'a Fractal,
     pub(super) points: &'a [DVec3; VECTOR],
     pub(super) live: usize,
     /// The whole power.
     pub(super) n: u32,
     pub(super) out: &'a mut [Out; VECTOR],
+    pub(super) lane: PhantomData<E>,
 }
 
-impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
+impl<E: KernelLane, Out: Finished> pulp::WithSimd for Kernel<'_, E, Out> {
     type Output = ();
 
     #[inline(always)]
@@ -193,8 +180,9 @@ impl<Out: Finished> pulp::WithSimd for Kernel<'_, Out> {
             live,
             n,
             out,
+            lane: _,
         } = self;
-        run_vector(simd, fractal, points, live, n, out)
+        run_vector::<S, E, Out>(simd, fractal, points, live, n, out)
     }
 }
 
@@ -204,11 +192,13 @@ pub(super) trait Finished: Copy {
     const IDLE: Self;
     /// The orbit iterations this result took.
     fn iterations(&self) -> u32;
+    /// `escape` is the escape radius the orbits stopped at.
     fn write<S: pulp::Simd>(
         register: &Register<S>,
         fractal: &Fractal,
         points: &[DVec3],
         out: &mut [Self],
+        escape: Real,
     );
 }
 
@@ -221,11 +211,12 @@ impl Finished for Orbit<f64> {
     #[inline(always)]
     fn write<S: pulp::Simd>(
         register: &Register<S>,
-        fractal: &Fractal,
+        _: &Fractal,
         _: &[DVec3],
         out: &mut [Self],
+        escape: Real,
     ) {
-        register.finish(fractal, out)
+        register.finish(out, escape)
     }
 }
 
@@ -240,8 +231,113 @@ impl Finished for Estimate {
         fractal: &Fractal,
         points: &[DVec3],
         out: &mut [Self],
+        escape: Real,
     ) {
-        register.estimates(fractal, points, out)
+        register.estimates(fractal, points, out, escape)
+    }
+}
+
+/// A float the kernel iterates orbits in: f64, whose registers are finished
+/// as they are, or f32, whose lanes are widened to f64 (exactly) first, as
+/// the scalar f32 estimate finishes in f64.
+pub(super) trait KernelLane: Lane + Number {
+    /// Runs `op` with the instruction set this float's kernel uses.
+    fn dispatch<Op: pulp::WithSimd<Output = ()>>(op: Op);
+    fn write<S: pulp::Simd, Out: Finished>(
+        register: &Register<S, Self>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Out],
+        escape: Real,
+    );
+}
+
+impl KernelLane for f64 {
+    #[inline(always)]
+    fn dispatch<Op: pulp::WithSimd<Output = ()>>(op: Op) {
+        pulp::Arch::new().dispatch(op)
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd, Out: Finished>(
+        register: &Register<S>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Out],
+        escape: Real,
+    ) {
+        Out::write(register, fractal, points, out, escape)
+    }
+}
+
+impl KernelLane for f32 {
+    /// AVX2's registers of eight f32 where the processor has them (AVX-512's
+    /// sixteen would hold a whole call in one register, leaving nothing to
+    /// overlap its square roots with), else one lane at a time.
+    #[inline(always)]
+    fn dispatch<Op: pulp::WithSimd<Output = ()>>(op: Op) {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(simd) = pulp::x86::V3::try_new() {
+            return pulp::Simd::vectorize(simd, op);
+        }
+        pulp::Simd::vectorize(pulp::Scalar::new(), op)
+    }
+    #[inline(always)]
+    fn write<S: pulp::Simd, Out: Finished>(
+        register: &Register<S, f32>,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Out],
+        escape: Real,
+    ) {
+        let wide = S::F64_LANES;
+        for (k, (points, out)) in points.chunks(wide).zip(out.chunks_mut(wide)).enumerate() {
+            Out::write(&register.widened(k * wide), fractal, points, out, escape);
+        }
+    }
+}
+
+/// Lanes `from..` of an f32 register as a register of f64, exactly.
+#[inline(always)]
+fn widen<S: pulp::Simd>(simd: S, v: Vector<S, f32>, from: usize) -> Vector<S> {
+    let narrow: Stored32 = Register::<S, f32>::store(v);
+    let mut wide = Stored::ZERO;
+    for (w, &x) in wide.iter_mut().zip(&narrow.0[from..]) {
+        *w = x as f64;
+    }
+    Register::<S>::load(simd, &wide)
+}
+
+impl<S: pulp::Simd> Register<S, f32> {
+    /// Lanes `from..` as a register of f64 to finish: its orbits' state
+    /// widened exactly (`c` is left as `z`: a widened register is not
+    /// iterated again).
+    #[inline(always)]
+    fn widened(&self, from: usize) -> Register<S> {
+        let simd = self.simd;
+        let z = [
+            widen(simd, self.z[0], from),
+            widen(simd, self.z[1], from),
+            widen(simd, self.z[2], from),
+        ];
+        let planes = [
+            widen(simd, self.planes[0], from),
+            widen(simd, self.planes[1], from),
+            widen(simd, self.planes[2], from),
+        ];
+        let i = widen(simd, self.i, from);
+        Register {
+            simd,
+            z,
+            c: z,
+            plus_one: self.plus_one,
+            r2: widen(simd, self.r2, from),
+            r: widen(simd, self.r, from),
+            dr: widen(simd, self.dr, from),
+            origin: widen(simd, self.origin, from),
+            planes,
+            i,
+            running: simd.equal_f64s(i.1, i.1),
+        }
     }
 }
 
@@ -249,7 +345,7 @@ impl Finished for Estimate {
 /// register, with its points, writes its lanes' results (`Finished::write`).
 /// Registers past `live` are skipped.
 #[inline(always)]
-pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
+pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3; VECTOR],
@@ -257,9 +353,13 @@ pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
     n: u32,
     out: &mut [Out; VECTOR],
 ) {
-    // Registers are stored in `Stored` arrays of `REGISTER` lanes.
+    // Registers are stored in `Stored` arrays of `REGISTER` f64 lanes.
     const { assert!(S::F64_LANES >= 1 && S::F64_LANES <= REGISTER) };
-    let lanes = S::F64_LANES;
+    let lanes = E::lanes::<S>();
+    // Two registers of `E` in one call (`KernelLane::dispatch` keeps f32
+    // to registers of eight).
+    assert!(lanes >= 1 && 2 * lanes <= VECTOR);
+    let escape = fractal.escape_radius::<E>();
     // Two registers at a time: their dependency chains are independent,
     // so the processor overlaps one's square roots and division with
     // the other's multiplications instead of waiting.
@@ -289,30 +389,31 @@ pub(super) fn run_vector<S: pulp::Simd, Out: Finished>(
             (Formula::Quaternion, n) => orbit_registers(simd, f, points, n, Formula::Quaternion),
         };
         let (first, second) = out.split_at_mut(lanes);
-        Out::write(&a, f, &points[..lanes], first);
+        E::write(&a, f, &points[..lanes], first, escape);
         // A second register of padding alone has stayed where it started.
         if live > (2 * pair + 1) * lanes {
-            Out::write(&b, f, &points[lanes..], second);
+            E::write(&b, f, &points[lanes..], second, escape);
         }
     }
 }
 
 /// Two registers of orbits iterated in one loop (see `Register`).
 #[inline(always)]
-pub(super) fn orbit_registers<S: pulp::Simd>(
+pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3],
     n: u32,
     formula: Formula,
-) -> (Register<S>, Register<S>) {
+) -> (Register<S, E>, Register<S, E>) {
     let lanes = points.len() / 2;
     let mut a = Register::start(simd, fractal, &points[..lanes]);
     let mut b = Register::start(simd, fractal, &points[lanes..]);
     // Worked out once: the escape test runs every iteration.
-    let escape2 = fractal.escape_radius::<f64>().powi(2);
+    let escape = fractal.escape_radius::<E>();
+    let bound = E::escape_bound(escape * escape);
     for _ in 0..fractal.iterations {
-        let (run_a, run_b) = (a.check(escape2), b.check(escape2));
+        let (run_a, run_b) = (a.check(bound), b.check(bound));
         if !(run_a || run_b) {
             break;
         }
@@ -326,59 +427,67 @@ pub(super) fn orbit_registers<S: pulp::Simd>(
     (a, b)
 }
 
-/// One register of orbits: `OrbitState` on `Vector`s, each lane's state
-/// frozen by selection once it has escaped. Lanes near the pole axis take
-/// the trigonometric form one at a time, as `whole_power_step` does.
+/// One register of orbits: `OrbitState` on `Vector`s of f64 or f32, each
+/// lane's state frozen by selection once it has escaped. Lanes near the
+/// pole axis take the trigonometric form one at a time, as
+/// `whole_power_step` does.
 #[derive(Clone, Copy)]
-pub(super) struct Register<S: pulp::Simd> {
+pub(super) struct Register<S: pulp::Simd, E: Lane = f64> {
     simd: S,
-    z: Triplex<Vector<S>>,
-    c: Triplex<Vector<S>>,
+    z: Triplex<Vector<S, E>>,
+    c: Triplex<Vector<S, E>>,
     plus_one: f64,
-    r2: Vector<S>,
-    r: Vector<S>,
-    dr: Vector<S>,
-    origin: Vector<S>,
-    planes: Triplex<Vector<S>>,
-    i: Vector<S>,
-    running: S::m64s,
+    r2: Vector<S, E>,
+    r: Vector<S, E>,
+    dr: Vector<S, E>,
+    origin: Vector<S, E>,
+    planes: Triplex<Vector<S, E>>,
+    i: Vector<S, E>,
+    running: E::Mask<S>,
 }
 
-impl<S: pulp::Simd> Register<S> {
+impl<S: pulp::Simd, E: Lane + Number> Register<S, E> {
     #[inline(always)]
-    pub(super) fn splat(&self, v: f64) -> Vector<S> {
+    pub(super) fn splat(&self, v: f64) -> Vector<S, E> {
         Vector::splat(self.simd, v)
     }
 
     #[inline(always)]
-    pub(super) fn select(&self, mask: S::m64s, new: Vector<S>, old: Vector<S>) -> Vector<S> {
-        Vector(self.simd, self.simd.select_f64s(mask, new.1, old.1))
+    pub(super) fn select(
+        &self,
+        mask: E::Mask<S>,
+        new: Vector<S, E>,
+        old: Vector<S, E>,
+    ) -> Vector<S, E> {
+        Vector(self.simd, E::select(self.simd, mask, new.1, old.1))
     }
 
     #[inline(always)]
-    pub(super) fn any(&self, mask: S::m64s) -> bool {
-        self.simd.first_true_m64s(mask) < S::F64_LANES
+    pub(super) fn any(&self, mask: E::Mask<S>) -> bool {
+        E::first_true(self.simd, mask) < E::lanes::<S>()
     }
 
     #[inline(always)]
-    pub(super) fn store(v: Vector<S>) -> Stored {
-        let mut a = Stored::ZERO;
-        S::as_mut_simd_f64s(&mut a[..S::F64_LANES]).0[0] = v.1;
+    pub(super) fn store(v: Vector<S, E>) -> E::Stored {
+        let mut a = E::Stored::default();
+        E::store::<S>(v.1, a.as_mut());
         a
     }
 
     #[inline(always)]
-    pub(super) fn load(simd: S, a: &Stored) -> Vector<S> {
-        Vector(simd, S::as_simd_f64s(&a[..S::F64_LANES]).0[0])
+    pub(super) fn load(simd: S, a: &E::Stored) -> Vector<S, E> {
+        Vector(simd, E::load::<S>(a.as_ref()))
     }
 
     /// The orbits of `points` (one register's worth) before iterating.
     #[inline(always)]
     pub(super) fn start(simd: S, fractal: &Fractal, points: &[DVec3]) -> Self {
-        debug_assert_eq!(points.len(), S::F64_LANES);
-        let mut xyz = [Stored::ZERO; 3];
+        debug_assert_eq!(points.len(), E::lanes::<S>());
+        let mut xyz = [E::Stored::default(); 3];
         for (k, p) in points.iter().enumerate() {
-            (xyz[0][k], xyz[1][k], xyz[2][k]) = (p.x, p.y, p.z);
+            for (axis, v) in xyz.iter_mut().zip([p.x, p.y, p.z]) {
+                axis.as_mut()[k] = E::from_f64(v);
+            }
         }
         let z = [
             Self::load(simd, &xyz[0]),
@@ -403,25 +512,25 @@ impl<S: pulp::Simd> Register<S> {
             origin: infinity,
             planes: [infinity; 3],
             i: splat(0.0),
-            running: simd.equal_f64s(infinity.1, infinity.1),
+            running: E::equal(simd, infinity.1, infinity.1),
         }
     }
 
     /// Stops the lanes past the bailout (`OrbitState::outside`: a NaN
     /// radius keeps iterating alike); whether any lane still runs.
+    /// `bound` is `Lane::escape_bound` of the squared escape radius.
     #[inline(always)]
-    pub(super) fn check(&mut self, escape2: f64) -> bool {
+    pub(super) fn check(&mut self, bound: E) -> bool {
         let simd = self.simd;
-        let outside = self.outside(escape2);
-        self.running = simd.and_m64s(self.running, simd.not_m64s(outside));
+        let outside = self.outside(bound);
+        self.running = E::and(simd, self.running, E::not(simd, outside));
         self.any(self.running)
     }
 
     /// The lanes past the bailout (`OrbitState::outside`).
     #[inline(always)]
-    pub(super) fn outside(&self, escape2: f64) -> S::m64s {
-        self.simd
-            .greater_than_f64s(self.r2.1, self.splat(escape2).1)
+    pub(super) fn outside(&self, bound: E) -> E::Mask<S> {
+        E::past(self.simd, self.r2.1, E::splat(self.simd, bound))
     }
 
     /// `OrbitState::step` on the running lanes.
@@ -432,17 +541,18 @@ impl<S: pulp::Simd> Register<S> {
         let (z, running) = (self.z, self.running);
         let (mut w, rho2, power_r2) = triplex_power_int_unchecked(formula, z, n, one);
         // `triplex_power_int`'s test, lane by lane.
-        let finite = |v: Vector<S>| simd.less_than_f64s(simd.abs_f64s(v.1), infinity.1);
+        let finite = |v: Vector<S, E>| E::less(simd, E::abs(simd, v.1), infinity.1);
         let margin = self.splat(formula.shape().axis_margin());
-        let usable = simd.and_m64s(
-            simd.greater_than_f64s(rho2.1, (margin * power_r2).1),
-            simd.and_m64s(simd.and_m64s(finite(w[0]), finite(w[1])), finite(w[2])),
+        let usable = E::and(
+            simd,
+            E::greater(simd, rho2.1, (margin * power_r2).1),
+            E::and(simd, E::and(simd, finite(w[0]), finite(w[1])), finite(w[2])),
         );
-        let near_axis = simd.and_m64s(running, simd.not_m64s(usable));
+        let near_axis = E::and(simd, running, E::not(simd, usable));
         if self.any(near_axis) {
             let flags = Self::store(self.select(near_axis, one, self.splat(0.0)));
             let exact =
-                near_axis_powers(formula, z.map(Self::store), Self::store(self.r), n, &flags);
+                near_axis_powers::<E>(formula, z.map(Self::store), Self::store(self.r), n, &flags);
             for axis in 0..3 {
                 let fixed = Self::load(simd, &exact[axis]);
                 w[axis] = self.select(near_axis, fixed, w[axis]);
@@ -452,16 +562,12 @@ impl<S: pulp::Simd> Register<S> {
         // replaces a number), glam's `if a < b { a } else { b }` for the
         // planes (a NaN |z| does).
         let lesser =
-            |a: Vector<S>, b: Vector<S>| simd.select_f64s(simd.less_than_f64s(a.1, b.1), a.1, b.1);
-        let origin = simd.select_f64s(
-            simd.less_than_f64s(self.r2.1, self.origin.1),
-            self.r2.1,
-            self.origin.1,
-        );
-        self.origin = Vector(simd, simd.select_f64s(running, origin, self.origin.1));
+            |a: Vector<S, E>, b: Vector<S, E>| E::select(simd, E::less(simd, a.1, b.1), a.1, b.1);
+        let origin = lesser(self.r2, self.origin);
+        self.origin = Vector(simd, E::select(simd, running, origin, self.origin.1));
         for (plane, z) in self.planes.iter_mut().zip(z) {
-            let next = lesser(*plane, Vector(simd, simd.abs_f64s(z.1)));
-            *plane = Vector(simd, simd.select_f64s(running, next, plane.1));
+            let next = lesser(*plane, Vector(simd, E::abs(simd, z.1)));
+            *plane = Vector(simd, E::select(simd, running, next, plane.1));
         }
         let power = self.splat(n as Real);
         let dr = power * powi(self.r, n - 1, |a, b| a * b) * self.dr + self.splat(self.plus_one);
@@ -476,15 +582,16 @@ impl<S: pulp::Simd> Register<S> {
         }
         self.i = self.select(running, self.i + one, self.i);
     }
+}
 
+impl<S: pulp::Simd> Register<S, f64> {
     /// The finished orbits, into `out` (one per lane).
     #[cfg(test)]
     #[inline(always)]
-    pub(super) fn finish(&self, fractal: &Fractal, out: &mut [Orbit<f64>]) {
+    pub(super) fn finish(&self, out: &mut [Orbit<f64>], escape: Real) {
         let store = Self::store;
         let (z, planes) = (self.z.map(store), self.planes.map(store));
         let [origin, r2, r, dr, i] = [self.origin, self.r2, self.r, self.dr, self.i].map(store);
-        let escape = fractal.escape_radius::<f64>();
         for (k, out) in out.iter_mut().enumerate() {
             let traps = OrbitTraps {
                 origin: origin[k],
@@ -502,10 +609,16 @@ impl<S: pulp::Simd> Register<S> {
     /// a point outside the bailout from the start, which is rare, goes
     /// lane by lane.
     #[inline(always)]
-    pub(super) fn estimates(&self, fractal: &Fractal, points: &[DVec3], out: &mut [Estimate]) {
-        // The analytic estimator in f64 is the only one finished here
+    pub(super) fn estimates(
+        &self,
+        fractal: &Fractal,
+        points: &[DVec3],
+        out: &mut [Estimate],
+        escape: Real,
+    ) {
+        // The analytic estimator is the only one finished here
         // (`estimate_lanes_into` sends the others one point at a time).
-        debug_assert!(fractal.de == DeMethod::Analytic && fractal.precision == Precision::F64);
+        debug_assert!(fractal.de == DeMethod::Analytic);
         let simd = self.simd;
         let (r, dr) = (self.r, self.dr);
         let (zero, one, infinity) = (self.splat(0.0), self.splat(1.0), self.splat(Real::INFINITY));
@@ -516,7 +629,7 @@ impl<S: pulp::Simd> Register<S> {
         // else its estimate is not above 0 or not finite, which
         // `as_distance` makes 0 as it does here: so one selection holds
         // `as_distance` and every case but the rare one.
-        let escaped = self.outside(fractal.escape_radius::<f64>().powi(2));
+        let escaped = self.outside(escape * escape);
         let stepped = simd.greater_than_or_equal_f64s(self.i.1, one.1);
         let in_range = simd.and_m64s(
             simd.greater_than_or_equal_f64s(r.1, self.splat(0.5).1),
@@ -563,7 +676,7 @@ impl<S: pulp::Simd> Register<S> {
         if self.any(rare) {
             let rare = store(self.select(rare, one, zero));
             for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
-                out[k].distance = distance_to_ball(points[k], fractal.escape_radius::<f64>());
+                out[k].distance = distance_to_ball(points[k], escape);
             }
         }
     }
@@ -574,18 +687,20 @@ impl<S: pulp::Simd> Register<S> {
 /// Rare, and out of line so the vector loop keeps its registers.
 #[cold]
 #[inline(never)]
-pub(super) fn near_axis_powers(
+pub(super) fn near_axis_powers<E: Lane + Number>(
     formula: Formula,
-    z: [Stored; 3],
-    r: Stored,
+    z: [E::Stored; 3],
+    r: E::Stored,
     n: u32,
-    which: &Stored,
-) -> [Stored; 3] {
-    let mut out = [Stored::ZERO; 3];
-    for k in (0..REGISTER).filter(|&k| which[k] != 0.0) {
-        let exact = triplex_power_trig(formula, [z[0][k], z[1][k], z[2][k]], r[k], n as Real);
+    which: &E::Stored,
+) -> [E::Stored; 3] {
+    let mut out = [E::Stored::default(); 3];
+    let r = r.as_ref();
+    for k in (0..which.as_ref().len()).filter(|&k| which.as_ref()[k] != E::default()) {
+        let at = [z[0].as_ref()[k], z[1].as_ref()[k], z[2].as_ref()[k]];
+        let exact = triplex_power_trig(formula, at, r[k], n as Real);
         for axis in 0..3 {
-            out[axis][k] = exact[axis];
+            out[axis].as_mut()[k] = exact[axis];
         }
     }
     out

@@ -179,6 +179,10 @@ impl Default for Fractal {
 /// past this a frame takes days.
 pub const MAX_ITERATIONS: u32 = 10_000;
 
+/// Bumped whenever a change alters the estimates f32 gives, so resume
+/// re-renders the frames that render in f32 and no others.
+pub const F32_REVISION: u32 = 1;
+
 /// `iterations: Auto(margin: m)`: per frame, the iterations after which
 /// the running derivative at the frame's surface passes one over a pixel's
 /// width (finer detail would alias), and `margin` more.
@@ -207,15 +211,15 @@ pub struct OrbitTraps {
 }
 
 impl OrbitTraps {
-    /// The traps of an orbit that ended at `z`: those it met, or `z`'s own
-    /// for a point outside the bailout from the start, which met none.
+    /// The traps of an orbit that ended at `z` (|z|² = `r2`, as its own
+    /// arithmetic rounds it): those it met, or `z`'s own for a point
+    /// outside the bailout from the start, which met none.
     #[inline(always)]
-    fn ended(self, z: [Real; 3]) -> OrbitTraps {
+    fn ended(self, z: [Real; 3], r2: Real) -> OrbitTraps {
         if self.origin == Real::INFINITY {
-            let zv = DVec3::from_array(z);
             OrbitTraps {
-                origin: zv.length_squared(),
-                planes: zv.abs(),
+                origin: r2,
+                planes: DVec3::from_array(z).abs(),
             }
         } else {
             self

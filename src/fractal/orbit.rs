@@ -99,7 +99,9 @@ impl<T: Number> OrbitState<T> {
     pub(super) fn step(&mut self, power: &impl Fn(Triplex<T>, T) -> (Triplex<T>, T)) {
         let z = self.z;
         let zv = DVec3::new(z[0].value(), z[1].value(), z[2].value());
-        self.traps.origin = self.traps.origin.min(zv.length_squared());
+        // |z|² as the orbit's own arithmetic rounds it (`r2`, so in f64
+        // `zv.length_squared()` to the bit), as the vector kernels keep it.
+        self.traps.origin = self.traps.origin.min(self.r2.value());
         self.traps.planes = self.traps.planes.min(zv.abs());
         let (w, r_n_minus_1) = power(z, self.r);
         self.dr = self.n * r_n_minus_1 * self.dr + self.plus_one;
@@ -142,7 +144,7 @@ impl<T: Number> Orbit<T> {
             z,
             r,
             dr,
-            traps: traps.ended([z[0].value(), z[1].value(), z[2].value()]),
+            traps: traps.ended([z[0].value(), z[1].value(), z[2].value()], r2.value()),
             iterations: i,
             // `OrbitState::outside`.
             escaped: r2.value() > bailout * bailout,

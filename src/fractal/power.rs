@@ -153,7 +153,9 @@ pub fn triplex_power_int<T: Number>(formula: Formula, z: Triplex<T>, n: u32) -> 
     let (out, rho2, r2) = triplex_power_int_unchecked(formula, z, n, T::from_real(1.0));
     // ρ² > margin·r² also fails for an infinite or NaN r².
     let margin = formula.shape().axis_margin();
-    let usable = rho2.value() > margin * r2.value() && out.iter().all(|v| v.value().is_finite());
+    // The product in T's own rounding, as the vector kernels take it.
+    let usable = rho2.value() > (T::from_real(margin) * r2).value()
+        && out.iter().all(|v| v.value().is_finite());
     usable.then_some(out)
 }
 

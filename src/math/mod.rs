@@ -21,7 +21,7 @@ pub use ln::{in_ln_range, ln, ln_in_range, Lanes};
 pub use number::{Arith, Number};
 pub use sample::{sample_1d, shell_points};
 pub use stats::{median, psnr_db, psnr_db_of_rmse};
-pub use vector::Vector;
+pub use vector::{Lane, Stored, Stored32, Vector};
 
 /// The floating-point type of all geometry and distance estimation.
 pub type Real = f64;

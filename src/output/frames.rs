@@ -62,6 +62,9 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         /// Only where f32 was asked for and f64 renders (`deep::f32_too_coarse`).
         #[serde(skip_serializing_if = "std::ops::Not::not")]
         f32_in_f64: bool,
+        /// Only where a frame renders in f32.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        f32: Option<u32>,
         /// Only where hits are checked (`MarchSettings::confirm_hits`), so
         /// that the check's frames go stale when it changes and others do not.
         #[serde(skip_serializing_if = "Option::is_none")]
@@ -81,6 +84,10 @@ fn light_digest(scenes: &[Scene], frame_index: u32, width: u32, height: u32) -> 
         f32_in_f64: scenes
             .iter()
             .any(|s| crate::deep::f32_too_coarse(s, [width, height])),
+        f32: scenes
+            .iter()
+            .any(|s| crate::deep::renders_in_f32(s, [width, height]))
+            .then_some(crate::fractal::F32_REVISION),
         confirm: scenes
             .iter()
             .any(|s| s.quality.confirm_hits)

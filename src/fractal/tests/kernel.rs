@@ -1,6 +1,7 @@
 //! The vector kernel, held bit for bit to the scalar orbit.
 
 use super::*;
+use std::marker::PhantomData;
 
 #[test]
 fn lanes_are_bit_identical_to_one_estimate_at_a_time() {
@@ -17,6 +18,20 @@ fn lanes_are_bit_identical_to_one_estimate_at_a_time() {
     for bailout in [1e40, 0.3] {
         fractals.push(Fractal {
             bailout,
+            ..Fractal::default()
+        });
+    }
+    // The f32 kernel, which widens its lanes to finish in f64, on each of
+    // them, and at bailouts whose square no f32 holds.
+    let f64_ones = fractals.clone();
+    fractals.extend(f64_ones.into_iter().map(|f| Fractal {
+        precision: Precision::F32,
+        ..f
+    }));
+    for bailout in [3.3, 10.1] {
+        fractals.push(Fractal {
+            bailout,
+            precision: Precision::F32,
             ..Fractal::default()
         });
     }
@@ -172,24 +187,26 @@ fn every_instruction_set_gives_the_scalar_orbit_bit_for_bit() {
                 let mut out = ([Orbit::IDLE; VECTOR], [Estimate::IDLE; VECTOR]);
                 let fractal = f;
                 let points = &points;
-                Kernel {
+                Kernel::<f64, _> {
                     fractal,
                     points,
                     live,
                     n,
                     out: &mut out.0,
+                    lane: PhantomData,
                 }
                 .with_simd(simd);
-                Kernel {
+                Kernel::<f64, _> {
                     fractal,
                     points,
                     live,
                     n,
                     out: &mut out.1,
+                    lane: PhantomData,
                 }
                 .with_simd(simd);
                 // As `estimate_lanes_into` finishes the kernel's estimates.
-                f.bound_lanes(&points[..live], &mut out.1[..live]);
+                f.bound_lanes::<f64>(&points[..live], &mut out.1[..live]);
                 out
             }
             check(
@@ -222,4 +239,111 @@ fn every_instruction_set_gives_the_scalar_orbit_bit_for_bit() {
     }
     // The lanes whose logarithm the kernel leaves to `f64::ln` were met.
     assert!(outside_ln_range > 0);
+}
+
+#[test]
+fn the_f32_kernel_gives_the_scalar_f32_estimate_bit_for_bit_on_each_instruction_set() {
+    // f32 orbits in registers of eight (AVX2) or one at a time (scalar),
+    // widened to finish in f64, against `estimate` in f32 one point at a
+    // time: every field, to the bit, with padding lanes left alone.
+    use pulp::WithSimd;
+    let mut pts = points(192, 0.0..2.5, 11);
+    pts.extend([
+        DVec3::new(0.0, 0.0, 0.7),
+        DVec3::new(0.0, -0.6, 0.0),
+        DVec3::new(1e-9, 0.0, 0.5),
+        DVec3::ZERO,
+        DVec3::new(40.0, -3.0, 2.0),
+        IDLE_POINT,
+        DVec3::splat(Real::NAN),
+        DVec3::new(1e-40, 2e-40, 0.0),
+    ]);
+    pts.resize(
+        pts.len().next_multiple_of(VECTOR),
+        DVec3::new(0.3, 0.2, -0.1),
+    );
+    let f32_of = |f: Fractal| Fractal {
+        precision: Precision::F32,
+        ..f
+    };
+    for f in [
+        f32_of(Fractal::default()),
+        f32_of(Fractal {
+            formula: Formula::Asin,
+            bailout: 10.1,
+            ..Fractal::default()
+        }),
+        f32_of(Fractal {
+            formula: Formula::WhiteNylander,
+            power: 5.0,
+            julia: Some(DVec3::new(0.3, -0.5, 0.2)),
+            ..Fractal::default()
+        }),
+        f32_of(Fractal {
+            formula: Formula::Quaternion,
+            power: 2.0,
+            iterations: 30,
+            ..Fractal::default()
+        }),
+        // A bailout past what f32 reaches in one step: `escape_radius`
+        // lowers it, in both paths.
+        f32_of(Fractal {
+            bailout: 1e6,
+            ..Fractal::default()
+        }),
+    ] {
+        let n = whole_power(f.power).unwrap();
+        for chunk in pts.chunks_exact(VECTOR) {
+            let points: [DVec3; VECTOR] = chunk.try_into().unwrap();
+            let expected: Vec<String> = points
+                .iter()
+                .map(|&p| format!("{:?}", f.estimate(p, 1e-4)))
+                .collect();
+            fn on<S: pulp::Simd>(
+                simd: S,
+                f: &Fractal,
+                points: &[DVec3; VECTOR],
+                live: usize,
+                n: u32,
+            ) -> [Estimate; VECTOR] {
+                let mut out = [Estimate::IDLE; VECTOR];
+                Kernel::<f32, _> {
+                    fractal: f,
+                    points,
+                    live,
+                    n,
+                    out: &mut out,
+                    lane: PhantomData,
+                }
+                .with_simd(simd);
+                f.bound_lanes::<f32>(&points[..live], &mut out[..live]);
+                out
+            }
+            let check = |estimates: [Estimate; VECTOR], live: usize, width: usize, arch: &str| {
+                let skipped = live.next_multiple_of(width);
+                for (k, e) in estimates.iter().enumerate() {
+                    let e = format!("{e:?}");
+                    if k < live {
+                        assert_eq!(e, expected[k], "{arch} {live} at {}", points[k]);
+                    } else if k >= skipped {
+                        assert_eq!(e, format!("{:?}", Estimate::IDLE), "{arch} {live}");
+                    }
+                }
+            };
+            let dispatched = f.estimate_lanes(points, [1e-4; VECTOR]);
+            check(dispatched, VECTOR, VECTOR, "dispatched");
+            for live in [VECTOR, 1, 5, 8, 9, 13] {
+                check(
+                    on(pulp::Scalar::new(), &f, &points, live, n),
+                    live,
+                    1,
+                    "scalar",
+                );
+                #[cfg(target_arch = "x86_64")]
+                if let Some(v3) = pulp::x86::V3::try_new() {
+                    check(on(v3, &f, &points, live, n), live, 8, "AVX2");
+                }
+            }
+        }
+    }
 }

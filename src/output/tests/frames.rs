@@ -45,35 +45,56 @@ fn hash_changes_with_any_input() {
     assert_eq!(key(Format::Png, &graded, &[]), graded);
 }
 
+/// The digest of the inputs as `frame_hash` writes them for `s` at 4×3
+/// (or `width`×`height`), with `extra` fields after the scenes.
+fn inputs_digest(s: &Scene, [width, height]: [u32; 2], extra: &str) -> String {
+    use sha2::{Digest, Sha256};
+    let json = format!(
+        r#"{{"renderer":"{}","revision":{},"frame_index":0,"width":{width},"height":{height},"scenes":{}{extra}}}"#,
+        env!("CARGO_PKG_VERSION"),
+        crate::RENDERER_REVISION,
+        serde_json::to_string(std::slice::from_ref(s)).unwrap()
+    );
+    let digest = Sha256::digest(json.as_bytes());
+    digest
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect::<String>()
+}
+
 #[test]
 fn checking_hits_adds_its_revision_to_the_hash_and_other_frames_keep_theirs() {
-    use sha2::{Digest, Sha256};
-    // The digest of the inputs as the hash writes them, with `extra`
-    // fields after the scenes.
-    let digest = |s: &Scene, extra: &str| {
-        let json = format!(
-            r#"{{"renderer":"{}","revision":{},"frame_index":0,"width":4,"height":3,"scenes":{}{extra}}}"#,
-            env!("CARGO_PKG_VERSION"),
-            crate::RENDERER_REVISION,
-            serde_json::to_string(std::slice::from_ref(s)).unwrap()
-        );
-        let digest = Sha256::digest(json.as_bytes());
-        digest
-            .iter()
-            .map(|b| format!("{b:02x}"))
-            .collect::<String>()
-    };
     let off = Scene::default();
     assert_eq!(
         frame_hash(std::slice::from_ref(&off), 0, 4, 3),
-        digest(&off, "")
+        inputs_digest(&off, [4, 3], "")
     );
     let mut on = off.clone();
     on.quality.confirm_hits = true;
     let revision = format!(r#","confirm":{}"#, crate::march::CONFIRM_REVISION);
     assert_eq!(
         frame_hash(std::slice::from_ref(&on), 0, 4, 3),
-        digest(&on, &revision)
+        inputs_digest(&on, [4, 3], &revision)
+    );
+}
+
+#[test]
+fn rendering_in_f32_adds_its_revision_to_the_hash_and_other_frames_keep_theirs() {
+    // A frame in f32 names the f32 revision; one asked in f32 but too fine
+    // for it names only that it renders in f64.
+    let mut s = Scene::default();
+    s.fractal.precision = crate::fractal::Precision::F32;
+    s.camera.target = crate::math::DVec3::new(0.5, 0.4, 0.4);
+    let revision = format!(r#","f32":{}"#, crate::fractal::F32_REVISION);
+    assert_eq!(
+        frame_hash(std::slice::from_ref(&s), 0, 4, 3),
+        inputs_digest(&s, [4, 3], &revision)
+    );
+    let fine = [1 << 20, 1 << 19];
+    assert!(crate::deep::f32_too_coarse(&s, fine));
+    assert_eq!(
+        frame_hash(std::slice::from_ref(&s), 0, fine[0], fine[1]),
+        inputs_digest(&s, fine, r#","f32_in_f64":true"#)
     );
 }
 
