@@ -117,18 +117,42 @@ fn estimate_formula(bencher: divan::Bencher, formula: Formula) {
 /// The analytic estimate at the same points, `N` at a time through the lanes.
 #[divan::bench(consts = [1, 4, 8, 16])]
 fn estimate_lanes<const N: usize>(bencher: divan::Bencher) {
-    bench_lanes::<N>(bencher, points(), 1);
+    bench_lanes::<N>(bencher, points(), 1, Precision::F64);
 }
 
 /// Orbits that never escape (points deep inside): the cost of 12 iterations,
 /// counted per iteration.
 #[divan::bench(consts = [1, 4, 8, 16])]
 fn inside_lanes<const N: usize>(bencher: divan::Bencher) {
-    bench_lanes::<N>(bencher, points().iter().map(|p| *p * 0.4).collect(), 12);
+    bench_lanes::<N>(bencher, inside(), 12, Precision::F64);
 }
 
-fn bench_lanes<const N: usize>(bencher: divan::Bencher, pts: Vec<DVec3>, items_per_point: usize) {
-    let f = Fractal::default();
+/// `estimate_lanes` in f32 (eight lanes to an AVX2 register).
+#[divan::bench(consts = [16])]
+fn estimate_lanes_f32<const N: usize>(bencher: divan::Bencher) {
+    bench_lanes::<N>(bencher, points(), 1, Precision::F32);
+}
+
+/// `inside_lanes` in f32.
+#[divan::bench(consts = [16])]
+fn inside_lanes_f32<const N: usize>(bencher: divan::Bencher) {
+    bench_lanes::<N>(bencher, inside(), 12, Precision::F32);
+}
+
+fn inside() -> Vec<DVec3> {
+    points().iter().map(|p| *p * 0.4).collect()
+}
+
+fn bench_lanes<const N: usize>(
+    bencher: divan::Bencher,
+    pts: Vec<DVec3>,
+    items_per_point: usize,
+    precision: Precision,
+) {
+    let f = Fractal {
+        precision,
+        ..Fractal::default()
+    };
     bencher
         .counter(divan::counter::ItemsCount::new(pts.len() * items_per_point))
         .bench(|| {

@@ -7,8 +7,8 @@ use crate::math::{DVec3, Dual, Number, Real};
 
 impl Fractal {
     /// The analytic estimator in f64 at world coordinates (no deep frame's
-    /// offsets): what the vector kernel runs, and where a hit can be checked
-    /// by the potential estimate's stencil (`MarchSettings::confirm_hits`).
+    /// offsets): where a hit can be checked by the potential estimate's
+    /// stencil (`MarchSettings::confirm_hits`).
     pub fn plain_analytic(&self) -> bool {
         self.lane_analytic() == Some(Precision::F64)
     }

@@ -33,9 +33,9 @@ impl Fractal {
     }
 
     /// Analytic estimates at `N` points at once, finished in the vector
-    /// registers their orbits ran in: bit-identical to `estimate` at each
-    /// point, faster in bulk. Other estimators, precisions and powers fall
-    /// back to one `estimate` per point.
+    /// registers their orbits ran in (f64 or f32, as the fractal asks):
+    /// bit-identical to `estimate` at each point, faster in bulk. Other
+    /// estimators and powers fall back to one `estimate` per point.
     pub fn estimate_lanes<const N: usize>(
         &self,
         points: [DVec3; N],
@@ -409,6 +409,8 @@ pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     let lanes = points.len() / 2;
     let mut a = Register::start(simd, fractal, &points[..lanes]);
     let mut b = Register::start(simd, fractal, &points[lanes..]);
+    // The iteration count is kept in `E`, exact to 2²⁴ in f32.
+    debug_assert!(Real::from(fractal.iterations) * E::EPSILON < 1.0);
     // Worked out once: the escape test runs every iteration.
     let escape = fractal.escape_radius::<E>();
     let bound = E::escape_bound(escape * escape);

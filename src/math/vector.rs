@@ -27,7 +27,6 @@ pub trait Lane: Copy + PartialOrd + Default + 'static {
     type Stored: Copy + Default + AsRef<[Self]> + AsMut<[Self]>;
     fn lanes<S: pulp::Simd>() -> usize;
     fn from_f64(v: f64) -> Self;
-    fn to_f64(self) -> f64;
     fn splat<S: pulp::Simd>(simd: S, v: Self) -> Self::Reg<S>;
     fn add<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Reg<S>;
     fn sub<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Reg<S>;
@@ -114,7 +113,7 @@ impl AsMut<[f32]> for Stored32 {
 }
 
 macro_rules! lane {
-    ($t:ty, $stored:ty, $lanes:ident, $m:ident, $splat:ident, $add:ident, $sub:ident,
+    ($t:ty, $stored:ty, $lanes:ident, $splat:ident, $add:ident, $sub:ident,
      $mul:ident, $div:ident, $sqrt:ident, $abs:ident, $select:ident, $lt:ident, $gt:ident,
      $ge:ident, $eq:ident, $and:ident, $not:ident, $first:ident, $as:ident, $as_mut:ident,
      $reg:ident, $mask:ident, $past:ident, $bound:path) => {
@@ -129,10 +128,6 @@ macro_rules! lane {
             #[inline(always)]
             fn from_f64(v: f64) -> Self {
                 v as $t
-            }
-            #[inline(always)]
-            fn to_f64(self) -> f64 {
-                self as f64
             }
             #[inline(always)]
             fn splat<S: pulp::Simd>(simd: S, v: Self) -> S::$reg {
@@ -218,7 +213,6 @@ lane!(
     f64,
     Stored,
     F64_LANES,
-    m64s,
     splat_f64s,
     add_f64s,
     sub_f64s,
@@ -245,7 +239,6 @@ lane!(
     f32,
     Stored32,
     F32_LANES,
-    m32s,
     splat_f32s,
     add_f32s,
     sub_f32s,
@@ -269,9 +262,13 @@ lane!(
     least_f32_above
 );
 
-/// The least f32 whose value is above `e2` (+∞ where none is): for an f32
-/// |z|², being at least it is being above `e2` in f64.
+/// The least f32 whose value is above `e2`: for an f32 |z|², being at
+/// least it is being above `e2` in f64. Where no f32 is above `e2` (it is
+/// +∞ or NaN), NaN, which nothing is at least.
 fn least_f32_above(e2: f64) -> f32 {
+    if e2.is_nan() || e2 == f64::INFINITY {
+        return f32::NAN;
+    }
     let mut x = e2 as f32;
     while (x as f64) <= e2 && x < f32::INFINITY {
         x = x.next_up();
@@ -302,5 +299,28 @@ impl<S: pulp::Simd, E: Lane> Arith for Vector<S, E> {
     #[inline(always)]
     fn sqrt(self) -> Self {
         Vector(self.0, E::sqrt(self.0, self.1))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::least_f32_above;
+
+    #[test]
+    fn an_f32_at_least_the_escape_bound_is_exactly_one_above_it_in_f64() {
+        let finite = [16.0, 10.89, 1e300, f32::MAX as f64, 0.0, -1.0, 1e-310];
+        let edges = [f64::INFINITY, f64::NEG_INFINITY, f64::NAN];
+        for e2 in finite.into_iter().chain(edges) {
+            let bound = least_f32_above(e2);
+            let near = e2 as f32;
+            let mut xs = vec![f32::INFINITY, f32::NEG_INFINITY, f32::NAN, 0.0, f32::MAX];
+            for k in 0..4 {
+                xs.push(f32::from_bits(near.to_bits().wrapping_add(k)));
+                xs.push(f32::from_bits(near.to_bits().wrapping_sub(k)));
+            }
+            for x in xs {
+                assert_eq!(x >= bound, (x as f64) > e2, "{x} against {e2}");
+            }
+        }
     }
 }
