@@ -59,19 +59,24 @@ impl Fractal {
         }
         if let (Some(precision), Some(n)) = (self.lane_analytic(), whole_power(self.power)) {
             return match precision {
-                Precision::F64 => {
-                    self.in_vectors::<N, f64, _>(points, n, out);
-                    self.bound_lanes::<f64>(points, out)
-                }
-                Precision::F32 => {
-                    self.in_vectors::<N, f32, _>(points, n, out);
-                    self.bound_lanes::<f32>(points, out)
-                }
+                Precision::F64 => self.analytic_lanes::<N, f64>(points, n, out),
+                Precision::F32 => self.analytic_lanes::<N, f32>(points, n, out),
             };
         }
         for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
             *out = self.estimate(p, scale);
         }
+    }
+
+    /// The vector kernel's analytic estimates in `E`, with their bounds.
+    fn analytic_lanes<const N: usize, E: KernelLane>(
+        &self,
+        points: &[DVec3; N],
+        n: u32,
+        out: &mut [Estimate; N],
+    ) {
+        self.in_vectors::<N, E, _>(points, n, out);
+        self.bound_lanes::<E>(points, out)
     }
 
     /// The bounds `estimate` puts on its estimator (`bounded`), on the
@@ -359,7 +364,9 @@ pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
     // Two registers of `E` in one call (`KernelLane::dispatch` keeps f32
     // to registers of eight).
     assert!(lanes >= 1 && 2 * lanes <= VECTOR);
+    // Worked out once: the escape test runs every iteration.
     let escape = fractal.escape_radius::<E>();
+    let bound = E::escape_bound(escape * escape);
     // Two registers at a time: their dependency chains are independent,
     // so the processor overlaps one's square roots and division with
     // the other's multiplications instead of waiting.
@@ -375,18 +382,22 @@ pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
         // one whose powers unroll.
         let f = fractal;
         let (a, b) = match (f.formula, n) {
-            (Formula::Quilez, 8) => orbit_registers(simd, f, points, 8, Formula::Quilez),
-            (Formula::Asin, 8) => orbit_registers(simd, f, points, 8, Formula::Asin),
+            (Formula::Quilez, 8) => orbit_registers(simd, f, points, bound, 8, Formula::Quilez),
+            (Formula::Asin, 8) => orbit_registers(simd, f, points, bound, 8, Formula::Asin),
             (Formula::WhiteNylander, 8) => {
-                orbit_registers(simd, f, points, 8, Formula::WhiteNylander)
+                orbit_registers(simd, f, points, bound, 8, Formula::WhiteNylander)
             }
-            (Formula::Quaternion, 2) => orbit_registers(simd, f, points, 2, Formula::Quaternion),
-            (Formula::Quilez, n) => orbit_registers(simd, f, points, n, Formula::Quilez),
-            (Formula::Asin, n) => orbit_registers(simd, f, points, n, Formula::Asin),
+            (Formula::Quaternion, 2) => {
+                orbit_registers(simd, f, points, bound, 2, Formula::Quaternion)
+            }
+            (Formula::Quilez, n) => orbit_registers(simd, f, points, bound, n, Formula::Quilez),
+            (Formula::Asin, n) => orbit_registers(simd, f, points, bound, n, Formula::Asin),
             (Formula::WhiteNylander, n) => {
-                orbit_registers(simd, f, points, n, Formula::WhiteNylander)
+                orbit_registers(simd, f, points, bound, n, Formula::WhiteNylander)
             }
-            (Formula::Quaternion, n) => orbit_registers(simd, f, points, n, Formula::Quaternion),
+            (Formula::Quaternion, n) => {
+                orbit_registers(simd, f, points, bound, n, Formula::Quaternion)
+            }
         };
         let (first, second) = out.split_at_mut(lanes);
         E::write(&a, f, &points[..lanes], first, escape);
@@ -397,12 +408,14 @@ pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
     }
 }
 
-/// Two registers of orbits iterated in one loop (see `Register`).
+/// Two registers of orbits iterated in one loop (see `Register`), stopping
+/// at `bound` (`Lane::escape_bound` of the squared escape radius).
 #[inline(always)]
 pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3],
+    bound: E,
     n: u32,
     formula: Formula,
 ) -> (Register<S, E>, Register<S, E>) {
@@ -411,9 +424,6 @@ pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     let mut b = Register::start(simd, fractal, &points[lanes..]);
     // The iteration count is kept in `E`, exact to 2²⁴ in f32.
     debug_assert!(Real::from(fractal.iterations) * E::EPSILON < 1.0);
-    // Worked out once: the escape test runs every iteration.
-    let escape = fractal.escape_radius::<E>();
-    let bound = E::escape_bound(escape * escape);
     for _ in 0..fractal.iterations {
         let (run_a, run_b) = (a.check(bound), b.check(bound));
         if !(run_a || run_b) {

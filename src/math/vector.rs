@@ -42,7 +42,6 @@ pub trait Lane: Copy + PartialOrd + Default + 'static {
     ) -> Self::Reg<S>;
     fn less<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Mask<S>;
     fn greater<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Mask<S>;
-    fn at_least<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Mask<S>;
     fn equal<S: pulp::Simd>(simd: S, a: Self::Reg<S>, b: Self::Reg<S>) -> Self::Mask<S>;
     fn and<S: pulp::Simd>(simd: S, a: Self::Mask<S>, b: Self::Mask<S>) -> Self::Mask<S>;
     fn not<S: pulp::Simd>(simd: S, a: Self::Mask<S>) -> Self::Mask<S>;
@@ -115,7 +114,7 @@ impl AsMut<[f32]> for Stored32 {
 macro_rules! lane {
     ($t:ty, $stored:ty, $lanes:ident, $splat:ident, $add:ident, $sub:ident,
      $mul:ident, $div:ident, $sqrt:ident, $abs:ident, $select:ident, $lt:ident, $gt:ident,
-     $ge:ident, $eq:ident, $and:ident, $not:ident, $first:ident, $as:ident, $as_mut:ident,
+     $eq:ident, $and:ident, $not:ident, $first:ident, $as:ident, $as_mut:ident,
      $reg:ident, $mask:ident, $past:ident, $bound:path) => {
         impl Lane for $t {
             type Reg<S: pulp::Simd> = S::$reg;
@@ -170,10 +169,6 @@ macro_rules! lane {
                 simd.$gt(a, b)
             }
             #[inline(always)]
-            fn at_least<S: pulp::Simd>(simd: S, a: S::$reg, b: S::$reg) -> S::$mask {
-                simd.$ge(a, b)
-            }
-            #[inline(always)]
             fn equal<S: pulp::Simd>(simd: S, a: S::$reg, b: S::$reg) -> S::$mask {
                 simd.$eq(a, b)
             }
@@ -223,7 +218,6 @@ lane!(
     select_f64s,
     less_than_f64s,
     greater_than_f64s,
-    greater_than_or_equal_f64s,
     equal_f64s,
     and_m64s,
     not_m64s,
@@ -249,7 +243,6 @@ lane!(
     select_f32s,
     less_than_f32s,
     greater_than_f32s,
-    greater_than_or_equal_f32s,
     equal_f32s,
     and_m32s,
     not_m32s,
