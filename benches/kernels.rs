@@ -4,7 +4,8 @@
 //! Run with `cargo bench`; CI only builds them.
 
 use mandelreel::fractal::{
-    power8_polynomial, triplex_power_int, triplex_power_trig, DeMethod, Formula, Fractal, Precision,
+    power8_polynomial, triplex_power_int, triplex_power_trig, DeMethod, Estimate, Formula, Fractal,
+    Precision,
 };
 use mandelreel::math::DVec3;
 
@@ -127,6 +128,13 @@ fn inside_lanes<const N: usize>(bencher: divan::Bencher) {
     bench_lanes::<N>(bencher, inside(), 12, Precision::F64);
 }
 
+/// `estimate_lanes` without orbit traps (`distance_lanes_into`), as shadow,
+/// occlusion, normal and cone walks take them.
+#[divan::bench(consts = [16])]
+fn distance_lanes<const N: usize>(bencher: divan::Bencher) {
+    bench_lanes_with::<N>(bencher, points(), 1, Precision::F64, false);
+}
+
 /// `estimate_lanes` in f32 (eight lanes to an AVX2 register).
 #[divan::bench(consts = [16])]
 fn estimate_lanes_f32<const N: usize>(bencher: divan::Bencher) {
@@ -149,6 +157,17 @@ fn bench_lanes<const N: usize>(
     items_per_point: usize,
     precision: Precision,
 ) {
+    bench_lanes_with::<N>(bencher, pts, items_per_point, precision, true);
+}
+
+/// `bench_lanes`, with orbit traps or without.
+fn bench_lanes_with<const N: usize>(
+    bencher: divan::Bencher,
+    pts: Vec<DVec3>,
+    items_per_point: usize,
+    precision: Precision,
+    traps: bool,
+) {
     let f = Fractal {
         precision,
         ..Fractal::default()
@@ -159,10 +178,13 @@ fn bench_lanes<const N: usize>(
             pts.chunks_exact(N)
                 .map(|c| {
                     let p: [DVec3; N] = std::array::from_fn(|k| c[k]);
-                    f.estimate_lanes(divan::black_box(p), [1e-4; N])
-                        .iter()
-                        .map(|e| e.distance)
-                        .sum::<f64>()
+                    let mut out = [Estimate::IDLE; N];
+                    if traps {
+                        f.estimate_lanes_into(divan::black_box(&p), &[1e-4; N], &mut out);
+                    } else {
+                        f.distance_lanes_into(divan::black_box(&p), &[1e-4; N], &mut out);
+                    }
+                    out.iter().map(|e| e.distance).sum::<f64>()
                 })
                 .sum::<f64>()
         });

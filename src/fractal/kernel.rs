@@ -28,7 +28,7 @@ impl Fractal {
     ) -> Option<[Orbit<f64>; N]> {
         let n = whole_power(self.power)?;
         let mut out = [Orbit::IDLE; N];
-        self.in_vectors::<N, f64, _>(&points, n, &mut out);
+        self.in_vectors::<N, f64, _, true>(&points, n, &mut out);
         Some(out)
     }
 
@@ -54,13 +54,38 @@ impl Fractal {
         scales: &[Real; N],
         out: &mut [Estimate; N],
     ) {
+        self.lanes_into::<N, true>(points, scales, out)
+    }
+
+    /// `estimate_lanes_into` for walks that read only the distance, whether
+    /// the orbit escaped and what it cost: the vector kernel then keeps no
+    /// orbit traps and leaves `out`'s `traps` and `end` as they were.
+    /// Distances, escapes, iterations and costs are the same bits as
+    /// `estimate_lanes_into`'s.
+    pub fn distance_lanes_into<const N: usize>(
+        &self,
+        points: &[DVec3; N],
+        scales: &[Real; N],
+        out: &mut [Estimate; N],
+    ) {
+        self.lanes_into::<N, false>(points, scales, out)
+    }
+
+    /// `estimate_lanes_into`, with orbit traps and ends or (`TRAPS` false,
+    /// in the vector kernel) without.
+    fn lanes_into<const N: usize, const TRAPS: bool>(
+        &self,
+        points: &[DVec3; N],
+        scales: &[Real; N],
+        out: &mut [Estimate; N],
+    ) {
         if let Some(reference) = self.perturbed_analytic() {
             return reference.estimates_into(self, points, scales, out);
         }
         if let (Some(precision), Some(n)) = (self.lane_analytic(), whole_power(self.power)) {
             return match precision {
-                Precision::F64 => self.analytic_lanes::<N, f64>(points, n, out),
-                Precision::F32 => self.analytic_lanes::<N, f32>(points, n, out),
+                Precision::F64 => self.analytic_lanes::<N, f64, TRAPS>(points, n, out),
+                Precision::F32 => self.analytic_lanes::<N, f32, TRAPS>(points, n, out),
             };
         }
         for ((out, &p), &scale) in out.iter_mut().zip(points).zip(scales) {
@@ -69,13 +94,13 @@ impl Fractal {
     }
 
     /// The vector kernel's analytic estimates in `E`, with their bounds.
-    fn analytic_lanes<const N: usize, E: KernelLane>(
+    fn analytic_lanes<const N: usize, E: KernelLane, const TRAPS: bool>(
         &self,
         points: &[DVec3; N],
         n: u32,
         out: &mut [Estimate; N],
     ) {
-        self.in_vectors::<N, E, _>(points, n, out);
+        self.in_vectors::<N, E, _, TRAPS>(points, n, out);
         self.bound_lanes::<E>(points, out)
     }
 
@@ -99,9 +124,10 @@ impl Fractal {
     /// `points` run through the vector kernel for whole power `n`, one
     /// vector at a time, each writing its results in place into `out`
     /// (lanes past the points start outside the bailout ball and cost no
-    /// iterations), with the iterations counted for this thread.
+    /// iterations), with the iterations counted for this thread; without
+    /// orbit traps where `TRAPS` is false.
     #[inline(always)]
-    pub(super) fn in_vectors<const N: usize, E: KernelLane, Out: Finished>(
+    pub(super) fn in_vectors<const N: usize, E: KernelLane, Out: Finished, const TRAPS: bool>(
         &self,
         points: &[DVec3; N],
         n: u32,
@@ -111,7 +137,7 @@ impl Fractal {
             // Chunks of points and of results have the same lengths.
             if let Ok(lanes) = <&[DVec3; VECTOR]>::try_from(chunk) {
                 let full = <&mut [Out; VECTOR]>::try_from(out).expect("as long as the points");
-                E::dispatch(Kernel::<E, Out> {
+                E::dispatch(Kernel::<E, Out, TRAPS> {
                     fractal: self,
                     points: lanes,
                     live: VECTOR,
@@ -122,8 +148,11 @@ impl Fractal {
             } else {
                 let lanes: [DVec3; VECTOR] =
                     std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(IDLE_POINT));
+                // Starting from `out`, which a kernel without traps leaves
+                // them in.
                 let mut full = [Out::IDLE; VECTOR];
-                E::dispatch(Kernel::<E, Out> {
+                full[..out.len()].copy_from_slice(out);
+                E::dispatch(Kernel::<E, Out, TRAPS> {
                     fractal: self,
                     points: &lanes,
                     live: chunk.len(),
@@ -163,8 +192,9 @@ const _: () = assert!(std::mem::size_of::<Stored>() == REGISTER * 8);
 /// `live` points are wanted: the rest are padding (`IDLE_POINT`), and a
 /// register of nothing but padding is loaded but neither iterated nor
 /// finished, its results left as they were (`Finished::IDLE` from
-/// `in_vectors`).
-pub(super) struct Kernel<'a, E, Out> {
+/// `in_vectors`). `TRAPS` false leaves out the orbit traps and ends
+/// (`Fractal::distance_lanes_into`).
+pub(super) struct Kernel<'a, E, Out, const TRAPS: bool> {
     pub(super) fractal: &'a Fractal,
     pub(super) points: &'a [DVec3; VECTOR],
     pub(super) live: usize,
@@ -174,7 +204,7 @@ pub(super) struct Kernel<'a, E, Out> {
     pub(super) lane: PhantomData<E>,
 }
 
-impl<E: KernelLane, Out: Finished> pulp::WithSimd for Kernel<'_, E, Out> {
+impl<E: KernelLane, Out: Finished, const TRAPS: bool> pulp::WithSimd for Kernel<'_, E, Out, TRAPS> {
     type Output = ();
 
     #[inline(always)]
@@ -187,7 +217,7 @@ impl<E: KernelLane, Out: Finished> pulp::WithSimd for Kernel<'_, E, Out> {
             out,
             lane: _,
         } = self;
-        run_vector::<S, E, Out>(simd, fractal, points, live, n, out)
+        run_vector::<S, E, Out, TRAPS>(simd, fractal, points, live, n, out)
     }
 }
 
@@ -197,13 +227,15 @@ pub(super) trait Finished: Copy {
     const IDLE: Self;
     /// The orbit iterations this result took.
     fn iterations(&self) -> u32;
-    /// `escape` is the escape radius the orbits stopped at.
+    /// `escape` is the escape radius the orbits stopped at; `traps`,
+    /// whether the register kept its orbit traps.
     fn write<S: pulp::Simd>(
         register: &Register<S>,
         fractal: &Fractal,
         points: &[DVec3],
         out: &mut [Self],
         escape: Real,
+        traps: bool,
     );
 }
 
@@ -220,6 +252,7 @@ impl Finished for Orbit<f64> {
         _: &[DVec3],
         out: &mut [Self],
         escape: Real,
+        _: bool,
     ) {
         register.finish(out, escape)
     }
@@ -237,8 +270,9 @@ impl Finished for Estimate {
         points: &[DVec3],
         out: &mut [Self],
         escape: Real,
+        traps: bool,
     ) {
-        register.estimates(fractal, points, out, escape)
+        register.estimates(fractal, points, out, escape, traps)
     }
 }
 
@@ -254,6 +288,7 @@ pub(super) trait KernelLane: Lane + Number {
         points: &[DVec3],
         out: &mut [Out],
         escape: Real,
+        traps: bool,
     );
 }
 
@@ -269,8 +304,9 @@ impl KernelLane for f64 {
         points: &[DVec3],
         out: &mut [Out],
         escape: Real,
+        traps: bool,
     ) {
-        Out::write(register, fractal, points, out, escape)
+        Out::write(register, fractal, points, out, escape, traps)
     }
 }
 
@@ -293,10 +329,12 @@ impl KernelLane for f32 {
         points: &[DVec3],
         out: &mut [Out],
         escape: Real,
+        traps: bool,
     ) {
         let wide = S::F64_LANES;
         for (k, (points, out)) in points.chunks(wide).zip(out.chunks_mut(wide)).enumerate() {
-            Out::write(&register.widened(k * wide), fractal, points, out, escape);
+            let register = register.widened(k * wide);
+            Out::write(&register, fractal, points, out, escape, traps);
         }
     }
 }
@@ -350,7 +388,7 @@ impl<S: pulp::Simd> Register<S, f32> {
 /// register, with its points, writes its lanes' results (`Finished::write`).
 /// Registers past `live` are skipped.
 #[inline(always)]
-pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
+pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished, const TRAPS: bool>(
     simd: S,
     fractal: &Fractal,
     points: &[DVec3; VECTOR],
@@ -382,34 +420,39 @@ pub(super) fn run_vector<S: pulp::Simd, E: KernelLane, Out: Finished>(
         // one whose powers unroll.
         let f = fractal;
         let (a, b) = match (f.formula, n) {
-            (Formula::Quilez, 8) => orbit_registers(simd, f, points, bound, 8, Formula::Quilez),
-            (Formula::Asin, 8) => orbit_registers(simd, f, points, bound, 8, Formula::Asin),
+            (Formula::Quilez, 8) => {
+                orbit_registers(simd, f, points, bound, 8, Formula::Quilez, TRAPS)
+            }
+            (Formula::Asin, 8) => orbit_registers(simd, f, points, bound, 8, Formula::Asin, TRAPS),
             (Formula::WhiteNylander, 8) => {
-                orbit_registers(simd, f, points, bound, 8, Formula::WhiteNylander)
+                orbit_registers(simd, f, points, bound, 8, Formula::WhiteNylander, TRAPS)
             }
             (Formula::Quaternion, 2) => {
-                orbit_registers(simd, f, points, bound, 2, Formula::Quaternion)
+                orbit_registers(simd, f, points, bound, 2, Formula::Quaternion, TRAPS)
             }
-            (Formula::Quilez, n) => orbit_registers(simd, f, points, bound, n, Formula::Quilez),
-            (Formula::Asin, n) => orbit_registers(simd, f, points, bound, n, Formula::Asin),
+            (Formula::Quilez, n) => {
+                orbit_registers(simd, f, points, bound, n, Formula::Quilez, TRAPS)
+            }
+            (Formula::Asin, n) => orbit_registers(simd, f, points, bound, n, Formula::Asin, TRAPS),
             (Formula::WhiteNylander, n) => {
-                orbit_registers(simd, f, points, bound, n, Formula::WhiteNylander)
+                orbit_registers(simd, f, points, bound, n, Formula::WhiteNylander, TRAPS)
             }
             (Formula::Quaternion, n) => {
-                orbit_registers(simd, f, points, bound, n, Formula::Quaternion)
+                orbit_registers(simd, f, points, bound, n, Formula::Quaternion, TRAPS)
             }
         };
         let (first, second) = out.split_at_mut(lanes);
-        E::write(&a, f, &points[..lanes], first, escape);
+        E::write(&a, f, &points[..lanes], first, escape, TRAPS);
         // A second register of padding alone has stayed where it started.
         if live > (2 * pair + 1) * lanes {
-            E::write(&b, f, &points[lanes..], second, escape);
+            E::write(&b, f, &points[lanes..], second, escape, TRAPS);
         }
     }
 }
 
 /// Two registers of orbits iterated in one loop (see `Register`), stopping
-/// at `bound` (`Lane::escape_bound` of the squared escape radius).
+/// at `bound` (`Lane::escape_bound` of the squared escape radius), keeping
+/// orbit traps where `traps` asks.
 #[inline(always)]
 pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     simd: S,
@@ -418,6 +461,7 @@ pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
     bound: E,
     n: u32,
     formula: Formula,
+    traps: bool,
 ) -> (Register<S, E>, Register<S, E>) {
     let lanes = points.len() / 2;
     let mut a = Register::start(simd, fractal, &points[..lanes]);
@@ -430,10 +474,10 @@ pub(super) fn orbit_registers<S: pulp::Simd, E: Lane + Number>(
             break;
         }
         if run_a {
-            a.step(formula, n);
+            a.step(formula, n, traps);
         }
         if run_b {
-            b.step(formula, n);
+            b.step(formula, n, traps);
         }
     }
     (a, b)
@@ -545,9 +589,10 @@ impl<S: pulp::Simd, E: Lane + Number> Register<S, E> {
         E::past(self.simd, self.r2.1, E::splat(self.simd, bound))
     }
 
-    /// `OrbitState::step` on the running lanes.
+    /// `OrbitState::step` on the running lanes; the traps stay as they
+    /// started unless `traps` asks.
     #[inline(always)]
-    pub(super) fn step(&mut self, formula: Formula, n: u32) {
+    pub(super) fn step(&mut self, formula: Formula, n: u32, traps: bool) {
         let simd = self.simd;
         let (one, infinity) = (self.splat(1.0), self.splat(Real::INFINITY));
         let (z, running) = (self.z, self.running);
@@ -570,16 +615,8 @@ impl<S: pulp::Simd, E: Lane + Number> Register<S, E> {
                 w[axis] = self.select(near_axis, fixed, w[axis]);
             }
         }
-        // The traps, as the scalar step: f64::min for the origin trap (a NaN never
-        // replaces a number), glam's `if a < b { a } else { b }` for the
-        // planes (a NaN |z| does).
-        let lesser =
-            |a: Vector<S, E>, b: Vector<S, E>| E::select(simd, E::less(simd, a.1, b.1), a.1, b.1);
-        let origin = lesser(self.r2, self.origin);
-        self.origin = Vector(simd, E::select(simd, running, origin, self.origin.1));
-        for (plane, z) in self.planes.iter_mut().zip(z) {
-            let next = lesser(*plane, Vector(simd, E::abs(simd, z.1)));
-            *plane = Vector(simd, E::select(simd, running, next, plane.1));
+        if traps {
+            self.trap(z);
         }
         let power = self.splat(n as Real);
         let dr = power * powi(self.r, n - 1, |a, b| a * b) * self.dr + self.splat(self.plus_one);
@@ -593,6 +630,24 @@ impl<S: pulp::Simd, E: Lane + Number> Register<S, E> {
             self.z[axis] = self.select(running, next_z[axis], z[axis]);
         }
         self.i = self.select(running, self.i + one, self.i);
+    }
+}
+
+impl<S: pulp::Simd, E: Lane + Number> Register<S, E> {
+    /// The running lanes' traps updated with `z`, as the scalar step: f64::min
+    /// for the origin trap (a NaN never replaces a number), glam's
+    /// `if a < b { a } else { b }` for the planes (a NaN |z| does).
+    #[inline(always)]
+    fn trap(&mut self, z: Triplex<Vector<S, E>>) {
+        let (simd, running) = (self.simd, self.running);
+        let lesser =
+            |a: Vector<S, E>, b: Vector<S, E>| E::select(simd, E::less(simd, a.1, b.1), a.1, b.1);
+        let origin = lesser(self.r2, self.origin);
+        self.origin = Vector(simd, E::select(simd, running, origin, self.origin.1));
+        for (plane, z) in self.planes.iter_mut().zip(z) {
+            let next = lesser(*plane, Vector(simd, E::abs(simd, z.1)));
+            *plane = Vector(simd, E::select(simd, running, next, plane.1));
+        }
     }
 }
 
@@ -619,7 +674,8 @@ impl<S: pulp::Simd> Register<S, f64> {
     /// and division taken in the registers, and so is the choice among its
     /// cases and the traps' ending (`Orbit::ended`), exact as selections;
     /// a point outside the bailout from the start, which is rare, goes
-    /// lane by lane.
+    /// lane by lane. Without `traps` (the register kept none), `out`'s
+    /// traps and ends are left as they were.
     #[inline(always)]
     pub(super) fn estimates(
         &self,
@@ -627,6 +683,7 @@ impl<S: pulp::Simd> Register<S, f64> {
         points: &[DVec3],
         out: &mut [Estimate],
         escape: Real,
+        traps: bool,
     ) {
         // The analytic estimator is the only one finished here
         // (`estimate_lanes_into` sends the others one point at a time).
@@ -656,6 +713,39 @@ impl<S: pulp::Simd> Register<S, f64> {
         );
         let distance = self.select(usual, raw, zero);
         let rare = simd.and_m64s(escaped, simd.not_m64s(stepped));
+        let store = Self::store;
+        let (distance, i) = (store(distance), store(self.i));
+        let escaped = store(self.select(escaped, one, zero));
+        if traps {
+            self.write_with_traps(out, &distance, &i, &escaped);
+        } else {
+            for (k, out) in out.iter_mut().enumerate() {
+                out.distance = distance[k];
+                out.iterations = i[k] as u32;
+                out.escaped = escaped[k] != 0.0;
+                out.orbits = 1;
+            }
+        }
+        if self.any(rare) {
+            let rare = store(self.select(rare, one, zero));
+            for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
+                out[k].distance = distance_to_ball(points[k], escape);
+            }
+        }
+    }
+
+    /// The estimates of `estimates` (their stored distances, iterations and
+    /// escapes) with the finished orbits' traps and ends, into `out`.
+    #[inline(always)]
+    fn write_with_traps(
+        &self,
+        out: &mut [Estimate],
+        distance: &Stored,
+        i: &Stored,
+        escaped: &Stored,
+    ) {
+        let simd = self.simd;
+        let infinity = self.splat(Real::INFINITY);
         // `OrbitTraps::ended`: an orbit whose origin trap is still +∞ met
         // no trap and takes those of where it ended (its |z|² is `r2`,
         // computed as `length_squared` computes it).
@@ -668,10 +758,8 @@ impl<S: pulp::Simd> Register<S, f64> {
             let end = Vector(simd, simd.abs_f64s(z.1));
             *plane = Self::store(self.select(untrapped, end, met));
         }
-        let store = Self::store;
-        let (distance, origin) = (store(distance), store(origin));
-        let (i, escaped) = (store(self.i), store(self.select(escaped, one, zero)));
-        let end = self.z.map(store);
+        let origin = Self::store(origin);
+        let end = self.z.map(Self::store);
         for (k, out) in out.iter_mut().enumerate() {
             *out = Estimate {
                 distance: distance[k],
@@ -684,12 +772,6 @@ impl<S: pulp::Simd> Register<S, f64> {
                 orbits: 1,
                 end: [end[0][k], end[1][k], end[2][k]],
             };
-        }
-        if self.any(rare) {
-            let rare = store(self.select(rare, one, zero));
-            for k in (0..out.len()).filter(|&k| rare[k] != 0.0) {
-                out[k].distance = distance_to_ball(points[k], escape);
-            }
         }
     }
 }

@@ -236,7 +236,9 @@ pub fn power8_polynomial<T: Number>(w: Triplex<T>) -> Option<Triplex<T>> {
 /// `n` as a whole number in 2..=64, if it is one.
 #[inline]
 pub fn whole_power(n: Real) -> Option<u32> {
-    (n.fract() == 0.0 && (2.0..=64.0).contains(&n)).then_some(n as u32)
+    // Compared through the integer, not `fract`, which is a call into libm
+    // on x86-64's baseline, once per call of the lane kernel.
+    ((2.0..=64.0).contains(&n) && (n as u32) as Real == n).then_some(n as u32)
 }
 
 /// One power step for a whole exponent `n`: (zⁿ, rⁿ⁻¹), the second for the

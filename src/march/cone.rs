@@ -200,6 +200,7 @@ impl ConeWalk {
 
 impl Walk for ConeWalk {
     type Output = (Real, u32);
+    const READS_ORBIT: bool = false;
 
     fn next_point(&self) -> (DVec3, Real) {
         (self.axis.at(self.t), self.axis.footprint(self.t))

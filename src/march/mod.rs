@@ -463,6 +463,8 @@ impl Marcher {
 
 impl Walk for Marcher {
     type Output = MarchResult;
+    // A hit carries its estimate's traps and end to shading.
+    const READS_ORBIT: bool = true;
 
     fn next_point(&self) -> (DVec3, Real) {
         if let (Some(check), Some((t, _))) = (&self.check, self.nearest) {

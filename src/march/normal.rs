@@ -37,7 +37,8 @@ pub fn normals_many<'h>(
             footprints[4 * k..4 * k + 4].fill(f);
             *slot = Some(hit);
         }
-        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
+        // A normal reads only the distances.
+        fractal.distance_lanes_into(&points, &footprints, &mut estimates);
         for (k, &(i, ray, hit)) in batch.iter().flatten().enumerate() {
             out(i, ray, hit, normal_from(ray, &estimates[4 * k..4 * k + 4]));
         }

@@ -10,6 +10,11 @@ use crate::math::{DVec3, Real};
 /// takes the same steps whichever does.
 pub trait Walk: Copy {
     type Output;
+    /// Whether `advance` reads an estimate's orbit traps or the end of its
+    /// orbit. `walk_many` takes estimates without them for walks that do
+    /// not (`Fractal::distance_lanes_into`), which the kernel works out
+    /// faster.
+    const READS_ORBIT: bool;
     /// The point to estimate next and its pixel footprint.
     fn next_point(&self) -> (DVec3, Real);
     /// Takes the estimate at `next_point` (and its footprint, as
@@ -83,7 +88,11 @@ pub fn walk_many<W: Walk>(
                 (*point, *footprint) = walk.next_point();
             }
         }
-        fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
+        if W::READS_ORBIT {
+            fractal.estimate_lanes_into(&points, &footprints, &mut estimates);
+        } else {
+            fractal.distance_lanes_into(&points, &footprints, &mut estimates);
+        }
         for ((lane, estimate), &footprint) in lanes.iter_mut().zip(&estimates).zip(&footprints) {
             if let Some((i, walk)) = lane {
                 if let Some(output) = walk.advance(estimate, footprint, fractal, settings) {

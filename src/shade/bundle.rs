@@ -265,6 +265,7 @@ struct Climb {
 impl Walk for Climb {
     /// The walk's outcome, or the walk paused.
     type Output = Result<(f32, u64), ShadowWalk>;
+    const READS_ORBIT: bool = false;
 
     fn next_point(&self) -> (DVec3, Real) {
         self.walk.next_point()
@@ -322,6 +323,7 @@ struct AxisWalk {
 
 impl Walk for AxisWalk {
     type Output = Stop;
+    const READS_ORBIT: bool = false;
 
     fn next_point(&self) -> (DVec3, Real) {
         let b = &self.bundle;

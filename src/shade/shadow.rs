@@ -131,6 +131,7 @@ impl ShadowWalk {
 
 impl crate::march::Walk for ShadowWalk {
     type Output = (f32, u64);
+    const READS_ORBIT: bool = false;
 
     fn next_point(&self) -> (DVec3, Real) {
         (self.from + self.to_light * self.t, self.footprint)
@@ -254,6 +255,7 @@ impl OcclusionWalk {
 
 impl crate::march::Walk for OcclusionWalk {
     type Output = (usize, (f32, u64));
+    const READS_ORBIT: bool = false;
 
     fn next_point(&self) -> (DVec3, Real) {
         (self.point + self.normal * self.along, self.footprint)

@@ -187,7 +187,7 @@ fn every_instruction_set_gives_the_scalar_orbit_bit_for_bit() {
                 let mut out = ([Orbit::IDLE; VECTOR], [Estimate::IDLE; VECTOR]);
                 let fractal = f;
                 let points = &points;
-                Kernel::<f64, _> {
+                Kernel::<f64, _, true> {
                     fractal,
                     points,
                     live,
@@ -196,7 +196,7 @@ fn every_instruction_set_gives_the_scalar_orbit_bit_for_bit() {
                     lane: PhantomData,
                 }
                 .with_simd(simd);
-                Kernel::<f64, _> {
+                Kernel::<f64, _, true> {
                     fractal,
                     points,
                     live,
@@ -246,7 +246,6 @@ fn the_f32_kernel_gives_the_scalar_f32_estimate_bit_for_bit_on_each_instruction_
     // f32 orbits in registers of eight (AVX2) or one at a time (scalar),
     // widened to finish in f64, against `estimate` in f32 one point at a
     // time: every field, to the bit, with padding lanes left alone.
-    use pulp::WithSimd;
     let mut pts = points(192, 0.0..2.5, 11);
     pts.extend([
         DVec3::new(0.0, 0.0, 0.7),
@@ -292,33 +291,12 @@ fn the_f32_kernel_gives_the_scalar_f32_estimate_bit_for_bit_on_each_instruction_
             ..Fractal::default()
         }),
     ] {
-        let n = whole_power(f.power).unwrap();
         for chunk in pts.chunks_exact(VECTOR) {
             let points: [DVec3; VECTOR] = chunk.try_into().unwrap();
             let expected: Vec<String> = points
                 .iter()
                 .map(|&p| format!("{:?}", f.estimate(p, 1e-4)))
                 .collect();
-            fn on<S: pulp::Simd>(
-                simd: S,
-                f: &Fractal,
-                points: &[DVec3; VECTOR],
-                live: usize,
-                n: u32,
-            ) -> [Estimate; VECTOR] {
-                let mut out = [Estimate::IDLE; VECTOR];
-                Kernel::<f32, _> {
-                    fractal: f,
-                    points,
-                    live,
-                    n,
-                    out: &mut out,
-                    lane: PhantomData,
-                }
-                .with_simd(simd);
-                f.bound_lanes::<f32>(&points[..live], &mut out[..live]);
-                out
-            }
             let check = |estimates: [Estimate; VECTOR], live: usize, width: usize, arch: &str| {
                 let skipped = live.next_multiple_of(width);
                 for (k, e) in estimates.iter().enumerate() {
@@ -334,16 +312,148 @@ fn the_f32_kernel_gives_the_scalar_f32_estimate_bit_for_bit_on_each_instruction_
             check(dispatched, VECTOR, VECTOR, "dispatched");
             for live in [VECTOR, 1, 5, 8, 9, 13] {
                 check(
-                    on(pulp::Scalar::new(), &f, &points, live, n),
+                    kernel_estimates::<_, f32, true>(pulp::Scalar::new(), &f, &points, live, IDLE),
                     live,
                     1,
                     "scalar",
                 );
                 #[cfg(target_arch = "x86_64")]
                 if let Some(v3) = pulp::x86::V3::try_new() {
-                    check(on(v3, &f, &points, live, n), live, 8, "AVX2");
+                    let estimates = kernel_estimates::<_, f32, true>(v3, &f, &points, live, IDLE);
+                    check(estimates, live, 8, "AVX2");
                 }
             }
         }
     }
+}
+
+#[test]
+fn estimates_without_traps_keep_every_other_field_bit_for_bit_on_each_instruction_set() {
+    // The kernel without orbit traps (`distance_lanes_into`, for walks
+    // that read only distances) against the kernel with them, on every
+    // instruction set and in both lane floats: the same distance,
+    // iterations, escape and cost to the bit, and `out`'s traps and ends
+    // left as they were.
+    let mut pts = points(160, 0.0..2.5, 13);
+    pts.extend([
+        DVec3::new(0.0, 0.0, 0.7),
+        DVec3::ZERO,
+        DVec3::new(40.0, -3.0, 2.0),
+        IDLE_POINT,
+        DVec3::splat(Real::NAN),
+    ]);
+    pts.resize(
+        pts.len().next_multiple_of(VECTOR),
+        DVec3::new(0.3, 0.2, -0.1),
+    );
+    let before = Estimate {
+        traps: OrbitTraps {
+            origin: 7.0,
+            planes: DVec3::new(5.0, 6.0, 7.0),
+        },
+        end: [9.0, -9.0, 8.0],
+        ..Estimate::IDLE
+    };
+    fn compare(with: &[Estimate], without: &[Estimate], before: &Estimate, what: &str) {
+        for (k, (a, b)) in with.iter().zip(without).enumerate() {
+            let fields = |e: &Estimate| (e.distance.to_bits(), e.iterations, e.escaped, e.orbits);
+            assert_eq!(fields(a), fields(b), "{what}, lane {k}");
+            let orbit = |e: &Estimate| format!("{:?} {:?}", e.traps, e.end);
+            assert_eq!(orbit(b), orbit(before), "{what}, lane {k}");
+        }
+    }
+    fn both<S: pulp::Simd, E: KernelLane>(
+        simd: S,
+        f: &Fractal,
+        points: &[DVec3; VECTOR],
+        before: Estimate,
+        what: &str,
+    ) {
+        for live in [VECTOR, 1, 5, 9, 13] {
+            let with = kernel_estimates::<S, E, true>(simd, f, points, live, before);
+            let without = kernel_estimates::<S, E, false>(simd, f, points, live, before);
+            compare(
+                &with[..live],
+                &without[..live],
+                &before,
+                &format!("{what} {live}"),
+            );
+        }
+    }
+    let mut fractals = variants();
+    let f64_ones = fractals.clone();
+    fractals.extend(f64_ones.into_iter().map(|f| Fractal {
+        precision: Precision::F32,
+        ..f
+    }));
+    let mut met_traps = 0;
+    for f in fractals.iter().filter(|f| whole_power(f.power).is_some()) {
+        for chunk in pts.chunks_exact(VECTOR) {
+            let points: &[DVec3; VECTOR] = chunk.try_into().unwrap();
+            // What rendering runs.
+            let mut with = [before; VECTOR];
+            let mut without = [before; VECTOR];
+            f.estimate_lanes_into(points, &[1e-4; VECTOR], &mut with);
+            f.distance_lanes_into(points, &[1e-4; VECTOR], &mut without);
+            if f.lane_analytic().is_none() {
+                // Estimated one point at a time, traps and all.
+                assert_eq!(format!("{with:?}"), format!("{without:?}"));
+                continue;
+            }
+            met_traps += with.iter().filter(|e| e.traps.origin.is_finite()).count();
+            compare(&with, &without, &before, &format!("{f:?} dispatched"));
+            // Fewer points than a call takes: the rest of the call is padding.
+            let short: &[DVec3; 5] = chunk[..5].try_into().unwrap();
+            let (mut with, mut without) = ([before; 5], [before; 5]);
+            f.estimate_lanes_into(short, &[1e-4; 5], &mut with);
+            f.distance_lanes_into(short, &[1e-4; 5], &mut without);
+            compare(&with, &without, &before, &format!("{f:?} 5 points"));
+            let what = format!("{f:?}");
+            match f.precision {
+                Precision::F64 => both::<_, f64>(pulp::Scalar::new(), f, points, before, &what),
+                Precision::F32 => both::<_, f32>(pulp::Scalar::new(), f, points, before, &what),
+            }
+            #[cfg(target_arch = "x86_64")]
+            if let Some(v3) = pulp::x86::V3::try_new() {
+                match f.precision {
+                    Precision::F64 => both::<_, f64>(v3, f, points, before, &what),
+                    Precision::F32 => both::<_, f32>(v3, f, points, before, &what),
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            if let (Some(v4), Precision::F64) = (pulp::x86::V4::try_new(), f.precision) {
+                both::<_, f64>(v4, f, points, before, &what);
+            }
+        }
+    }
+    // The kernel with traps did write traps, so leaving them is a change.
+    assert!(met_traps > 0);
+}
+
+const IDLE: Estimate = Estimate::IDLE;
+
+/// The kernel's estimates of the first `live` of `points` on `simd`, in
+/// `E`, with traps or (`TRAPS` false) without, finished as
+/// `estimate_lanes_into` finishes them, into an array of `fill`.
+fn kernel_estimates<S: pulp::Simd, E: KernelLane, const TRAPS: bool>(
+    simd: S,
+    f: &Fractal,
+    points: &[DVec3; VECTOR],
+    live: usize,
+    fill: Estimate,
+) -> [Estimate; VECTOR] {
+    use pulp::WithSimd;
+    let mut out = [fill; VECTOR];
+    let n = whole_power(f.power).expect("a whole power");
+    Kernel::<E, _, TRAPS> {
+        fractal: f,
+        points,
+        live,
+        n,
+        out: &mut out,
+        lane: PhantomData,
+    }
+    .with_simd(simd);
+    f.bound_lanes::<E>(&points[..live], &mut out[..live]);
+    out
 }
