@@ -52,7 +52,8 @@ pub fn walk_one<W: Walk>(
 }
 
 /// Drives many walks, `VECTOR` at a time (one call of the lane kernel): each step's estimates are taken
-/// side by side through `Fractal::estimate_lanes_into`, and a lane whose walk
+/// side by side through `Fractal::estimate_lanes_into` (`distance_lanes_into`
+/// for walks that do not read the orbit), and a lane whose walk
 /// ends takes the next walk at once, so the lanes stay full. Each walk's
 /// output, bit-identical to `walk_one`'s, goes to `done` with its index
 /// (walks that end at the start included), in the order walks end.
