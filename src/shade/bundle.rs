@@ -265,7 +265,8 @@ struct Climb {
 impl Walk for Climb {
     /// The walk's outcome, or the walk paused.
     type Output = Result<(f32, u64), ShadowWalk>;
-    const READS_ORBIT: bool = false;
+    // It hands each estimate to the shadow walk it drives.
+    const READS_ORBIT: bool = ShadowWalk::READS_ORBIT;
 
     fn next_point(&self) -> (DVec3, Real) {
         self.walk.next_point()
